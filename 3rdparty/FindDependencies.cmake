@@ -1,0 +1,18 @@
+# Every dependency comes from a Debian 12 package (scripts/setup.sh installs them).
+# Versions seen on Debian 12: fmt 9.1, Eigen 3.4, nlohmann-json 3.11, CLI11 2.3,
+# libpng 1.6, GoogleTest 1.12, Google Benchmark 1.7. No sources are vendored here.
+
+find_package(Threads REQUIRED)
+find_package(fmt 9 REQUIRED)
+find_package(Eigen3 3.3 REQUIRED NO_MODULE)
+find_package(nlohmann_json 3 REQUIRED)
+find_package(CLI11 REQUIRED)
+find_package(PNG REQUIRED)
+
+# Eigen's headers are included as SYSTEM through its imported target already.
+if(OPEN3D_BUILD_TESTS)
+  find_package(GTest REQUIRED)
+endif()
+if(OPEN3D_BUILD_BENCHMARKS)
+  find_package(benchmark REQUIRED)
+endif()

@@ -1,0 +1,28 @@
+# Helpers that give every target of ours the same warnings and sanitizer flags.
+# Third-party headers come in as SYSTEM includes so -Werror only judges our code.
+
+function(open3d_set_target_flags target)
+  target_compile_options(${target} PRIVATE -Wall -Wextra -Werror)
+  if(OPEN3D_SANITIZE)
+    target_compile_options(${target} PRIVATE -fsanitize=address,undefined -fno-omit-frame-pointer
+                                             -fno-sanitize-recover=undefined)
+    target_link_options(${target} PRIVATE -fsanitize=address,undefined)
+  endif()
+endfunction()
+
+# open3d_add_library(name SOURCES ... DEPS ...): one library per layer.
+function(open3d_add_library name)
+  cmake_parse_arguments(ARG "" "" "SOURCES;DEPS;SYSTEM_DEPS" ${ARGN})
+  add_library(${name} STATIC ${ARG_SOURCES})
+  target_include_directories(${name} PUBLIC ${CMAKE_SOURCE_DIR}/cpp)
+  target_link_libraries(${name} PUBLIC ${ARG_DEPS} ${ARG_SYSTEM_DEPS})
+  set_target_properties(${name} PROPERTIES POSITION_INDEPENDENT_CODE ON)
+  open3d_set_target_flags(${name})
+endfunction()
+
+function(open3d_add_executable name)
+  cmake_parse_arguments(ARG "" "" "SOURCES;DEPS" ${ARGN})
+  add_executable(${name} ${ARG_SOURCES})
+  target_link_libraries(${name} PRIVATE ${ARG_DEPS})
+  open3d_set_target_flags(${name})
+endfunction()

@@ -1,0 +1,48 @@
+// Levelled logging through fmt, with a replaceable sink so tests can count messages.
+#pragma once
+
+#include <fmt/format.h>
+
+#include <functional>
+#include <string>
+#include <string_view>
+
+namespace open3d {
+namespace core {
+
+enum class LogLevel { Debug = 0, Info = 1, Warning = 2, Error = 3 };
+
+using LogSink = std::function<void(LogLevel, std::string_view)>;
+
+/// Messages below this level are dropped. Default: Info (env OPEN3D_LOG_LEVEL=debug lowers it).
+void SetLogLevel(LogLevel level);
+LogLevel GetLogLevel();
+
+/// Replaces the sink (default: stderr with a level prefix). Returns the previous sink.
+/// Pass nullptr to restore the default.
+LogSink SetLogSink(LogSink sink);
+
+void LogMessage(LogLevel level, std::string_view message);
+
+template <typename... Args>
+void LogDebug(fmt::format_string<Args...> format, Args&&... args) {
+    if (GetLogLevel() <= LogLevel::Debug)
+        LogMessage(LogLevel::Debug, fmt::format(format, std::forward<Args>(args)...));
+}
+template <typename... Args>
+void LogInfo(fmt::format_string<Args...> format, Args&&... args) {
+    if (GetLogLevel() <= LogLevel::Info)
+        LogMessage(LogLevel::Info, fmt::format(format, std::forward<Args>(args)...));
+}
+template <typename... Args>
+void LogWarning(fmt::format_string<Args...> format, Args&&... args) {
+    if (GetLogLevel() <= LogLevel::Warning)
+        LogMessage(LogLevel::Warning, fmt::format(format, std::forward<Args>(args)...));
+}
+template <typename... Args>
+void LogError(fmt::format_string<Args...> format, Args&&... args) {
+    LogMessage(LogLevel::Error, fmt::format(format, std::forward<Args>(args)...));
+}
+
+}  // namespace core
+}  // namespace open3d

@@ -1,0 +1,87 @@
+// A point cloud with named per-point attributes; with the Gaussian attributes present
+// it is a 3D Gaussian Splatting scene.
+#pragma once
+
+#include <Eigen/Core>
+
+#include <map>
+#include <string>
+#include <vector>
+
+#include "open3d/core/Tensor.h"
+
+namespace open3d {
+namespace t {
+namespace geometry {
+
+/// Attribute names of a Gaussian splat cloud (Open3D's names).
+/// Shapes: positions [N,3]; scale [N,3] linear; rot [N,4] unit quaternion (w,x,y,z);
+/// opacity [N,1] logit (sigmoid applied when packing for the GPU); f_dc [N,3];
+/// f_rest [N,Nc,3] with Nc = (degree+1)^2 - 1, degree 1..3 (absent for degree 0).
+namespace gs_attr {
+inline constexpr const char* kPositions = "positions";
+inline constexpr const char* kScale = "scale";
+inline constexpr const char* kRot = "rot";
+inline constexpr const char* kOpacity = "opacity";
+inline constexpr const char* kFDc = "f_dc";
+inline constexpr const char* kFRest = "f_rest";
+}  // namespace gs_attr
+
+/// Number of f_rest coefficients per channel for an SH degree: (degree+1)^2 - 1.
+inline int NumSHRestCoeffs(int degree) { return (degree + 1) * (degree + 1) - 1; }
+
+class PointCloud {
+public:
+    PointCloud() = default;
+    /// positions: [N, 3] Float32.
+    explicit PointCloud(const core::Tensor& positions);
+
+    int64_t NumPoints() const;
+    bool IsEmpty() const { return NumPoints() == 0; }
+
+    const core::Tensor& GetPointPositions() const { return GetPointAttr(gs_attr::kPositions); }
+    void SetPointPositions(const core::Tensor& positions) {
+        SetPointAttr(gs_attr::kPositions, positions);
+    }
+
+    bool HasPointAttr(const std::string& name) const { return attrs_.count(name) > 0; }
+    /// Throws Open3DError when the attribute is missing.
+    const core::Tensor& GetPointAttr(const std::string& name) const;
+    core::Tensor& GetPointAttr(const std::string& name);
+    /// The first dimension must equal NumPoints() unless the cloud has no positions yet.
+    void SetPointAttr(const std::string& name, const core::Tensor& value);
+    void RemovePointAttr(const std::string& name) { attrs_.erase(name); }
+    std::vector<std::string> GetPointAttrNames() const;
+
+    /// True when scale, rot, opacity and f_dc exist (f_rest optional) with valid shapes.
+    bool IsGaussianSplat() const;
+    /// SH degree 0..3 from the f_rest shape. Throws if the cloud is not a valid splat cloud.
+    int GaussianSplatGetSHOrder() const;
+    /// Throws Open3DError naming the first attribute whose dtype or shape is wrong.
+    void ValidateGaussianSplat() const;
+
+    // Geometric transforms (PointCloudTransform.cpp). For splat clouds every Gaussian
+    // attribute follows: see docs/DESIGN.md "Transforms".
+
+    /// Moves positions by t (relative) or so that their mean lands on t (relative = false).
+    PointCloud& Translate(const Eigen::Vector3d& translation, bool relative = true);
+    /// Proper rotation R (det +1, orthonormal) about center: positions rotate, rot is
+    /// left-multiplied by q_R, f_rest is rotated band by band. Throws for any other matrix
+    /// and leaves the cloud unchanged.
+    PointCloud& Rotate(const Eigen::Matrix3d& R, const Eigen::Vector3d& center);
+    /// Uniform scale s about center: scale *= |s|; s < 0 negates odd SH bands (parity).
+    PointCloud& Scale(double scale, const Eigen::Vector3d& center);
+    /// General 4x4 transform of positions only; warns for splat clouds (attributes unchanged).
+    PointCloud& Transform(const Eigen::Matrix4d& transformation);
+    /// Mean of positions (zero for an empty cloud).
+    Eigen::Vector3d GetCenter() const;
+
+    bool operator==(const PointCloud& other) const { return attrs_ == other.attrs_; }
+
+private:
+    std::map<std::string, core::Tensor> attrs_;
+};
+
+}  // namespace geometry
+}  // namespace t
+}  // namespace open3d

@@ -1,0 +1,1 @@
+#include "open3d/t/io/PointCloudIO.h"

@@ -1,0 +1,31 @@
+#include "TestUtility.h"
+
+#include <cstdlib>
+#include <filesystem>
+
+namespace open3d {
+namespace tests {
+
+std::string DataDir() {
+    if (const char* env = std::getenv("OPEN3D_DATA_DIR")) return env;
+    return OPEN3D_DATA_DIR;
+}
+
+std::string DataPath(const std::string& relative) { return DataDir() + "/" + relative; }
+
+bool FileExists(const std::string& path) { return std::filesystem::exists(path); }
+
+std::string TempDir() {
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    std::string name = info ? std::string(info->test_suite_name()) + "." + info->name() : "misc";
+    for (char& c : name) {
+        if (c == '/') c = '_';
+    }
+    const auto dir = std::filesystem::current_path() / "test_tmp" / name;
+    std::filesystem::remove_all(dir);
+    std::filesystem::create_directories(dir);
+    return dir.string();
+}
+
+}  // namespace tests
+}  // namespace open3d
