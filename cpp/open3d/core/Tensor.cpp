@@ -2,6 +2,9 @@
 
 #include <fmt/format.h>
 
+#include <sys/mman.h>
+
+#include <cstdlib>
 #include <cstring>
 
 #include "open3d/core/Exception.h"
@@ -26,10 +29,52 @@ static int64_t CountElements(const SizeVector& shape) {
     return n;
 }
 
+namespace {
+
+constexpr size_t kHugePage = size_t(2) << 20;
+
+uint8_t* Allocate(int64_t num_bytes) {
+    if (num_bytes == 0) return nullptr;
+    const size_t align = num_bytes >= int64_t(kHugePage) ? kHugePage : 64;
+    const size_t size = (size_t(num_bytes) + align - 1) / align * align;
+    void* p = std::aligned_alloc(align, size);
+    if (p == nullptr) ThrowError("Tensor: cannot allocate {} bytes", num_bytes);
+    // A 4 KiB page fault costs ~10 us on our VMs; a 2 MiB one amortises that 512 times.
+    if (align == kHugePage) madvise(p, size, MADV_HUGEPAGE);
+    return static_cast<uint8_t*>(p);
+}
+
+}  // namespace
+
+void Tensor::Free::operator()(uint8_t* p) const { std::free(p); }
+
 Tensor::Tensor() = default;
 
-Tensor::Tensor(const SizeVector& shape, Dtype dtype)
-    : dtype_(dtype), shape_(shape), bytes_(CountElements(shape) * DtypeSize(dtype), 0) {}
+Tensor::Tensor(const SizeVector& shape, Dtype dtype) : Tensor(Empty(shape, dtype)) {
+    if (num_bytes_ > 0) std::memset(bytes_.get(), 0, num_bytes_);
+}
+
+Tensor Tensor::Empty(const SizeVector& shape, Dtype dtype) {
+    Tensor t;
+    t.dtype_ = dtype;
+    t.shape_ = shape;
+    t.num_bytes_ = CountElements(shape) * DtypeSize(dtype);
+    t.bytes_.reset(Allocate(t.num_bytes_));
+    return t;
+}
+
+Tensor::Tensor(const Tensor& other)
+    : dtype_(other.dtype_),
+      shape_(other.shape_),
+      bytes_(Allocate(other.num_bytes_)),
+      num_bytes_(other.num_bytes_) {
+    if (num_bytes_ > 0) std::memcpy(bytes_.get(), other.bytes_.get(), num_bytes_);
+}
+
+Tensor& Tensor::operator=(const Tensor& other) {
+    if (this != &other) *this = Tensor(other);
+    return *this;
+}
 
 int64_t Tensor::NumElements() const { return CountElements(shape_); }
 
@@ -44,7 +89,8 @@ Tensor Tensor::Reshape(const SizeVector& shape) const {
 }
 
 bool Tensor::operator==(const Tensor& other) const {
-    return dtype_ == other.dtype_ && shape_ == other.shape_ && bytes_ == other.bytes_;
+    return dtype_ == other.dtype_ && shape_ == other.shape_ &&
+           (num_bytes_ == 0 || std::memcmp(bytes_.get(), other.bytes_.get(), num_bytes_) == 0);
 }
 
 void Tensor::CheckDtype(Dtype dtype) const {

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -36,6 +37,14 @@ public:
     Tensor();
     /// Zero-initialised tensor. Negative dimensions are an error.
     Tensor(const SizeVector& shape, Dtype dtype);
+    /// Uninitialised tensor, for producers that write every element anyway (readers):
+    /// skips a pass over memory that the first touch pays for again.
+    static Tensor Empty(const SizeVector& shape, Dtype dtype);
+
+    Tensor(const Tensor& other);
+    Tensor& operator=(const Tensor& other);
+    Tensor(Tensor&& other) noexcept = default;
+    Tensor& operator=(Tensor&& other) noexcept = default;
 
     template <typename T>
     static Tensor FromVector(const std::vector<T>& values, const SizeVector& shape) {
@@ -50,21 +59,21 @@ public:
     int64_t GetShape(int dim) const { return shape_.at(dim); }
     int64_t NumDims() const { return static_cast<int64_t>(shape_.size()); }
     int64_t NumElements() const;
-    int64_t NumBytes() const { return static_cast<int64_t>(bytes_.size()); }
+    int64_t NumBytes() const { return num_bytes_; }
 
     /// Typed access; throws Open3DError when T does not match the dtype.
     template <typename T>
     T* Data() {
         CheckDtype(DtypeOf<T>());
-        return reinterpret_cast<T*>(bytes_.data());
+        return reinterpret_cast<T*>(bytes_.get());
     }
     template <typename T>
     const T* Data() const {
         CheckDtype(DtypeOf<T>());
-        return reinterpret_cast<const T*>(bytes_.data());
+        return reinterpret_cast<const T*>(bytes_.get());
     }
-    void* RawData() { return bytes_.data(); }
-    const void* RawData() const { return bytes_.data(); }
+    void* RawData() { return bytes_.get(); }
+    const void* RawData() const { return bytes_.get(); }
 
     /// Same elements, new shape with the same element count.
     Tensor Reshape(const SizeVector& shape) const;
@@ -79,8 +88,13 @@ private:
 
     Dtype dtype_ = Dtype::Float32;
     SizeVector shape_{0};
-    // operator new aligns to __STDCPP_DEFAULT_NEW_ALIGNMENT__ (16), enough for float.
-    std::vector<uint8_t> bytes_;
+    struct Free {
+        void operator()(uint8_t* p) const;
+    };
+    // 64-byte aligned; buffers of 2 MiB and more ask for transparent huge pages, because
+    // first-touch page faults dominate reading large scenes (see docs/environment-notes.md).
+    std::unique_ptr<uint8_t[], Free> bytes_;
+    int64_t num_bytes_ = 0;
 };
 
 }  // namespace core

@@ -10,7 +10,7 @@ using core::Dtype;
 using core::ShapeToString;
 using core::Tensor;
 
-PointCloud::PointCloud(const Tensor& positions) { SetPointPositions(positions); }
+PointCloud::PointCloud(Tensor positions) { SetPointPositions(std::move(positions)); }
 
 int64_t PointCloud::NumPoints() const {
     auto it = attrs_.find(gs_attr::kPositions);
@@ -29,7 +29,7 @@ Tensor& PointCloud::GetPointAttr(const std::string& name) {
     return it->second;
 }
 
-void PointCloud::SetPointAttr(const std::string& name, const Tensor& value) {
+void PointCloud::SetPointAttr(const std::string& name, Tensor value) {
     if (value.NumDims() < 1) core::ThrowError("PointCloud attribute '{}' needs rank >= 1", name);
     if (name == gs_attr::kPositions) {
         if (value.GetDtype() != Dtype::Float32 || value.NumDims() != 2 || value.GetShape(1) != 3) {
@@ -46,7 +46,7 @@ void PointCloud::SetPointAttr(const std::string& name, const Tensor& value) {
         core::ThrowError("PointCloud attribute '{}' has {} rows, expected {}", name,
                          value.GetShape(0), NumPoints());
     }
-    attrs_[name] = value;
+    attrs_[name] = std::move(value);
 }
 
 std::vector<std::string> PointCloud::GetPointAttrNames() const {

@@ -34,14 +34,14 @@ class PointCloud {
 public:
     PointCloud() = default;
     /// positions: [N, 3] Float32.
-    explicit PointCloud(const core::Tensor& positions);
+    explicit PointCloud(core::Tensor positions);
 
     int64_t NumPoints() const;
     bool IsEmpty() const { return NumPoints() == 0; }
 
     const core::Tensor& GetPointPositions() const { return GetPointAttr(gs_attr::kPositions); }
-    void SetPointPositions(const core::Tensor& positions) {
-        SetPointAttr(gs_attr::kPositions, positions);
+    void SetPointPositions(core::Tensor positions) {
+        SetPointAttr(gs_attr::kPositions, std::move(positions));
     }
 
     bool HasPointAttr(const std::string& name) const { return attrs_.count(name) > 0; }
@@ -49,7 +49,7 @@ public:
     const core::Tensor& GetPointAttr(const std::string& name) const;
     core::Tensor& GetPointAttr(const std::string& name);
     /// The first dimension must equal NumPoints() unless the cloud has no positions yet.
-    void SetPointAttr(const std::string& name, const core::Tensor& value);
+    void SetPointAttr(const std::string& name, core::Tensor value);
     void RemovePointAttr(const std::string& name) { attrs_.erase(name); }
     std::vector<std::string> GetPointAttrNames() const;
 
@@ -61,7 +61,7 @@ public:
     void ValidateGaussianSplat() const;
 
     // Geometric transforms (PointCloudTransform.cpp). For splat clouds every Gaussian
-    // attribute follows: see docs/DESIGN.md "Transforms".
+    // attribute follows: see docs/transforms.md.
 
     /// Moves positions by t (relative) or so that their mean lands on t (relative = false).
     PointCloud& Translate(const Eigen::Vector3d& translation, bool relative = true);

@@ -1,0 +1,205 @@
+#include "open3d/t/io/SplatColumns.h"
+
+#include <fcntl.h>
+#include <sys/mman.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <memory>
+
+#include "open3d/core/Exception.h"
+#include "open3d/core/Logging.h"
+#include "open3d/core/ParallelFor.h"
+
+namespace open3d {
+namespace t {
+namespace io {
+
+using geometry::NumSHRestCoeffs;
+
+void SplatColumns::Allocate(int64_t n, bool gaussian, int degree) {
+    using core::Dtype;
+    using core::Tensor;
+    num_points = n;
+    is_gaussian = gaussian;
+    sh_degree = degree;
+    positions = Tensor::Empty({n, 3}, Dtype::Float32);
+    if (!gaussian) return;
+    scale = Tensor::Empty({n, 3}, Dtype::Float32);
+    rot = Tensor::Empty({n, 4}, Dtype::Float32);
+    opacity = Tensor::Empty({n, 1}, Dtype::Float32);
+    f_dc = Tensor::Empty({n, 3}, Dtype::Float32);
+    f_rest = Tensor::Empty({n, NumSHRestCoeffs(degree), 3}, Dtype::Float32);
+}
+
+MappedFile::MappedFile(const std::string& filename) {
+    const int fd = ::open(filename.c_str(), O_RDONLY | O_CLOEXEC);
+    if (fd < 0) core::ThrowError("Cannot open '{}' for reading: {}", filename, std::strerror(errno));
+    struct stat info;
+    if (::fstat(fd, &info) != 0 || !S_ISREG(info.st_mode)) {
+        ::close(fd);
+        core::ThrowError("Cannot read '{}': not a regular file", filename);
+    }
+    size_ = static_cast<size_t>(info.st_size);
+    if (size_ == 0) {
+        ::close(fd);
+        core::ThrowError("'{}' is empty", filename);
+    }
+    // MAP_POPULATE maps the whole file in one go instead of one page fault per 4 KiB.
+    void* p = ::mmap(nullptr, size_, PROT_READ, MAP_PRIVATE | MAP_POPULATE, fd, 0);
+    ::close(fd);
+    if (p == MAP_FAILED) core::ThrowError("Cannot map '{}': {}", filename, std::strerror(errno));
+    data_ = static_cast<const uint8_t*>(p);
+}
+
+MappedFile::~MappedFile() {
+    if (data_ != nullptr) ::munmap(const_cast<uint8_t*>(data_), size_);
+}
+
+void WriteFileBytes(const std::string& filename, const std::vector<uint8_t>& bytes) {
+    std::unique_ptr<FILE, int (*)(FILE*)> file(std::fopen(filename.c_str(), "wb"), &std::fclose);
+    if (!file) core::ThrowError("Cannot open '{}' for writing: {}", filename, std::strerror(errno));
+    if (std::fwrite(bytes.data(), 1, bytes.size(), file.get()) != bytes.size() ||
+        std::fflush(file.get()) != 0) {
+        core::ThrowError("Cannot write '{}': {}", filename, std::strerror(errno));
+    }
+}
+
+namespace {
+
+enum VertexStatus : uint8_t { kOk = 0, kNonFinite = 1, kZeroQuaternion = 2 };
+
+float* F(core::Tensor& t) { return t.NumBytes() > 0 ? t.Data<float>() : nullptr; }
+
+bool AllFinite(const float* v, int64_t n) {
+    for (int64_t i = 0; i < n; ++i) {
+        if (!std::isfinite(v[i])) return false;
+    }
+    return true;
+}
+
+// Names the first non-finite attribute of vertex i, for the error message.
+std::string DescribeNonFinite(const SplatColumns& c, int64_t i) {
+    const int nc = NumSHRestCoeffs(c.sh_degree);
+    struct Column {
+        const char* name;
+        const core::Tensor* data;
+        int64_t width;
+    };
+    const Column columns[] = {{"position", &c.positions, 3}, {"scale (exp of log-scale)", &c.scale, 3},
+                              {"rot", &c.rot, 4},           {"opacity", &c.opacity, 1},
+                              {"f_dc", &c.f_dc, 3},         {"f_rest", &c.f_rest, nc * 3}};
+    for (const Column& col : columns) {
+        if (col.data->NumBytes() == 0) continue;
+        for (int64_t k = 0; k < col.width; ++k) {
+            const float v = col.data->Data<float>()[i * col.width + k];
+            if (!std::isfinite(v)) return fmt::format("{}[{}] = {}", col.name, k, v);
+        }
+    }
+    return "unknown";
+}
+
+// Keeps the rows whose status is kOk, in order, in a new tensor of m rows.
+core::Tensor Compact(const core::Tensor& column, int64_t m, const std::vector<uint8_t>& status) {
+    core::SizeVector shape = column.GetShape();
+    const int64_t width = column.NumElements() / std::max<int64_t>(1, shape[0]);
+    shape[0] = m;
+    core::Tensor out = core::Tensor::Empty(shape, core::Dtype::Float32);
+    const float* src = column.Data<float>();
+    float* dst = out.Data<float>();
+    for (size_t i = 0; i < status.size(); ++i) {
+        if (status[i] != kOk) continue;
+        dst = std::copy_n(src + i * width, width, dst);
+    }
+    return out;
+}
+
+}  // namespace
+
+geometry::PointCloud FinalizeColumns(const std::string& filename, SplatColumns& c,
+                                     const ReadPointCloudOptions& options,
+                                     ReadPointCloudReport& report) {
+    const int64_t n = c.num_points;
+    const int nc = NumSHRestCoeffs(c.sh_degree);
+    std::vector<uint8_t> status(n, kOk);
+    core::ParallelFor(
+            n,
+            [&](int64_t i) {
+                bool finite = AllFinite(F(c.positions) + i * 3, 3);
+                if (c.is_gaussian) {
+                    finite = finite && AllFinite(F(c.scale) + i * 3, 3) &&
+                             AllFinite(F(c.rot) + i * 4, 4) && AllFinite(F(c.opacity) + i, 1) &&
+                             AllFinite(F(c.f_dc) + i * 3, 3) &&
+                             (nc == 0 || AllFinite(F(c.f_rest) + i * nc * 3, nc * 3));
+                }
+                if (!finite) {
+                    status[i] = kNonFinite;
+                    return;
+                }
+                if (!c.is_gaussian) return;
+                float* q = F(c.rot) + i * 4;
+                const double n2 = double(q[0]) * q[0] + double(q[1]) * q[1] +
+                                  double(q[2]) * q[2] + double(q[3]) * q[3];
+                if (n2 == 0.0) {
+                    status[i] = kZeroQuaternion;
+                    return;
+                }
+                // Already-unit quaternions (|n2 - 1| <= 2^-20, i.e. within ~4 float ulps)
+                // are kept bit-exact so that write -> read round trips are exact.
+                if (std::abs(n2 - 1.0) > 0x1p-20) {
+                    const double inv = 1.0 / std::sqrt(n2);
+                    for (int k = 0; k < 4; ++k) q[k] = static_cast<float>(q[k] * inv);
+                }
+            },
+            4096);
+
+    int64_t non_finite = 0;
+    for (int64_t i = 0; i < n; ++i) {
+        if (status[i] == kZeroQuaternion) {
+            core::ThrowError("'{}': splat {} has a zero rotation quaternion (cannot be normalised)",
+                             filename, i);
+        }
+        if (status[i] == kNonFinite) {
+            if (!options.drop_non_finite) {
+                core::ThrowError(
+                        "'{}': splat {} has a non-finite value: {} (set drop_non_finite to skip "
+                        "such splats)",
+                        filename, i, DescribeNonFinite(c, i));
+            }
+            ++non_finite;
+        }
+    }
+    const int64_t m = n - non_finite;
+    if (non_finite > 0) {
+        core::LogWarning("'{}': dropped {} of {} splats with NaN/Inf values", filename, non_finite, n);
+        c.positions = Compact(c.positions, m, status);
+        if (c.is_gaussian) {
+            c.scale = Compact(c.scale, m, status);
+            c.rot = Compact(c.rot, m, status);
+            c.opacity = Compact(c.opacity, m, status);
+            c.f_dc = Compact(c.f_dc, m, status);
+            c.f_rest = Compact(c.f_rest, m, status);
+        }
+    }
+    report.num_points = m;
+    report.dropped_non_finite = non_finite;
+
+    geometry::PointCloud cloud(std::move(c.positions));
+    if (c.is_gaussian) {
+        cloud.SetPointAttr(geometry::gs_attr::kScale, std::move(c.scale));
+        cloud.SetPointAttr(geometry::gs_attr::kRot, std::move(c.rot));
+        cloud.SetPointAttr(geometry::gs_attr::kOpacity, std::move(c.opacity));
+        cloud.SetPointAttr(geometry::gs_attr::kFDc, std::move(c.f_dc));
+        if (nc > 0) cloud.SetPointAttr(geometry::gs_attr::kFRest, std::move(c.f_rest));
+    }
+    return cloud;
+}
+
+}  // namespace io
+}  // namespace t
+}  // namespace open3d

@@ -1,0 +1,61 @@
+// Internal to t/io: Gaussian attributes as flat columns while a reader fills them, and
+// the shared checks every format applies before a cloud is handed out.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "open3d/t/geometry/PointCloud.h"
+#include "open3d/t/io/PointCloudIO.h"
+
+namespace open3d {
+namespace t {
+namespace io {
+
+struct SplatColumns {
+    int64_t num_points = 0;
+    bool is_gaussian = false;
+    int sh_degree = 0;
+    // Readers write straight into the tensors the cloud will own (no extra copy).
+    core::Tensor positions;  // [N, 3]
+    core::Tensor scale;      // [N, 3] linear
+    core::Tensor rot;        // [N, 4] (w, x, y, z), normalised by FinalizeColumns
+    core::Tensor opacity;    // [N, 1] logit
+    core::Tensor f_dc;       // [N, 3]
+    core::Tensor f_rest;     // [N, Nc, 3]
+
+    /// Sizes every column for n points, uninitialised (positions only when !gaussian).
+    void Allocate(int64_t n, bool gaussian, int degree);
+};
+
+/// A read-only view of a whole file (memory-mapped). Throws naming the file when it
+/// cannot be opened or mapped, or when it is empty.
+class MappedFile {
+public:
+    explicit MappedFile(const std::string& filename);
+    ~MappedFile();
+    MappedFile(const MappedFile&) = delete;
+    MappedFile& operator=(const MappedFile&) = delete;
+
+    const uint8_t* data() const { return data_; }
+    size_t size() const { return size_; }
+
+private:
+    const uint8_t* data_ = nullptr;
+    size_t size_ = 0;
+};
+
+/// Writes bytes to a file, throwing with the file name on failure.
+void WriteFileBytes(const std::string& filename, const std::vector<uint8_t>& bytes);
+
+/// Normalises quaternions (zero -> error with the splat index), refuses or drops
+/// non-finite splats (the error names the first offending attribute and splat index),
+/// and builds the cloud. Frees the columns as it goes.
+geometry::PointCloud FinalizeColumns(const std::string& filename, SplatColumns& columns,
+                                     const ReadPointCloudOptions& options,
+                                     ReadPointCloudReport& report);
+
+}  // namespace io
+}  // namespace t
+}  // namespace open3d
