@@ -21,7 +21,7 @@ std::string TempDir() {
     for (char& c : name) {
         if (c == '/') c = '_';
     }
-    const auto dir = std::filesystem::current_path() / "test_tmp" / name;
+    const auto dir = std::filesystem::temp_directory_path() / "open3d_tests" / name;
     std::filesystem::remove_all(dir);
     std::filesystem::create_directories(dir);
     return dir.string();

@@ -14,7 +14,7 @@ std::string DataDir();
 std::string DataPath(const std::string& relative);
 /// True when the file exists.
 bool FileExists(const std::string& path);
-/// A fresh temporary folder for this test (removed by nobody: it lives in the build tree).
+/// A fresh, empty folder for this test under $TMPDIR/open3d_tests (left for inspection).
 std::string TempDir();
 
 }  // namespace tests

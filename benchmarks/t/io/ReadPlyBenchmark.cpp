@@ -24,9 +24,15 @@ void ReadPly(benchmark::State& state, const std::string& relative) {
     state.SetBytesProcessed(state.iterations() * bytes);
 }
 
-BENCHMARK_CAPTURE(ReadPly, playbot_125k, "playbot/playbot_125k.ply")->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK_CAPTURE(ReadPly, biker_152k, "biker/biker_152k.ply")->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK_CAPTURE(ReadPly, chair_splat, "chair/chair.splat")->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(ReadPly, playbot_125k, "playbot/playbot_125k.ply")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(ReadPly, biker_152k, "biker/biker_152k.ply")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(ReadPly, chair_splat, "chair/chair.splat")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 
 }  // namespace
 

@@ -37,7 +37,7 @@ void ExpectReadError(const std::string& path, const std::vector<std::string>& fr
         EXPECT_NE(message.find(path), std::string::npos) << message;
         for (const auto& fragment : fragments) {
             EXPECT_NE(message.find(fragment), std::string::npos)
-                    << "'" << fragment << "' not in: " << message;
+                << "'" << fragment << "' not in: " << message;
         }
     }
     EXPECT_TRUE(cloud == before) << "a failed read changed the output cloud";
@@ -74,17 +74,17 @@ TEST(PlyReader, PropertyOrderTypesEncodingsAndExtrasAreFree) {
     // element after the vertices, in ASCII and big endian: all must read the same values.
     const std::string dir = tests::TempDir();
     const std::string props =
-            "property double rot_1\nproperty float opacity\nproperty uchar extra\n"
-            "property float f_dc_2\nproperty int x\nproperty float scale_2\nproperty float rot_0\n"
-            "property float y\nproperty float f_dc_0\nproperty float scale_0\nproperty float z\n"
-            "property float rot_3\nproperty float f_dc_1\nproperty float scale_1\n"
-            "property float rot_2\n";
+        "property double rot_1\nproperty float opacity\nproperty uchar extra\n"
+        "property float f_dc_2\nproperty int x\nproperty float scale_2\nproperty float rot_0\n"
+        "property float y\nproperty float f_dc_0\nproperty float scale_0\nproperty float z\n"
+        "property float rot_3\nproperty float f_dc_1\nproperty float scale_1\n"
+        "property float rot_2\n";
     WriteText(dir + "/a.ply", "ply\nformat ascii 1.0\ncomment hi\nelement vertex 2\n" + props +
-                                      "element face 1\nproperty list uchar int vertex_indices\n"
-                                      "end_header\n"
-                                      "0 0.5 7 0.1 3 -1 2 4 0.2 -1 5 0 0.3 -1 0\n"
-                                      "0 -0.5 9 0.1 -6 -1 0 4 0.2 -1 5 0 0.3 -1 2\n"
-                                      "3 0 1 2\n");
+                                  "element face 1\nproperty list uchar int vertex_indices\n"
+                                  "end_header\n"
+                                  "0 0.5 7 0.1 3 -1 2 4 0.2 -1 5 0 0.3 -1 0\n"
+                                  "0 -0.5 9 0.1 -6 -1 0 4 0.2 -1 5 0 0.3 -1 2\n"
+                                  "3 0 1 2\n");
     PointCloud cloud;
     ReadPointCloud(dir + "/a.ply", cloud);
     ASSERT_EQ(cloud.NumPoints(), 2);
@@ -143,8 +143,9 @@ TEST(PlyReader, HugeCountIsRefusedBeforeAllocating) {
     WriteFloatPly(path, GaussianPropertyNames(0), PlausibleRows(0, 1), 1000000000000000LL);
     ExpectReadError(path, {"declares 1000000000000000 vertices"});
     const std::string ascii = tests::TempDir() + "/ha.ply";
-    WriteText(ascii, "ply\nformat ascii 1.0\nelement vertex 999999999999\nproperty float x\n"
-                     "property float y\nproperty float z\nend_header\n1 2 3\n");
+    WriteText(ascii,
+              "ply\nformat ascii 1.0\nelement vertex 999999999999\nproperty float x\n"
+              "property float y\nproperty float z\nend_header\n1 2 3\n");
     ExpectReadError(ascii, {"declares 999999999999 vertices"});
 }
 
@@ -174,8 +175,9 @@ TEST(PlyReader, BadSHCount) {
 
 TEST(PlyReader, UnsupportedPropertyType) {
     const std::string path = tests::TempDir() + "/u.ply";
-    WriteText(path, "ply\nformat binary_little_endian 1.0\nelement vertex 1\nproperty half x\n"
-                    "end_header\n");
+    WriteText(path,
+              "ply\nformat binary_little_endian 1.0\nelement vertex 1\nproperty half x\n"
+              "end_header\n");
     ExpectReadError(path, {"unsupported property type 'half'", "line 4"});
 }
 
@@ -189,8 +191,9 @@ TEST(PlyReader, MalformedHeaders) {
     ExpectReadError(dir + "/f.ply", {"unknown format"});
     WriteText(dir + "/v.ply", "ply\nformat ascii 1.0\nelement face 0\nend_header\n");
     ExpectReadError(dir + "/v.ply", {"no 'vertex' element"});
-    WriteText(dir + "/a.ply", "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\n"
-                              "property float y\nproperty float z\nend_header\n1 two 3\n");
+    WriteText(dir + "/a.ply",
+              "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\n"
+              "property float y\nproperty float z\nend_header\n1 two 3\n");
     ExpectReadError(dir + "/a.ply", {"vertex 0 property 'y'", "'two'"});
 }
 
@@ -210,9 +213,9 @@ TEST(PlyReader, NonFiniteValuesRefusedOrDropped) {
     const auto names = GaussianPropertyNames(1);
     auto rows = PlausibleRows(1, 6);
     const size_t w = names.size();
-    rows[2 * w + 1] = std::numeric_limits<float>::quiet_NaN();           // y of splat 2
-    rows[4 * w + w - 6] = std::numeric_limits<float>::infinity();        // scale_1 of splat 4
-    rows[5 * w + 12] = -std::numeric_limits<float>::infinity();          // an f_rest of splat 5
+    rows[2 * w + 1] = std::numeric_limits<float>::quiet_NaN();     // y of splat 2
+    rows[4 * w + w - 6] = std::numeric_limits<float>::infinity();  // scale_1 of splat 4
+    rows[5 * w + 12] = -std::numeric_limits<float>::infinity();    // an f_rest of splat 5
     WriteFloatPly(path, names, rows);
     ExpectReadError(path, {"splat 2", "non-finite", "position[1]"});
 
@@ -271,7 +274,8 @@ TEST(PlyReader, TrailingBytesLoadWithWarning) {
     WriteFloatPly(path, GaussianPropertyNames(0), PlausibleRows(0, 2), -1, "garbage!!");
     int warnings = 0;
     auto previous = core::SetLogSink([&](core::LogLevel level, std::string_view msg) {
-        if (level == core::LogLevel::Warning && msg.find("ignoring 9 bytes") != msg.npos) ++warnings;
+        if (level == core::LogLevel::Warning && msg.find("ignoring 9 bytes") != msg.npos)
+            ++warnings;
     });
     PointCloud cloud;
     const auto report = ReadPointCloud(path, cloud);

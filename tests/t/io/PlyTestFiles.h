@@ -15,10 +15,12 @@ namespace tests {
 
 /// The 3DGS property names for an SH degree, in the trainer's order.
 inline std::vector<std::string> GaussianPropertyNames(int degree) {
-    std::vector<std::string> names = {"x", "y", "z", "nx", "ny", "nz", "f_dc_0", "f_dc_1", "f_dc_2"};
+    std::vector<std::string> names = {"x",  "y",      "z",      "nx",    "ny",
+                                      "nz", "f_dc_0", "f_dc_1", "f_dc_2"};
     const int rest = 3 * t::geometry::NumSHRestCoeffs(degree);
     for (int k = 0; k < rest; ++k) names.push_back("f_rest_" + std::to_string(k));
-    for (const char* n : {"opacity", "scale_0", "scale_1", "scale_2", "rot_0", "rot_1", "rot_2", "rot_3"}) {
+    for (const char* n :
+         {"opacity", "scale_0", "scale_1", "scale_2", "rot_0", "rot_1", "rot_2", "rot_3"}) {
         names.push_back(n);
     }
     return names;

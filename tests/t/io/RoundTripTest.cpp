@@ -80,7 +80,8 @@ TEST(RoundTrip, LogScaleEncodingIsExactWherePossible) {
     }
     EXPECT_EQ(DecodeLogScale(EncodeLogScale(0.0f)), 0.0f);
     // Arbitrary scales (not from a log) come back within the log's rounding: for |log s| <= 20
-    // a half ulp of the log is <= 9.5e-7, so the relative error is <= ~1e-6 (measured 1.01e-6 over 200k samples).
+    // a half ulp of the log is <= 9.5e-7, so the relative error is <= ~1e-6 (measured 1.01e-6 over
+    // 200k samples).
     std::uniform_real_distribution<double> any(1e-8, 1e8);
     double worst = 0;
     for (int i = 0; i < 200000; ++i) {
@@ -159,7 +160,8 @@ TEST(RoundTrip, SplatTruncatedRecord) {
         ReadPointCloud(path, cloud);
         ADD_FAILURE() << "no error";
     } catch (const core::Open3DError& e) {
-        EXPECT_NE(std::string(e.what()).find("splat 2 is incomplete"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("splat 2 is incomplete"), std::string::npos)
+            << e.what();
     }
     EXPECT_TRUE(cloud.IsEmpty());
 }
@@ -170,7 +172,8 @@ TEST(RoundTrip, WriterRefusesWhatItCannotStore) {
     EXPECT_THROW(WritePointCloud(tests::TempDir() + "/neg.ply", cloud), core::Open3DError);
     EXPECT_THROW(WritePointCloud(tests::TempDir() + "/x.xyz", RandomCloud(2, 0, 1)),
                  core::Open3DError);
-    EXPECT_THROW(WritePointCloud("/nonexistent-dir/x.ply", RandomCloud(2, 0, 1)), core::Open3DError);
+    EXPECT_THROW(WritePointCloud("/nonexistent-dir/x.ply", RandomCloud(2, 0, 1)),
+                 core::Open3DError);
 }
 
 }  // namespace

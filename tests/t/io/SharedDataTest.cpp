@@ -35,17 +35,25 @@ struct Expected {
 
 // Figures from the Python above (printed with 6 significant digits).
 const Expected kFiles[] = {
-        {"playbot/playbot_31k.ply", 31000, 2, -1.0269, 1.02928, -268.000942, 6.99397e-05, 0.296438, 0},
-        {"playbot/playbot_125k.ply", 125000, 2, -1.02831, 1.03114, -782.153197, 4.03818e-05, 0.404836, 0},
-        {"biker/biker_152k.ply", 152746, 0, -0.621338, 0.414307, -7419.369629, 4.53999e-05, 0.144064, 0},
-        {"train3/train_3points.ply", 3, 3, -2.74808, 2.00785, -2.239456, 0.00341077, 0.0205153, 0},
-        {"sh3_iter7000/point_cloud.ply", 9080, 3, -409.66, 471.384, 447353.613106, 0.00562162, 227.68, 0},
-        {"pc_short/pc_short.ply", 100, 3, -0.932074, 0.0834385, -58.935648, 2.51065e-05, 0.0353115, 0},
-        {"pc_short/pc_short_trailing_bytes.ply", 100, 3, -0.932074, 0.0834385, -58.935648, 2.51065e-05, 0.0353115, 14029},
-        {"chair/chair.splat", 89945, 0, -0.253645, 0.253992, 1287.029634, 1.17464e-08, 0.0674766, 0},
-        {"train3/one_splat.splat", 1, 0, -21.4309, -21.4309, -21.430897, 1.77184, 1.77184, 0},
-        {"sh3_iter7000/model.splat", 22764, 0, -409.637, 498.318, 786410.783085, 0.00562162, 226.459, 0},
+    {"playbot/playbot_31k.ply", 31000, 2, -1.0269, 1.02928, -268.000942, 6.99397e-05, 0.296438, 0},
+    {"playbot/playbot_125k.ply", 125000, 2, -1.02831, 1.03114, -782.153197, 4.03818e-05, 0.404836,
+     0},
+    {"biker/biker_152k.ply", 152746, 0, -0.621338, 0.414307, -7419.369629, 4.53999e-05, 0.144064,
+     0},
+    {"train3/train_3points.ply", 3, 3, -2.74808, 2.00785, -2.239456, 0.00341077, 0.0205153, 0},
+    {"sh3_iter7000/point_cloud.ply", 9080, 3, -409.66, 471.384, 447353.613106, 0.00562162, 227.68,
+     0},
+    {"pc_short/pc_short.ply", 100, 3, -0.932074, 0.0834385, -58.935648, 2.51065e-05, 0.0353115, 0},
+    {"pc_short/pc_short_trailing_bytes.ply", 100, 3, -0.932074, 0.0834385, -58.935648, 2.51065e-05,
+     0.0353115, 14029},
+    {"chair/chair.splat", 89945, 0, -0.253645, 0.253992, 1287.029634, 1.17464e-08, 0.0674766, 0},
+    {"train3/one_splat.splat", 1, 0, -21.4309, -21.4309, -21.430897, 1.77184, 1.77184, 0},
+    {"sh3_iter7000/model.splat", 22764, 0, -409.637, 498.318, 786410.783085, 0.00562162, 226.459,
+     0},
 };
+
+// Names the file instead of dumping the struct's bytes in test listings.
+void PrintTo(const Expected& e, std::ostream* os) { *os << e.file; }
 
 class SharedData : public ::testing::TestWithParam<Expected> {};
 
@@ -85,9 +93,9 @@ TEST_P(SharedData, MatchesIndependentFigures) {
     // Every quaternion unit length after reading (sh3_iter7000 stores norms 0.62-1.15).
     const float* q = cloud.GetPointAttr("rot").Data<float>();
     for (int64_t i = 0; i < e.n; ++i) {
-        const double norm = std::sqrt(double(q[i * 4]) * q[i * 4] + double(q[i * 4 + 1]) * q[i * 4 + 1] +
-                                      double(q[i * 4 + 2]) * q[i * 4 + 2] +
-                                      double(q[i * 4 + 3]) * q[i * 4 + 3]);
+        const double norm =
+            std::sqrt(double(q[i * 4]) * q[i * 4] + double(q[i * 4 + 1]) * q[i * 4 + 1] +
+                      double(q[i * 4 + 2]) * q[i * 4 + 2] + double(q[i * 4 + 3]) * q[i * 4 + 3]);
         ASSERT_NEAR(norm, 1.0, 1e-6) << e.file << " splat " << i;  // float rounding: <= 2.4e-7
     }
     // Opacity is a finite logit; .splat alpha 0 (chair) maps to logit(1e-6) ~ -13.8.
@@ -106,7 +114,8 @@ INSTANTIATE_TEST_SUITE_P(AllFiles, SharedData, ::testing::ValuesIn(kFiles),
 
 TEST(SharedData, PlyRoundTripOfRealFilesIsExact) {
     for (const char* file : {"playbot/playbot_31k.ply", "sh3_iter7000/point_cloud.ply"}) {
-        if (!tests::FileExists(tests::DataPath(file))) GTEST_SKIP() << tests::DataPath(file) << " absent";
+        if (!tests::FileExists(tests::DataPath(file)))
+            GTEST_SKIP() << tests::DataPath(file) << " absent";
         PointCloud original, back;
         ReadPointCloud(tests::DataPath(file), original);
         const std::string path = tests::TempDir() + "/copy.ply";

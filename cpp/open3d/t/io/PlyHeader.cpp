@@ -12,13 +12,17 @@ namespace io {
 int PlyTypeSize(PlyType type) {
     switch (type) {
         case PlyType::Int8:
-        case PlyType::UInt8: return 1;
+        case PlyType::UInt8:
+            return 1;
         case PlyType::Int16:
-        case PlyType::UInt16: return 2;
+        case PlyType::UInt16:
+            return 2;
         case PlyType::Int32:
         case PlyType::UInt32:
-        case PlyType::Float32: return 4;
-        case PlyType::Float64: return 8;
+        case PlyType::Float32:
+            return 4;
+        case PlyType::Float64:
+            return 8;
     }
     return 0;
 }
@@ -47,12 +51,12 @@ namespace {
 
 bool ParseType(const std::string& word, PlyType& type) {
     static const std::pair<const char*, PlyType> kNames[] = {
-            {"char", PlyType::Int8},      {"int8", PlyType::Int8},       {"uchar", PlyType::UInt8},
-            {"uint8", PlyType::UInt8},    {"short", PlyType::Int16},     {"int16", PlyType::Int16},
-            {"ushort", PlyType::UInt16},  {"uint16", PlyType::UInt16},   {"int", PlyType::Int32},
-            {"int32", PlyType::Int32},    {"uint", PlyType::UInt32},     {"uint32", PlyType::UInt32},
-            {"float", PlyType::Float32},  {"float32", PlyType::Float32}, {"double", PlyType::Float64},
-            {"float64", PlyType::Float64}};
+        {"char", PlyType::Int8},      {"int8", PlyType::Int8},       {"uchar", PlyType::UInt8},
+        {"uint8", PlyType::UInt8},    {"short", PlyType::Int16},     {"int16", PlyType::Int16},
+        {"ushort", PlyType::UInt16},  {"uint16", PlyType::UInt16},   {"int", PlyType::Int32},
+        {"int32", PlyType::Int32},    {"uint", PlyType::UInt32},     {"uint32", PlyType::UInt32},
+        {"float", PlyType::Float32},  {"float32", PlyType::Float32}, {"double", PlyType::Float64},
+        {"float64", PlyType::Float64}};
     for (const auto& [name, t] : kNames) {
         if (word == name) {
             type = t;
@@ -68,7 +72,8 @@ PlyHeader ParsePlyHeader(const std::string& filename, const uint8_t* bytes, size
     // Headers are short; refuse to scan more than 1 MiB for end_header.
     const size_t limit = std::min<size_t>(size, 1 << 20);
     const std::string_view text(reinterpret_cast<const char*>(bytes), limit);
-    if (text.substr(0, 3) != "ply") core::ThrowError("'{}' is not a PLY file (no 'ply' magic)", filename);
+    if (text.substr(0, 3) != "ply")
+        core::ThrowError("'{}' is not a PLY file (no 'ply' magic)", filename);
 
     PlyHeader header;
     bool have_format = false;
@@ -77,7 +82,8 @@ PlyHeader ParsePlyHeader(const std::string& filename, const uint8_t* bytes, size
     for (;;) {
         const size_t eol = text.find('\n', pos);
         if (eol == std::string_view::npos) {
-            core::ThrowError("'{}': PLY header has no 'end_header' line (truncated header)", filename);
+            core::ThrowError("'{}': PLY header has no 'end_header' line (truncated header)",
+                             filename);
         }
         std::string line(text.substr(pos, eol - pos));
         pos = eol + 1;
@@ -87,7 +93,8 @@ PlyHeader ParsePlyHeader(const std::string& filename, const uint8_t* bytes, size
         std::string keyword;
         in >> keyword;
         auto fail = [&](const std::string& why) {
-            core::ThrowError("'{}': PLY header line {} ('{}'): {}", filename, line_number, line, why);
+            core::ThrowError("'{}': PLY header line {} ('{}'): {}", filename, line_number, line,
+                             why);
         };
         if (keyword.empty() || keyword == "comment" || keyword == "obj_info") continue;
         if (line_number == 1) {
@@ -112,7 +119,8 @@ PlyHeader ParsePlyHeader(const std::string& filename, const uint8_t* bytes, size
             std::string count;
             in >> element.name >> count;
             int64_t value = -1;
-            const auto [ptr, ec] = std::from_chars(count.data(), count.data() + count.size(), value);
+            const auto [ptr, ec] =
+                std::from_chars(count.data(), count.data() + count.size(), value);
             if (element.name.empty() || ec != std::errc() || ptr != count.data() + count.size() ||
                 value < 0) {
                 fail("element needs a name and a non-negative count");

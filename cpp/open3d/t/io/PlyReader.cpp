@@ -22,7 +22,7 @@ using geometry::NumSHRestCoeffs;
 
 // One value copied from a PLY row into an output column.
 struct Field {
-    int property = 0;     // index into the vertex element's properties
+    int property = 0;  // index into the vertex element's properties
     float* dest = nullptr;
     int dest_stride = 0;  // floats per point in the destination column
     int dest_index = 0;   // position inside the point's row of the destination column
@@ -41,21 +41,29 @@ T Load(const uint8_t* p, bool swap) {
 
 double LoadValue(const uint8_t* p, PlyType type, bool swap) {
     switch (type) {
-        case PlyType::Int8: return Load<int8_t>(p, swap);
-        case PlyType::UInt8: return Load<uint8_t>(p, swap);
-        case PlyType::Int16: return Load<int16_t>(p, swap);
-        case PlyType::UInt16: return Load<uint16_t>(p, swap);
-        case PlyType::Int32: return Load<int32_t>(p, swap);
-        case PlyType::UInt32: return Load<uint32_t>(p, swap);
-        case PlyType::Float32: return Load<float>(p, swap);
-        case PlyType::Float64: return Load<double>(p, swap);
+        case PlyType::Int8:
+            return Load<int8_t>(p, swap);
+        case PlyType::UInt8:
+            return Load<uint8_t>(p, swap);
+        case PlyType::Int16:
+            return Load<int16_t>(p, swap);
+        case PlyType::UInt16:
+            return Load<uint16_t>(p, swap);
+        case PlyType::Int32:
+            return Load<int32_t>(p, swap);
+        case PlyType::UInt32:
+            return Load<uint32_t>(p, swap);
+        case PlyType::Float32:
+            return Load<float>(p, swap);
+        case PlyType::Float64:
+            return Load<double>(p, swap);
     }
     return 0.0;
 }
 
 void Store(const Field& f, int64_t i, double value) {
     f.dest[i * f.dest_stride + f.dest_index] =
-            f.exp ? DecodeLogScale(static_cast<float>(value)) : static_cast<float>(value);
+        f.exp ? DecodeLogScale(static_cast<float>(value)) : static_cast<float>(value);
 }
 
 // Works out which properties go where, allocating the columns for `count` points.
@@ -74,9 +82,9 @@ std::vector<Field> PlanFields(const std::string& filename, const PlyElement& ver
         return index;
     };
 
-    static const char* kGaussianNames[] = {"f_dc_0",  "f_dc_1",  "f_dc_2",  "opacity", "scale_0",
-                                           "scale_1", "scale_2", "rot_0",   "rot_1",   "rot_2",
-                                           "rot_3"};
+    static const char* kGaussianNames[] = {"f_dc_0",  "f_dc_1",  "f_dc_2",  "opacity",
+                                           "scale_0", "scale_1", "scale_2", "rot_0",
+                                           "rot_1",   "rot_2",   "rot_3"};
     bool gaussian = find("f_rest_0") >= 0;
     for (const char* name : kGaussianNames) gaussian = gaussian || find(name) >= 0;
 
@@ -88,9 +96,10 @@ std::vector<Field> PlanFields(const std::string& filename, const PlyElement& ver
             const char* begin = p.name.data() + 7;
             const auto [ptr, ec] = std::from_chars(begin, p.name.data() + p.name.size(), k);
             if (ec == std::errc() && ptr == p.name.data() + p.name.size() && k >= num_rest) {
-                core::ThrowError("'{}': f_rest properties are not contiguous ('{}' present, "
-                                 "'f_rest_{}' missing)",
-                                 filename, p.name, num_rest);
+                core::ThrowError(
+                    "'{}': f_rest properties are not contiguous ('{}' present, "
+                    "'f_rest_{}' missing)",
+                    filename, p.name, num_rest);
             }
         }
     }
@@ -135,23 +144,23 @@ void ReadBinaryVertices(const PlyElement& vertex, const std::vector<Field>& fiel
         all_float = all_float && vertex.properties[f.property].type == PlyType::Float32;
     }
     core::ParallelForRange(
-            vertex.count,
-            [&](int64_t begin, int64_t end) {
-                for (int64_t i = begin; i < end; ++i) {
-                    const uint8_t* row = data + i * stride;
-                    for (const Field& f : fields) {
-                        const PlyProperty& p = vertex.properties[f.property];
-                        if (all_float) {
-                            float value;
-                            std::memcpy(&value, row + p.offset, 4);
-                            Store(f, i, value);
-                        } else {
-                            Store(f, i, LoadValue(row + p.offset, p.type, swap));
-                        }
+        vertex.count,
+        [&](int64_t begin, int64_t end) {
+            for (int64_t i = begin; i < end; ++i) {
+                const uint8_t* row = data + i * stride;
+                for (const Field& f : fields) {
+                    const PlyProperty& p = vertex.properties[f.property];
+                    if (all_float) {
+                        float value;
+                        std::memcpy(&value, row + p.offset, 4);
+                        Store(f, i, value);
+                    } else {
+                        Store(f, i, LoadValue(row + p.offset, p.type, swap));
                     }
                 }
-            },
-            2048);
+            }
+        },
+        2048);
 }
 
 // Cursor over whitespace-separated ASCII tokens.
@@ -181,13 +190,15 @@ void ReadAsciiVertices(const std::string& filename, const PlyElement& vertex,
     for (int64_t i = 0; i < vertex.count; ++i) {
         for (size_t p = 0; p < vertex.properties.size(); ++p) {
             if (!cursor.Next(token)) {
-                core::ThrowError("'{}': ASCII data ends inside vertex {} of {} (truncated file or "
-                                 "vertex count too large)",
-                                 filename, i, vertex.count);
+                core::ThrowError(
+                    "'{}': ASCII data ends inside vertex {} of {} (truncated file or "
+                    "vertex count too large)",
+                    filename, i, vertex.count);
             }
             if (targets[p].empty()) continue;
             double value = 0.0;
-            const auto [ptr, ec] = std::from_chars(token.data(), token.data() + token.size(), value);
+            const auto [ptr, ec] =
+                std::from_chars(token.data(), token.data() + token.size(), value);
             if (ptr != token.data() + token.size() ||
                 (ec != std::errc() && ec != std::errc::result_out_of_range)) {
                 core::ThrowError("'{}': vertex {} property '{}': cannot parse '{}' as a number",
@@ -223,13 +234,15 @@ geometry::PointCloud ReadPly(const std::string& filename, const ReadPointCloudOp
     for (int e = 0; e < vertex_index; ++e) {
         const PlyElement& element = header.elements[e];
         if (ascii) {
-            for (int64_t i = 0; i < element.count && cursor.pos < cursor.end; ++i) cursor.SkipLine();
+            for (int64_t i = 0; i < element.count && cursor.pos < cursor.end; ++i)
+                cursor.SkipLine();
             continue;
         }
         if (element.HasList()) {
-            core::ThrowError("'{}': element '{}' with list properties before 'vertex' is not "
-                             "supported",
-                             filename, element.name);
+            core::ThrowError(
+                "'{}': element '{}' with list properties before 'vertex' is not "
+                "supported",
+                filename, element.name);
         }
         const int64_t row = element.RowSize();
         if (row > 0 && element.count > static_cast<int64_t>((size - offset) / row)) {
@@ -242,13 +255,14 @@ geometry::PointCloud ReadPly(const std::string& filename, const ReadPointCloudOp
     // Bound the allocation by what the file can hold before allocating anything.
     const int64_t available = ascii ? cursor.end - cursor.pos : static_cast<int64_t>(size - offset);
     // ASCII rows take at least 2 bytes per property ("0 ... 0\n"; the last newline optional).
-    const int64_t min_row = ascii ? 2 * static_cast<int64_t>(vertex.properties.size())
-                                  : vertex.RowSize();
+    const int64_t min_row =
+        ascii ? 2 * static_cast<int64_t>(vertex.properties.size()) : vertex.RowSize();
     const int64_t max_rows = min_row > 0 ? (available + (ascii ? 1 : 0)) / min_row : 0;
     if (vertex.count > max_rows) {
-        core::ThrowError("'{}': header declares {} vertices but the data holds at most {} ({} bytes "
-                         "follow, {} bytes per vertex): the file is truncated or the count is wrong",
-                         filename, vertex.count, max_rows, available, min_row);
+        core::ThrowError(
+            "'{}': header declares {} vertices but the data holds at most {} ({} bytes "
+            "follow, {} bytes per vertex): the file is truncated or the count is wrong",
+            filename, vertex.count, max_rows, available, min_row);
     }
 
     SplatColumns columns;
@@ -272,8 +286,8 @@ geometry::PointCloud ReadPly(const std::string& filename, const ReadPointCloudOp
         const char* rest = cursor.pos;
         if (cursor.Next(token)) report.trailing_bytes = cursor.end - rest;
     } else if (later_sizes_known) {
-        report.trailing_bytes = std::max<int64_t>(
-                0, available - vertex.count * vertex.RowSize() - declared_after);
+        report.trailing_bytes =
+            std::max<int64_t>(0, available - vertex.count * vertex.RowSize() - declared_after);
     }
     if (report.trailing_bytes > 0) {
         core::LogWarning("'{}': ignoring {} bytes after the {} declared vertices", filename,

@@ -36,8 +36,8 @@ std::vector<std::string> PropertyNames(bool gaussian, int num_rest) {
     if (!gaussian) return names;
     for (const char* n : {"nx", "ny", "nz", "f_dc_0", "f_dc_1", "f_dc_2"}) names.push_back(n);
     for (int k = 0; k < num_rest; ++k) names.push_back("f_rest_" + std::to_string(k));
-    for (const char* n : {"opacity", "scale_0", "scale_1", "scale_2", "rot_0", "rot_1", "rot_2",
-                          "rot_3"}) {
+    for (const char* n :
+         {"opacity", "scale_0", "scale_1", "scale_2", "rot_0", "rot_1", "rot_2", "rot_3"}) {
         names.push_back(n);
     }
     return names;
@@ -98,7 +98,7 @@ void WritePly(const std::string& filename, const geometry::PointCloud& cloud, Pl
     const int64_t n = cloud.NumPoints();
     const int64_t width = static_cast<int64_t>(names.size());
     std::string header = "ply\nformat ";
-    header += format == PlyFormat::Ascii                ? "ascii"
+    header += format == PlyFormat::Ascii             ? "ascii"
               : format == PlyFormat::BinaryBigEndian ? "binary_big_endian"
                                                      : "binary_little_endian";
     header += " 1.0\ncomment written by open3d (3DGS layout: log-scales, opacity logits)\n";
@@ -108,16 +108,16 @@ void WritePly(const std::string& filename, const geometry::PointCloud& cloud, Pl
 
     std::vector<float> values(n * width);
     core::ParallelFor(
-            n, [&](int64_t i) { FillRow(cloud, gaussian, nc, i, &values[i * width]); }, 4096);
+        n, [&](int64_t i) { FillRow(cloud, gaussian, nc, i, &values[i * width]); }, 4096);
 
     std::vector<uint8_t> bytes(header.begin(), header.end());
     if (format == PlyFormat::Ascii) {
         fmt::memory_buffer text;
         for (int64_t i = 0; i < n; ++i) {
             // "{}" prints the shortest text that parses back to the same float.
-            fmt::format_to(std::back_inserter(text), "{}\n",
-                           fmt::join(values.begin() + i * width, values.begin() + (i + 1) * width,
-                                     " "));
+            fmt::format_to(
+                std::back_inserter(text), "{}\n",
+                fmt::join(values.begin() + i * width, values.begin() + (i + 1) * width, " "));
         }
         bytes.insert(bytes.end(), text.begin(), text.end());
     } else {

@@ -39,7 +39,8 @@ void SplatColumns::Allocate(int64_t n, bool gaussian, int degree) {
 
 MappedFile::MappedFile(const std::string& filename) {
     const int fd = ::open(filename.c_str(), O_RDONLY | O_CLOEXEC);
-    if (fd < 0) core::ThrowError("Cannot open '{}' for reading: {}", filename, std::strerror(errno));
+    if (fd < 0)
+        core::ThrowError("Cannot open '{}' for reading: {}", filename, std::strerror(errno));
     struct stat info;
     if (::fstat(fd, &info) != 0 || !S_ISREG(info.st_mode)) {
         ::close(fd);
@@ -91,9 +92,12 @@ std::string DescribeNonFinite(const SplatColumns& c, int64_t i) {
         const core::Tensor* data;
         int64_t width;
     };
-    const Column columns[] = {{"position", &c.positions, 3}, {"scale (exp of log-scale)", &c.scale, 3},
-                              {"rot", &c.rot, 4},           {"opacity", &c.opacity, 1},
-                              {"f_dc", &c.f_dc, 3},         {"f_rest", &c.f_rest, nc * 3}};
+    const Column columns[] = {{"position", &c.positions, 3},
+                              {"scale (exp of log-scale)", &c.scale, 3},
+                              {"rot", &c.rot, 4},
+                              {"opacity", &c.opacity, 1},
+                              {"f_dc", &c.f_dc, 3},
+                              {"f_rest", &c.f_rest, nc * 3}};
     for (const Column& col : columns) {
         if (col.data->NumBytes() == 0) continue;
         for (int64_t k = 0; k < col.width; ++k) {
@@ -128,35 +132,35 @@ geometry::PointCloud FinalizeColumns(const std::string& filename, SplatColumns& 
     const int nc = NumSHRestCoeffs(c.sh_degree);
     std::vector<uint8_t> status(n, kOk);
     core::ParallelFor(
-            n,
-            [&](int64_t i) {
-                bool finite = AllFinite(F(c.positions) + i * 3, 3);
-                if (c.is_gaussian) {
-                    finite = finite && AllFinite(F(c.scale) + i * 3, 3) &&
-                             AllFinite(F(c.rot) + i * 4, 4) && AllFinite(F(c.opacity) + i, 1) &&
-                             AllFinite(F(c.f_dc) + i * 3, 3) &&
-                             (nc == 0 || AllFinite(F(c.f_rest) + i * nc * 3, nc * 3));
-                }
-                if (!finite) {
-                    status[i] = kNonFinite;
-                    return;
-                }
-                if (!c.is_gaussian) return;
-                float* q = F(c.rot) + i * 4;
-                const double n2 = double(q[0]) * q[0] + double(q[1]) * q[1] +
-                                  double(q[2]) * q[2] + double(q[3]) * q[3];
-                if (n2 == 0.0) {
-                    status[i] = kZeroQuaternion;
-                    return;
-                }
-                // Already-unit quaternions (|n2 - 1| <= 2^-20, i.e. within ~4 float ulps)
-                // are kept bit-exact so that write -> read round trips are exact.
-                if (std::abs(n2 - 1.0) > 0x1p-20) {
-                    const double inv = 1.0 / std::sqrt(n2);
-                    for (int k = 0; k < 4; ++k) q[k] = static_cast<float>(q[k] * inv);
-                }
-            },
-            4096);
+        n,
+        [&](int64_t i) {
+            bool finite = AllFinite(F(c.positions) + i * 3, 3);
+            if (c.is_gaussian) {
+                finite = finite && AllFinite(F(c.scale) + i * 3, 3) &&
+                         AllFinite(F(c.rot) + i * 4, 4) && AllFinite(F(c.opacity) + i, 1) &&
+                         AllFinite(F(c.f_dc) + i * 3, 3) &&
+                         (nc == 0 || AllFinite(F(c.f_rest) + i * nc * 3, nc * 3));
+            }
+            if (!finite) {
+                status[i] = kNonFinite;
+                return;
+            }
+            if (!c.is_gaussian) return;
+            float* q = F(c.rot) + i * 4;
+            const double n2 = double(q[0]) * q[0] + double(q[1]) * q[1] + double(q[2]) * q[2] +
+                              double(q[3]) * q[3];
+            if (n2 == 0.0) {
+                status[i] = kZeroQuaternion;
+                return;
+            }
+            // Already-unit quaternions (|n2 - 1| <= 2^-20, i.e. within ~4 float ulps)
+            // are kept bit-exact so that write -> read round trips are exact.
+            if (std::abs(n2 - 1.0) > 0x1p-20) {
+                const double inv = 1.0 / std::sqrt(n2);
+                for (int k = 0; k < 4; ++k) q[k] = static_cast<float>(q[k] * inv);
+            }
+        },
+        4096);
 
     int64_t non_finite = 0;
     for (int64_t i = 0; i < n; ++i) {
@@ -167,16 +171,17 @@ geometry::PointCloud FinalizeColumns(const std::string& filename, SplatColumns& 
         if (status[i] == kNonFinite) {
             if (!options.drop_non_finite) {
                 core::ThrowError(
-                        "'{}': splat {} has a non-finite value: {} (set drop_non_finite to skip "
-                        "such splats)",
-                        filename, i, DescribeNonFinite(c, i));
+                    "'{}': splat {} has a non-finite value: {} (set drop_non_finite to skip "
+                    "such splats)",
+                    filename, i, DescribeNonFinite(c, i));
             }
             ++non_finite;
         }
     }
     const int64_t m = n - non_finite;
     if (non_finite > 0) {
-        core::LogWarning("'{}': dropped {} of {} splats with NaN/Inf values", filename, non_finite, n);
+        core::LogWarning("'{}': dropped {} of {} splats with NaN/Inf values", filename, non_finite,
+                         n);
         c.positions = Compact(c.positions, m, status);
         if (c.is_gaussian) {
             c.scale = Compact(c.scale, m, status);

@@ -34,9 +34,10 @@ geometry::PointCloud ReadSplat(const std::string& filename, const ReadPointCloud
     const MappedFile bytes(filename);
     const int64_t size = static_cast<int64_t>(bytes.size());
     if (size % kSplatBytes != 0) {
-        core::ThrowError("'{}': size {} bytes is not a multiple of 32 (.splat record size): the "
-                         "file is truncated (splat {} is incomplete)",
-                         filename, size, size / kSplatBytes);
+        core::ThrowError(
+            "'{}': size {} bytes is not a multiple of 32 (.splat record size): the "
+            "file is truncated (splat {} is incomplete)",
+            filename, size, size / kSplatBytes);
     }
     const int64_t n = size / kSplatBytes;
     SplatColumns columns;
@@ -47,36 +48,36 @@ geometry::PointCloud ReadSplat(const std::string& filename, const ReadPointCloud
     float* opacity = columns.opacity.Data<float>();
     float* rot = columns.rot.Data<float>();
     core::ParallelFor(
-            n,
-            [&](int64_t i) {
-                const uint8_t* record = bytes.data() + i * kSplatBytes;
-                float floats[6];
-                std::memcpy(floats, record, sizeof(floats));
-                for (int c = 0; c < 3; ++c) {
-                    positions[i * 3 + c] = floats[c];
-                    scale[i * 3 + c] = floats[3 + c];
-                }
-                const uint8_t* rgba = record + 24;
-                for (int c = 0; c < 3; ++c) {
-                    f_dc[i * 3 + c] =
-                            static_cast<float>((rgba[c] / 255.0 - 0.5) / geometry::kSH_C0);
-                }
-                const double alpha = std::clamp(rgba[3] / 255.0, kAlphaMargin, 1.0 - kAlphaMargin);
-                opacity[i] = static_cast<float>(std::log(alpha / (1.0 - alpha)));
-                for (int c = 0; c < 4; ++c) {
-                    rot[i * 4 + c] = static_cast<float>((record[28 + c] - 128) / 128.0);
-                }
-            },
-            4096);
+        n,
+        [&](int64_t i) {
+            const uint8_t* record = bytes.data() + i * kSplatBytes;
+            float floats[6];
+            std::memcpy(floats, record, sizeof(floats));
+            for (int c = 0; c < 3; ++c) {
+                positions[i * 3 + c] = floats[c];
+                scale[i * 3 + c] = floats[3 + c];
+            }
+            const uint8_t* rgba = record + 24;
+            for (int c = 0; c < 3; ++c) {
+                f_dc[i * 3 + c] = static_cast<float>((rgba[c] / 255.0 - 0.5) / geometry::kSH_C0);
+            }
+            const double alpha = std::clamp(rgba[3] / 255.0, kAlphaMargin, 1.0 - kAlphaMargin);
+            opacity[i] = static_cast<float>(std::log(alpha / (1.0 - alpha)));
+            for (int c = 0; c < 4; ++c) {
+                rot[i * 4 + c] = static_cast<float>((record[28 + c] - 128) / 128.0);
+            }
+        },
+        4096);
     return FinalizeColumns(filename, columns, options, report);
 }
 
 void WriteSplat(const std::string& filename, const geometry::PointCloud& cloud) {
     using namespace geometry::gs_attr;
     if (!cloud.IsGaussianSplat()) {
-        core::ThrowError("Cannot write '{}': .splat needs a Gaussian splat cloud (scale, rot, "
-                         "opacity, f_dc)",
-                         filename);
+        core::ThrowError(
+            "Cannot write '{}': .splat needs a Gaussian splat cloud (scale, rot, "
+            "opacity, f_dc)",
+            filename);
     }
     if (cloud.GaussianSplatGetSHOrder() > 0) {
         core::LogWarning("'{}': .splat holds SH degree 0 only; f_rest (degree {}) is not written",
@@ -91,32 +92,33 @@ void WriteSplat(const std::string& filename, const geometry::PointCloud& cloud) 
     std::vector<uint8_t> bytes(n * kSplatBytes);
     std::vector<uint8_t> clamped(n, 0);
     core::ParallelFor(
-            n,
-            [&](int64_t i) {
-                uint8_t* record = bytes.data() + i * kSplatBytes;
-                std::memcpy(record, positions + i * 3, 12);
-                std::memcpy(record + 12, scale + i * 3, 12);
-                for (int c = 0; c < 3; ++c) {
-                    const double colour = 0.5 + geometry::kSH_C0 * f_dc[i * 3 + c];
-                    if (colour < -0.5 / 255 || colour > 1.0 + 0.5 / 255) clamped[i] = 1;
-                    record[24 + c] = QuantiseUnit(colour);
-                }
-                record[27] = QuantiseUnit(1.0 / (1.0 + std::exp(-double(opacity[i]))));
-                const float* q = rot + i * 4;
-                const double norm = std::sqrt(double(q[0]) * q[0] + double(q[1]) * q[1] +
-                                              double(q[2]) * q[2] + double(q[3]) * q[3]);
-                for (int c = 0; c < 4; ++c) {
-                    const double v = norm > 0 ? q[c] / norm : 0.0;
-                    record[28 + c] = static_cast<uint8_t>(
-                            std::clamp(std::lround(v * 128.0 + 128.0), 0L, 255L));
-                }
-            },
-            4096);
+        n,
+        [&](int64_t i) {
+            uint8_t* record = bytes.data() + i * kSplatBytes;
+            std::memcpy(record, positions + i * 3, 12);
+            std::memcpy(record + 12, scale + i * 3, 12);
+            for (int c = 0; c < 3; ++c) {
+                const double colour = 0.5 + geometry::kSH_C0 * f_dc[i * 3 + c];
+                if (colour < -0.5 / 255 || colour > 1.0 + 0.5 / 255) clamped[i] = 1;
+                record[24 + c] = QuantiseUnit(colour);
+            }
+            record[27] = QuantiseUnit(1.0 / (1.0 + std::exp(-double(opacity[i]))));
+            const float* q = rot + i * 4;
+            const double norm = std::sqrt(double(q[0]) * q[0] + double(q[1]) * q[1] +
+                                          double(q[2]) * q[2] + double(q[3]) * q[3]);
+            for (int c = 0; c < 4; ++c) {
+                const double v = norm > 0 ? q[c] / norm : 0.0;
+                record[28 + c] =
+                    static_cast<uint8_t>(std::clamp(std::lround(v * 128.0 + 128.0), 0L, 255L));
+            }
+        },
+        4096);
     const int64_t num_clamped = std::count(clamped.begin(), clamped.end(), 1);
     if (num_clamped > 0) {
-        core::LogWarning("'{}': {} splats have base colours outside [0, 1], clamped by .splat's "
-                         "8-bit colour",
-                         filename, num_clamped);
+        core::LogWarning(
+            "'{}': {} splats have base colours outside [0, 1], clamped by .splat's "
+            "8-bit colour",
+            filename, num_clamped);
     }
     WriteFileBytes(filename, bytes);
 }

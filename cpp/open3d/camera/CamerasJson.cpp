@@ -1,0 +1,113 @@
+#include "open3d/camera/CamerasJson.h"
+
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "open3d/core/Exception.h"
+
+namespace open3d {
+namespace camera {
+
+namespace {
+
+using Json = nlohmann::json;
+
+const Json& Field(const Json& entry, const char* name, const std::string& where) {
+    auto it = entry.find(name);
+    if (it == entry.end()) core::ThrowError("{}: missing field '{}'", where, name);
+    return *it;
+}
+
+double Number(const Json& entry, const char* name, const std::string& where) {
+    const Json& v = Field(entry, name, where);
+    if (!v.is_number()) core::ThrowError("{}: field '{}' must be a number", where, name);
+    return v.get<double>();
+}
+
+int Integer(const Json& entry, const char* name, const std::string& where) {
+    const Json& v = Field(entry, name, where);
+    if (!v.is_number_integer()) core::ThrowError("{}: field '{}' must be an integer", where, name);
+    return v.get<int>();
+}
+
+Eigen::Vector3d Vec3(const Json& v, const std::string& what) {
+    if (!v.is_array() || v.size() != 3) core::ThrowError("{} must be a list of 3 numbers", what);
+    Eigen::Vector3d out;
+    for (int i = 0; i < 3; ++i) {
+        if (!v[i].is_number()) core::ThrowError("{} must be a list of 3 numbers", what);
+        out[i] = v[i].get<double>();
+    }
+    return out;
+}
+
+CameraView ParseEntry(const Json& entry, const std::string& where) {
+    if (!entry.is_object()) core::ThrowError("{}: must be an object", where);
+    CameraView view;
+    view.id = Integer(entry, "id", where);
+    if (entry.contains("img_name") && entry["img_name"].is_string()) {
+        view.img_name = entry["img_name"].get<std::string>();
+    }
+    PinholeCamera& cam = view.camera;
+    cam.width = Integer(entry, "width", where);
+    cam.height = Integer(entry, "height", where);
+    cam.fx = Number(entry, "fx", where);
+    cam.fy = Number(entry, "fy", where);
+    if (cam.width <= 0 || cam.height <= 0) {
+        core::ThrowError("{}: image size must be positive, got {}x{}", where, cam.width,
+                         cam.height);
+    }
+    if (!(cam.fx > 0 && cam.fy > 0)) {
+        core::ThrowError("{}: fx and fy must be positive, got {} {}", where, cam.fx, cam.fy);
+    }
+    cam.cx = (cam.width - 1) / 2.0;
+    cam.cy = (cam.height - 1) / 2.0;
+    const Eigen::Vector3d position = Vec3(Field(entry, "position", where), where + ": 'position'");
+    const Json& rot = Field(entry, "rotation", where);
+    if (!rot.is_array() || rot.size() != 3) {
+        core::ThrowError("{}: 'rotation' must be a 3x3 list of rows", where);
+    }
+    Eigen::Matrix3d camera_to_world;
+    for (int r = 0; r < 3; ++r) {
+        camera_to_world.row(r) = Vec3(rot[r], where + ": 'rotation' row").transpose();
+    }
+    const Eigen::Matrix3d world_to_camera = camera_to_world.transpose();
+    cam.world_to_camera.setIdentity();
+    cam.world_to_camera.topLeftCorner<3, 3>() = world_to_camera;
+    cam.world_to_camera.topRightCorner<3, 1>() = -world_to_camera * position;
+    try {
+        cam.Validate();
+    } catch (const core::Open3DError& e) {
+        core::ThrowError("{}: {}", where, e.what());
+    }
+    return view;
+}
+
+}  // namespace
+
+std::vector<CameraView> ParseCamerasJson(const std::string& text, const std::string& source_name) {
+    Json root;
+    try {
+        root = Json::parse(text);
+    } catch (const Json::parse_error& e) {
+        core::ThrowError("{}: malformed JSON: {}", source_name, e.what());
+    }
+    if (!root.is_array()) core::ThrowError("{}: expected a JSON list of cameras", source_name);
+    std::vector<CameraView> views;
+    views.reserve(root.size());
+    for (size_t i = 0; i < root.size(); ++i) {
+        views.push_back(ParseEntry(root[i], fmt::format("{}: camera entry {}", source_name, i)));
+    }
+    return views;
+}
+
+std::vector<CameraView> ReadCamerasJson(const std::string& filename) {
+    std::ifstream in(filename, std::ios::binary);
+    if (!in) core::ThrowError("cannot open cameras file '{}'", filename);
+    std::stringstream buffer;
+    buffer << in.rdbuf();
+    return ParseCamerasJson(buffer.str(), filename);
+}
+
+}  // namespace camera
+}  // namespace open3d

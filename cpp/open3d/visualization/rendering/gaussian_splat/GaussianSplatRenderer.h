@@ -1,0 +1,77 @@
+// The backend interface at stage granularity (docs/DESIGN.md section 2): a backend holds a
+// scene, runs Stage A (RenderGeometryStage: project + per-tile entries + depth sort) for a
+// view, then Stage B (RenderCompositeStage: per-tile front-to-back blending). Backends are
+// made by name ("cpu", "placeholder", later "vulkan"/"metal" registered by their layers).
+#pragma once
+
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "open3d/camera/PinholeCamera.h"
+#include "open3d/t/geometry/Image.h"
+#include "open3d/t/geometry/PointCloud.h"
+#include "open3d/visualization/rendering/gaussian_splat/RenderConfig.h"
+
+namespace open3d {
+namespace visualization {
+namespace rendering {
+
+/// Images of one frame, all camera.height x camera.width.
+struct RenderOutput {
+    /// Float32 [H, W, 4]: rgb = C + T * background, a = 1 - T (premultiplied when the
+    /// background is black).
+    t::geometry::Image color;
+    /// Float32 [H, W, 1]: sum(alpha_i T_i z_i) / (1 - T), view-space z; 0 where no splat
+    /// contributes.
+    t::geometry::Image depth_expected;
+    /// Float32 [H, W, 1]: view-space z of the first blended splat after which 1 - T >= 0.5;
+    /// 0 where the accumulated alpha never reaches one half.
+    t::geometry::Image depth_median;
+    RenderStats stats;
+};
+
+/// Optional inputs to the composite stage.
+struct CompositeInputs {
+    /// Float32 [H, W, 1] view-space z of opaque scene geometry (meshes), or empty for none.
+    /// A splat is skipped at a pixel when its depth is greater than the scene depth there.
+    const t::geometry::Image* scene_depth = nullptr;
+};
+
+class GaussianSplatBackend {
+public:
+    virtual ~GaussianSplatBackend() = default;
+
+    /// Registered name, e.g. "cpu".
+    virtual std::string GetName() const = 0;
+
+    /// Lifecycle: takes (a copy of or a GPU upload of) the splat scene. Throws
+    /// core::Open3DError when the cloud is not a valid Gaussian splat cloud.
+    virtual void SetScene(const t::geometry::PointCloud& cloud) = 0;
+    /// Lifecycle: drops the scene and every per-view buffer.
+    virtual void ReleaseResources() = 0;
+
+    /// Stage A for one view: project, emit per-tile entries, sort by (tile, depth).
+    virtual void RenderGeometryStage(const camera::PinholeCamera& camera,
+                                     const RenderConfig& config) = 0;
+    /// Stage B: composite the sorted tiles of the last geometry stage into `output`
+    /// (images are (re)allocated to the view size). Throws when no geometry stage ran.
+    virtual void RenderCompositeStage(RenderOutput& output, const CompositeInputs& inputs = {}) = 0;
+
+    /// Both stages.
+    RenderOutput Render(const camera::PinholeCamera& camera, const RenderConfig& config);
+};
+
+using GaussianSplatBackendFactory = std::function<std::unique_ptr<GaussianSplatBackend>()>;
+
+/// Adds (or replaces) a backend factory. Higher layers (Vulkan, Metal) register theirs.
+void RegisterGaussianSplatBackend(const std::string& name, GaussianSplatBackendFactory factory);
+/// Names of the registered backends, sorted ("cpu" and "placeholder" are built in).
+std::vector<std::string> GetGaussianSplatBackendNames();
+/// Makes a backend by name; throws core::Open3DError naming the known backends otherwise.
+std::unique_ptr<GaussianSplatBackend> CreateGaussianSplatBackend(const std::string& name);
+
+}  // namespace rendering
+}  // namespace visualization
+}  // namespace open3d

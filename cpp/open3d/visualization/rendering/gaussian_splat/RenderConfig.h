@@ -1,0 +1,47 @@
+// Every knob of the Gaussian splat pipeline, shared by all backends. Defaults reproduce
+// the original 3DGS rasterizer (docs/DESIGN.md section 3); other values are measured options.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+
+namespace open3d {
+namespace visualization {
+namespace rendering {
+
+/// Side of the square screen tiles (pixels), as in the 3DGS rasterizer (BLOCK_X = BLOCK_Y).
+inline constexpr int kTileSize = 16;
+
+struct RenderConfig {
+    /// Splats with view-space z <= near_plane are culled (3DGS: 0.2).
+    double near_plane = 0.2;
+    /// Upper bound on the SH degree evaluated; the scene's own degree is used when lower.
+    int sh_degree = 3;
+    /// Mip-Splatting style compensation: opacity *= sqrt(max(2.5e-5, det(cov) / det(cov + 0.3 I))).
+    bool antialias = false;
+    /// Colour where nothing covers the pixel: out.rgb = C + T * background, alpha = 1 - T
+    /// (the 3DGS rule). Black keeps the output premultiplied.
+    Eigen::Vector3d background = Eigen::Vector3d::Zero();
+    /// A splat touching more tiles than this emits no entries (flag kEntriesDropped).
+    uint32_t max_tiles_per_splat = 1u << 16;
+    /// Entries beyond this total are dropped, farthest splats first (flag kEntriesDropped).
+    uint64_t max_tile_entries_total = 1ull << 26;
+};
+
+/// Bits of RenderStats::error_flags (the same bits the GPU backends read back).
+inline constexpr uint32_t kEntriesDropped = 1u << 0;
+inline constexpr uint32_t kCountsClamped = 1u << 1;
+
+/// What a frame did, for logs, benchmarks and tests.
+struct RenderStats {
+    int64_t num_splats = 0;
+    int64_t num_visible = 0;       ///< splats that survived projection (>= 1 tile)
+    int64_t num_tile_entries = 0;  ///< (tile, splat) pairs composited
+    uint32_t error_flags = 0;      ///< kEntriesDropped | kCountsClamped
+    double geometry_ms = 0.0;      ///< project + tile entries + sort
+    double composite_ms = 0.0;
+};
+
+}  // namespace rendering
+}  // namespace visualization
+}  // namespace open3d

@@ -1,0 +1,72 @@
+#include "open3d/visualization/rendering/gaussian_splat/cpu/CpuBackend.h"
+
+#include <chrono>
+
+#include "open3d/core/Exception.h"
+#include "open3d/visualization/rendering/gaussian_splat/cpu/Composite.h"
+
+namespace open3d {
+namespace visualization {
+namespace rendering {
+namespace cpu {
+
+namespace {
+double MillisecondsSince(std::chrono::steady_clock::time_point start) {
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+        .count();
+}
+}  // namespace
+
+void CpuBackend::SetScene(const t::geometry::PointCloud& cloud) {
+    cloud.ValidateGaussianSplat();
+    cloud_ = cloud;
+    camera_.reset();
+    projected_.clear();
+    tile_lists_ = TileLists{};
+}
+
+void CpuBackend::ReleaseResources() {
+    cloud_.reset();
+    camera_.reset();
+    projected_ = {};
+    tile_lists_ = TileLists{};
+}
+
+void CpuBackend::RenderGeometryStage(const camera::PinholeCamera& camera,
+                                     const RenderConfig& config) {
+    if (!cloud_) core::ThrowError("cpu backend: RenderGeometryStage called before SetScene");
+    const auto start = std::chrono::steady_clock::now();
+    projected_ = ProjectSplats(*cloud_, camera, config);
+    tile_lists_ =
+        BuildTileLists(projected_, TileGrid::ForImage(camera.width, camera.height), config);
+    camera_ = camera;
+    config_ = config;
+    geometry_ms_ = MillisecondsSince(start);
+}
+
+void CpuBackend::RenderCompositeStage(RenderOutput& output, const CompositeInputs& inputs) {
+    if (!camera_)
+        core::ThrowError("cpu backend: RenderCompositeStage called before the geometry stage");
+    const auto start = std::chrono::steady_clock::now();
+    CompositeTiles(projected_, tile_lists_, camera_->width, camera_->height, config_, inputs,
+                   output);
+    output.stats = RenderStats{};
+    output.stats.num_splats = static_cast<int64_t>(projected_.size());
+    for (const ProjectedSplat& s : projected_) output.stats.num_visible += s.IsVisible() ? 1 : 0;
+    output.stats.num_tile_entries = tile_lists_.NumEntries();
+    output.stats.error_flags = tile_lists_.error_flags;
+    output.stats.geometry_ms = geometry_ms_;
+    output.stats.composite_ms = MillisecondsSince(start);
+}
+
+RenderOutput RenderReference(const t::geometry::PointCloud& cloud,
+                             const camera::PinholeCamera& camera, const RenderConfig& config) {
+    CpuBackend backend;
+    backend.SetScene(cloud);
+    return backend.Render(camera, config);
+}
+
+}  // namespace cpu
+}  // namespace rendering
+}  // namespace visualization
+}  // namespace open3d

@@ -1,0 +1,176 @@
+#include "open3d/visualization/rendering/gaussian_splat/cpu/Projection.h"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+
+#include "open3d/core/Exception.h"
+#include "open3d/core/ParallelFor.h"
+#include "open3d/t/geometry/SphericalHarmonics.h"
+
+namespace open3d {
+namespace visualization {
+namespace rendering {
+namespace cpu {
+
+namespace gs = t::geometry::gs_attr;
+
+ScreenEllipse ComputeScreenEllipse(double cov_a, double cov_b, double cov_c, bool antialias) {
+    // The low-pass filter: every splat covers at least about one pixel.
+    constexpr double kDilation = 0.3;
+    ScreenEllipse e;
+    const double det_raw = cov_a * cov_c - cov_b * cov_b;
+    e.cov_a = cov_a + kDilation;
+    e.cov_b = cov_b;
+    e.cov_c = cov_c + kDilation;
+    const double det = e.cov_a * e.cov_c - e.cov_b * e.cov_b;
+    if (det == 0.0) {
+        e.degenerate = true;
+        return e;
+    }
+    if (antialias) e.opacity_scale = std::sqrt(std::max(0.000025, det_raw / det));
+    e.conic_a = e.cov_c / det;
+    e.conic_b = -e.cov_b / det;
+    e.conic_c = e.cov_a / det;
+    const double mid = 0.5 * (e.cov_a + e.cov_c);
+    const double lambda1 = mid + std::sqrt(std::max(0.1, mid * mid - det));
+    const double lambda2 = mid - std::sqrt(std::max(0.1, mid * mid - det));
+    e.radius = static_cast<int>(std::ceil(3.0 * std::sqrt(std::max(lambda1, lambda2))));
+    return e;
+}
+
+void ComputeTileRect(double x, double y, int radius, const TileGrid& grid, ProjectedSplat& splat) {
+    // (int) truncates toward zero as in the CUDA code; the clamp makes that equal to floor.
+    // The double is clamped first so far-away or non-finite centres cannot overflow the cast.
+    auto lo = [](double v, int tiles) {
+        const double t = v / kTileSize;
+        if (!(t > 0.0)) return 0;
+        return static_cast<int>(std::min(t, static_cast<double>(tiles)));
+    };
+    splat.rect_min_x = lo(x - radius, grid.tiles_x);
+    splat.rect_min_y = lo(y - radius, grid.tiles_y);
+    splat.rect_max_x = lo(x + radius + kTileSize - 1, grid.tiles_x);
+    splat.rect_max_y = lo(y + radius + kTileSize - 1, grid.tiles_y);
+}
+
+namespace {
+
+struct ViewParams {
+    Eigen::Matrix3d rotation;  // world to camera
+    Eigen::Vector3d translation;
+    Eigen::Vector3d center;  // camera centre, world space
+    double fx, fy, cx, cy;
+    double lim_x, lim_y;  // 1.3 tan(fov / 2): the Jacobian guard band
+    TileGrid grid;
+};
+
+// R diag(s^2) R^T for a (w, x, y, z) quaternion, normalised here because 3DGS normalises
+// rotations before the rasterizer sees them.
+Eigen::Matrix3d Covariance3D(const float* scale, const float* rot) {
+    Eigen::Quaterniond q(rot[0], rot[1], rot[2], rot[3]);
+    const double norm = q.norm();
+    if (norm > 0.0) q.coeffs() /= norm;
+    const Eigen::Matrix3d r = q.toRotationMatrix();
+    const Eigen::Vector3d s(scale[0], scale[1], scale[2]);
+    return r * s.cwiseProduct(s).asDiagonal() * r.transpose();
+}
+
+ProjectedSplat ProjectOne(const ViewParams& view, const RenderConfig& config, int sh_degree,
+                          int64_t num_rest, const float* position, const float* scale,
+                          const float* rot, float opacity_logit, const float* f_dc,
+                          const float* f_rest) {
+    ProjectedSplat out;
+    const Eigen::Vector3d p(position[0], position[1], position[2]);
+    const Eigen::Vector3d v = view.rotation * p + view.translation;
+    out.depth = v.z();
+    if (!(v.z() > config.near_plane)) {
+        out.cull = CullReason::kNearPlane;
+        return out;
+    }
+    out.x = view.fx * v.x() / v.z() + view.cx;
+    out.y = view.fy * v.y() / v.z() + view.cy;
+
+    // Perspective Jacobian at the clamped position: splats far outside the view would
+    // otherwise get huge, smeared footprints.
+    const double tx = std::clamp(v.x() / v.z(), -view.lim_x, view.lim_x) * v.z();
+    const double ty = std::clamp(v.y() / v.z(), -view.lim_y, view.lim_y) * v.z();
+    Eigen::Matrix<double, 2, 3> j;
+    j << view.fx / v.z(), 0.0, -view.fx * tx / (v.z() * v.z()), 0.0, view.fy / v.z(),
+        -view.fy * ty / (v.z() * v.z());
+    const Eigen::Matrix<double, 2, 3> t = j * view.rotation;
+    const Eigen::Matrix2d cov = t * Covariance3D(scale, rot) * t.transpose();
+
+    const ScreenEllipse e = ComputeScreenEllipse(cov(0, 0), cov(0, 1), cov(1, 1), config.antialias);
+    out.cov_a = e.cov_a;
+    out.cov_b = e.cov_b;
+    out.cov_c = e.cov_c;
+    if (e.degenerate) {
+        out.cull = CullReason::kDegenerate;
+        return out;
+    }
+    out.conic_a = e.conic_a;
+    out.conic_b = e.conic_b;
+    out.conic_c = e.conic_c;
+    out.radius = e.radius;
+    ComputeTileRect(out.x, out.y, out.radius, view.grid, out);
+    if (out.NumTiles() == 0) {
+        out.cull = CullReason::kNoTiles;
+        return out;
+    }
+
+    const Eigen::Vector3d dir = (p - view.center).normalized();
+    const auto sh = t::geometry::EvaluateSH<double>(
+        sh_degree, f_dc, num_rest > 0 ? f_rest : nullptr, dir.x(), dir.y(), dir.z());
+    for (int c = 0; c < 3; ++c) out.color[c] = std::max(0.0, 0.5 + sh[c]);
+    out.opacity = 1.0 / (1.0 + std::exp(-static_cast<double>(opacity_logit))) * e.opacity_scale;
+    out.cull = CullReason::kVisible;
+    return out;
+}
+
+}  // namespace
+
+std::vector<ProjectedSplat> ProjectSplats(const t::geometry::PointCloud& cloud,
+                                          const camera::PinholeCamera& camera,
+                                          const RenderConfig& config) {
+    cloud.ValidateGaussianSplat();
+    camera.Validate();
+    ViewParams view;
+    view.rotation = camera.GetRotation();
+    view.translation = camera.GetTranslation();
+    view.center = camera.GetCenter();
+    view.fx = camera.fx;
+    view.fy = camera.fy;
+    view.cx = camera.cx;
+    view.cy = camera.cy;
+    view.lim_x = 1.3 * camera.GetTanHalfFovX();
+    view.lim_y = 1.3 * camera.GetTanHalfFovY();
+    view.grid = TileGrid::ForImage(camera.width, camera.height);
+
+    const int64_t n = cloud.NumPoints();
+    const int scene_degree = cloud.GaussianSplatGetSHOrder();
+    const int sh_degree = std::clamp(config.sh_degree, 0, scene_degree);
+    const int64_t num_rest = t::geometry::NumSHRestCoeffs(scene_degree);        // per channel
+    const float* positions = cloud.GetPointAttr(gs::kPositions).Data<float>();  // [N, 3]
+    const float* scales = cloud.GetPointAttr(gs::kScale).Data<float>();         // [N, 3]
+    const float* rots = cloud.GetPointAttr(gs::kRot).Data<float>();             // [N, 4]
+    const float* opacities = cloud.GetPointAttr(gs::kOpacity).Data<float>();    // [N, 1]
+    const float* f_dc = cloud.GetPointAttr(gs::kFDc).Data<float>();             // [N, 3]
+    const float* f_rest =
+        scene_degree > 0 ? cloud.GetPointAttr(gs::kFRest).Data<float>() : nullptr;  // [N, Nc, 3]
+
+    std::vector<ProjectedSplat> out(n);
+    core::ParallelFor(
+        n,
+        [&](int64_t i) {
+            out[i] = ProjectOne(view, config, sh_degree, num_rest, positions + 3 * i,
+                                scales + 3 * i, rots + 4 * i, opacities[i], f_dc + 3 * i,
+                                f_rest ? f_rest + i * num_rest * 3 : nullptr);
+        },
+        4096);
+    return out;
+}
+
+}  // namespace cpu
+}  // namespace rendering
+}  // namespace visualization
+}  // namespace open3d

@@ -1,0 +1,84 @@
+// Stage A, step 1 of the CPU reference: per-splat projection, exactly the 3DGS
+// rasterizer's preprocess (docs/DESIGN.md section 3), computed in double precision.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "open3d/camera/PinholeCamera.h"
+#include "open3d/t/geometry/PointCloud.h"
+#include "open3d/visualization/rendering/gaussian_splat/RenderConfig.h"
+
+namespace open3d {
+namespace visualization {
+namespace rendering {
+namespace cpu {
+
+/// Why a splat produced no tile entries.
+enum class CullReason : uint8_t {
+    kVisible = 0,
+    kNearPlane,   ///< view-space z <= RenderConfig::near_plane
+    kDegenerate,  ///< det(cov2D + 0.3 I) == 0
+    kNoTiles,     ///< the tile rectangle of the 3-sigma square is empty
+};
+
+/// One splat after projection. Index i of ProjectSplats' result is splat i of the cloud.
+/// Fields past `cull` are meaningful only as far as the splat got (all when visible).
+struct ProjectedSplat {
+    CullReason cull = CullReason::kNearPlane;
+    double x = 0.0, y = 0.0;  ///< centre in pixels: fx * X / Z + cx, fy * Y / Z + cy
+    double depth = 0.0;       ///< view-space Z
+    /// 2D covariance after the +0.3 dilation: [[cov_a, cov_b], [cov_b, cov_c]] (pixels^2).
+    double cov_a = 0.0, cov_b = 0.0, cov_c = 0.0;
+    /// Inverse of the dilated covariance: [[conic_a, conic_b], [conic_b, conic_c]].
+    double conic_a = 0.0, conic_b = 0.0, conic_c = 0.0;
+    int radius = 0;                 ///< ceil(3 sqrt(lambda_max)) in pixels
+    double opacity = 0.0;           ///< sigmoid(logit), times the antialias factor when enabled
+    std::array<double, 3> color{};  ///< max(0, 0.5 + SH(direction))
+    /// Tile rectangle [rect_min, rect_max) in tile units (16 px), clamped to the grid.
+    int rect_min_x = 0, rect_min_y = 0, rect_max_x = 0, rect_max_y = 0;
+
+    bool IsVisible() const { return cull == CullReason::kVisible; }
+    int64_t NumTiles() const {
+        return static_cast<int64_t>(rect_max_x - rect_min_x) * (rect_max_y - rect_min_y);
+    }
+};
+
+/// Tiles covering the image: ceil(W / 16) x ceil(H / 16).
+struct TileGrid {
+    int tiles_x = 0;
+    int tiles_y = 0;
+    static TileGrid ForImage(int width, int height) {
+        return {(width + kTileSize - 1) / kTileSize, (height + kTileSize - 1) / kTileSize};
+    }
+    int64_t NumTiles() const { return static_cast<int64_t>(tiles_x) * tiles_y; }
+};
+
+/// Screen-space parameters derived from a 2D covariance (before dilation).
+struct ScreenEllipse {
+    bool degenerate = false;  ///< det of the dilated covariance == 0
+    double cov_a = 0.0, cov_b = 0.0, cov_c = 0.0;
+    double conic_a = 0.0, conic_b = 0.0, conic_c = 0.0;
+    int radius = 0;
+    double opacity_scale = 1.0;  ///< antialias factor (1 when antialias is off)
+};
+
+/// Adds 0.3 to the diagonal, inverts, and takes the 3-sigma radius from the larger
+/// eigenvalue mid + sqrt(max(0.1, mid^2 - det)); antialias gives the opacity factor.
+ScreenEllipse ComputeScreenEllipse(double cov_a, double cov_b, double cov_c, bool antialias);
+
+/// 3DGS getRect: rect_min = clamp((int)((p - r) / 16)), rect_max = clamp((int)((p + r + 15) / 16))
+/// per axis, clamped to [0, tiles]. Writes [min, max) into the splat.
+void ComputeTileRect(double x, double y, int radius, const TileGrid& grid, ProjectedSplat& splat);
+
+/// Projects every splat of a valid Gaussian splat cloud for one camera, multi-threaded.
+/// Throws core::Open3DError for an invalid cloud or camera.
+std::vector<ProjectedSplat> ProjectSplats(const t::geometry::PointCloud& cloud,
+                                          const camera::PinholeCamera& camera,
+                                          const RenderConfig& config);
+
+}  // namespace cpu
+}  // namespace rendering
+}  // namespace visualization
+}  // namespace open3d

@@ -1,0 +1,79 @@
+#include "open3d/visualization/rendering/gaussian_splat/cpu/TileLists.h"
+
+#include <algorithm>
+
+namespace open3d {
+namespace visualization {
+namespace rendering {
+namespace cpu {
+
+std::vector<uint32_t> SortVisibleByDepth(const std::vector<ProjectedSplat>& splats) {
+    // GPU keys hold float32 depths: splats whose depths round to the same float tie
+    // there and fall back to the splat index, so the reference sorts the same way.
+    struct Key {
+        float depth;
+        uint32_t index;
+    };
+    std::vector<Key> keys;
+    keys.reserve(splats.size());
+    for (size_t i = 0; i < splats.size(); ++i) {
+        if (splats[i].IsVisible()) {
+            keys.push_back({static_cast<float>(splats[i].depth), static_cast<uint32_t>(i)});
+        }
+    }
+    std::sort(keys.begin(), keys.end(), [](const Key& a, const Key& b) {
+        return a.depth < b.depth || (a.depth == b.depth && a.index < b.index);
+    });
+    std::vector<uint32_t> order(keys.size());
+    for (size_t k = 0; k < keys.size(); ++k) order[k] = keys[k].index;
+    return order;
+}
+
+TileLists BuildTileLists(const std::vector<ProjectedSplat>& splats, const TileGrid& grid,
+                         const RenderConfig& config) {
+    TileLists lists;
+    lists.grid = grid;
+    const std::vector<uint32_t> order = SortVisibleByDepth(splats);
+
+    // Decide which splats emit entries, front to back, honouring the capacity limits.
+    std::vector<uint32_t> emitting;
+    emitting.reserve(order.size());
+    uint64_t total = 0;
+    for (uint32_t index : order) {
+        const uint64_t tiles = static_cast<uint64_t>(splats[index].NumTiles());
+        if (tiles > config.max_tiles_per_splat || total + tiles > config.max_tile_entries_total) {
+            lists.error_flags |= kEntriesDropped;
+            continue;
+        }
+        total += tiles;
+        emitting.push_back(index);
+    }
+
+    // Counting sort by tile: stable, so each tile keeps the depth order.
+    lists.offsets.assign(grid.NumTiles() + 1, 0);
+    for (uint32_t index : emitting) {
+        const ProjectedSplat& s = splats[index];
+        for (int ty = s.rect_min_y; ty < s.rect_max_y; ++ty) {
+            for (int tx = s.rect_min_x; tx < s.rect_max_x; ++tx) {
+                ++lists.offsets[static_cast<int64_t>(ty) * grid.tiles_x + tx + 1];
+            }
+        }
+    }
+    for (size_t t = 1; t < lists.offsets.size(); ++t) lists.offsets[t] += lists.offsets[t - 1];
+    std::vector<uint64_t> cursor(lists.offsets.begin(), lists.offsets.end() - 1);
+    lists.splat_indices.resize(total);
+    for (uint32_t index : emitting) {
+        const ProjectedSplat& s = splats[index];
+        for (int ty = s.rect_min_y; ty < s.rect_max_y; ++ty) {
+            for (int tx = s.rect_min_x; tx < s.rect_max_x; ++tx) {
+                lists.splat_indices[cursor[static_cast<int64_t>(ty) * grid.tiles_x + tx]++] = index;
+            }
+        }
+    }
+    return lists;
+}
+
+}  // namespace cpu
+}  // namespace rendering
+}  // namespace visualization
+}  // namespace open3d
