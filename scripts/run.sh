@@ -1,0 +1,12 @@
+#!/usr/bin/env bash
+# README command 1: builds what is needed and renders the built-in default scene
+# (SH degree 3, anisotropic, semi-transparent splats) to a PNG with gs-render.
+# Any arguments are passed to gs-render (try: scripts/run.sh --help).
+set -euo pipefail
+root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+build_dir="${BUILD_DIR:-$root/build}"
+bash "$root/scripts/build.sh" >/dev/null
+if [ $# -eq 0 ]; then
+  set -- --output "$build_dir/default_scene.png"
+fi
+exec "$build_dir/bin/gs-render" "$@"
