@@ -2,6 +2,8 @@
 // geometry (covariance, view-dependent colour), and a refused transform changes nothing.
 #include <gtest/gtest.h>
 
+#include "RandomGeometry.h"
+
 #include <Eigen/Dense>
 #include <Eigen/Geometry>
 #include <array>
@@ -27,23 +29,6 @@ namespace {
 
 using core::Dtype;
 using core::Tensor;
-
-std::string Sci(double value) {
-    char text[32];
-    std::snprintf(text, sizeof(text), "%.3g", value);
-    return text;
-}
-
-Eigen::Matrix3d RandomRotation(std::mt19937& rng) {
-    std::normal_distribution<double> normal;
-    Eigen::Quaterniond q(normal(rng), normal(rng), normal(rng), normal(rng));
-    return q.normalized().toRotationMatrix();
-}
-
-Eigen::Vector3d RandomDirection(std::mt19937& rng) {
-    std::normal_distribution<double> normal;
-    return Eigen::Vector3d(normal(rng), normal(rng), normal(rng)).normalized();
-}
 
 Tensor RandomTensor(std::mt19937& rng, const core::SizeVector& shape, float lo, float hi) {
     Tensor t(shape, Dtype::Float32);

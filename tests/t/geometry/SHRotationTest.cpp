@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include "RandomGeometry.h"
+
 #include <Eigen/Dense>
 #include <Eigen/Geometry>
 #include <cmath>
@@ -20,25 +22,6 @@ namespace open3d {
 namespace t {
 namespace geometry {
 namespace {
-
-// Measured errors go to the test XML (--gtest_output=xml) in scientific notation.
-std::string Sci(double value) {
-    char text[32];
-    std::snprintf(text, sizeof(text), "%.3g", value);
-    return text;
-}
-
-// Uniform random rotation: a normalised 4D Gaussian is a uniform unit quaternion.
-Eigen::Matrix3d RandomRotation(std::mt19937& rng) {
-    std::normal_distribution<double> normal;
-    Eigen::Quaterniond q(normal(rng), normal(rng), normal(rng), normal(rng));
-    return q.normalized().toRotationMatrix();
-}
-
-Eigen::Vector3d RandomDirection(std::mt19937& rng) {
-    std::normal_distribution<double> normal;
-    return Eigen::Vector3d(normal(rng), normal(rng), normal(rng)).normalized();
-}
 
 // Basis values of band l (2l+1 of them) at a unit direction.
 Eigen::VectorXd BandBasis(int l, const Eigen::Vector3d& d) {
