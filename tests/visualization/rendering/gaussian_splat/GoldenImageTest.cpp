@@ -22,6 +22,9 @@ struct GoldenCase {
     const char* golden;   // file name under golden/
 };
 
+// Names the golden instead of dumping the struct's bytes in test listings.
+inline void PrintTo(const GoldenCase& c, std::ostream* os) { *os << c.golden; }
+
 class GoldenImage : public ::testing::TestWithParam<GoldenCase> {};
 
 TEST_P(GoldenImage, View0At64x64MatchesGolden) {
