@@ -8,6 +8,10 @@ function(open3d_set_target_flags target)
                                              -fno-sanitize-recover=undefined)
     target_link_options(${target} PRIVATE -fsanitize=address,undefined)
   endif()
+  if(OPEN3D_BUILD_FUZZERS)
+    # Coverage instrumentation for libFuzzer in every library the harnesses link.
+    target_compile_options(${target} PRIVATE -fsanitize=fuzzer-no-link)
+  endif()
 endfunction()
 
 # open3d_add_library(name SOURCES ... DEPS ...): one library per layer.

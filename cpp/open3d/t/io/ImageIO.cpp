@@ -154,9 +154,16 @@ geometry::Image ReadPNG(const std::string& filename) {
     const int channels = png_get_channels(png, info);
     const int out_depth = png_get_bit_depth(png, info);
     const size_t row_bytes = png_get_rowbytes(png, info);
+    // A longjmp must not skip a destructor: C++ objects that libpng calls may jump over are
+    // created before this second setjmp, so they stay live in this frame and unwind normally.
     std::vector<uint8_t> buffer(row_bytes * height);
     rows.resize(height);
     for (int y = 0; y < height; ++y) rows[y] = buffer.data() + y * row_bytes;
+    if (setjmp(png_jmpbuf(png))) {
+        png_destroy_read_struct(&png, &info, nullptr);
+        std::fclose(file);
+        core::ThrowError("failed to read PNG '{}': {}", filename, state.message);
+    }
     png_read_image(png, rows.data());
     png_read_end(png, nullptr);
     png_destroy_read_struct(&png, &info, nullptr);
