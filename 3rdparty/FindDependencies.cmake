@@ -16,3 +16,9 @@ endif()
 if(OPEN3D_BUILD_BENCHMARKS)
   find_package(benchmark REQUIRED)
 endif()
+
+# Vulkan compute backend: loader + headers (libvulkan-dev 1.3.239), and the shader tools
+# (glslang-tools 12, spirv-cross) used by cmake/CompileShaders.cmake.
+find_package(Vulkan REQUIRED)
+find_program(GLSLANG_VALIDATOR glslangValidator REQUIRED)
+find_program(SPIRV_CROSS spirv-cross REQUIRED)

@@ -20,7 +20,7 @@ run() {  # name, seed files...
   mkdir -p "$corpus"
   for f in "$@"; do [ -f "$f" ] && cp -n "$f" "$corpus/" || true; done
   echo "fuzz: $name for ${seconds}s"
-  "$build_dir/tests/fuzz/$name" "$corpus" -max_total_time="$seconds" -rss_limit_mb=2048 \
+  "$build_dir/bin/$name" "$corpus" -max_total_time="$seconds" -rss_limit_mb=2048 \
     -max_len=65536 -artifact_prefix="$artifacts/$name-" -print_final_stats=1 2>&1 | tail -n 12
 }
 run fuzz_ply_reader "$data/pc_short/pc_short.ply" "$data/train3/train_3points.ply" "$root"/tests/fuzz/seeds/*.ply

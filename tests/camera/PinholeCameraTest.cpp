@@ -146,6 +146,15 @@ TEST(CamerasJson, ErrorsNameFileEntryAndField) {
         "rotation": [[1,0,0],[0,1,0],[0,0,1]], "fx": 10, "fy": 10}])",
                  "size");
     EXPECT_THROW(camera::ReadCamerasJson(dir + "/missing.json"), core::Open3DError);
+    // Found by fuzz_cameras_json: a number too large for a double made nlohmann throw
+    // out_of_range (not parse_error), which escaped as a non-Open3D exception.
+    expect_error(R"([{"id": 0, "width": 8, "height": 8, "position": [0,0,-0.7071e067811865476],
+        "rotation": [[1,0,0],[0,1,0],[0,0,1]], "fx": 10, "fy": 10}])",
+                 "malformed JSON");
+    // Integers beyond int range are refused rather than wrapped.
+    expect_error(R"([{"id": 0, "width": 8589934600, "height": 8, "position": [0,0,0],
+        "rotation": [[1,0,0],[0,1,0],[0,0,1]], "fx": 10, "fy": 10}])",
+                 "out of range");
 }
 
 TEST(CamerasJson, ReadsSharedPlaybotCameras) {

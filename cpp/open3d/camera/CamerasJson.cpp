@@ -1,5 +1,8 @@
 #include "open3d/camera/CamerasJson.h"
 
+#include <algorithm>
+#include <cstdint>
+
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -28,7 +31,14 @@ double Number(const Json& entry, const char* name, const std::string& where) {
 int Integer(const Json& entry, const char* name, const std::string& where) {
     const Json& v = Field(entry, name, where);
     if (!v.is_number_integer()) core::ThrowError("{}: field '{}' must be an integer", where, name);
-    return v.get<int>();
+    const int64_t value =
+        v.is_number_unsigned()
+            ? static_cast<int64_t>(std::min<uint64_t>(v.get<uint64_t>(), uint64_t(INT64_MAX)))
+            : v.get<int64_t>();
+    if (value < INT32_MIN || value > INT32_MAX) {
+        core::ThrowError("{}: field '{}' = {} is out of range", where, name, value);
+    }
+    return static_cast<int>(value);
 }
 
 Eigen::Vector3d Vec3(const Json& v, const std::string& what) {
@@ -89,7 +99,7 @@ std::vector<CameraView> ParseCamerasJson(const std::string& text, const std::str
     Json root;
     try {
         root = Json::parse(text);
-    } catch (const Json::parse_error& e) {
+    } catch (const Json::exception& e) {  // parse_error, and out_of_range for number overflow
         core::ThrowError("{}: malformed JSON: {}", source_name, e.what());
     }
     if (!root.is_array()) core::ThrowError("{}: expected a JSON list of cameras", source_name);

@@ -115,6 +115,44 @@ void WritePNG16(const std::string& filename, const geometry::Image& image, doubl
                  16, rows);
 }
 
+namespace {
+
+// The libpng calls that may longjmp run in these two frames, which hold only plain C data:
+// a longjmp must not skip a C++ destructor (GCC's -Wclobbered and LeakSanitizer agree).
+struct PngLayout {
+    int width = 0, height = 0, channels = 0, depth = 0;
+    size_t row_bytes = 0;
+};
+
+bool ReadPngLayout(png_structp png, png_infop info, FILE* file, PngLayout* layout) {
+    if (setjmp(png_jmpbuf(png))) return false;
+    png_init_io(png, file);
+    png_set_sig_bytes(png, 8);
+    png_read_info(png, info);
+    const int color_type = png_get_color_type(png, info);
+    const int bit_depth = png_get_bit_depth(png, info);
+    if (color_type == PNG_COLOR_TYPE_PALETTE) png_set_palette_to_rgb(png);
+    if (color_type == PNG_COLOR_TYPE_GRAY && bit_depth < 8) png_set_expand_gray_1_2_4_to_8(png);
+    if (png_get_valid(png, info, PNG_INFO_tRNS)) png_set_tRNS_to_alpha(png);
+    if (bit_depth == 16) png_set_swap(png);
+    png_read_update_info(png, info);
+    layout->width = static_cast<int>(png_get_image_width(png, info));
+    layout->height = static_cast<int>(png_get_image_height(png, info));
+    layout->channels = png_get_channels(png, info);
+    layout->depth = png_get_bit_depth(png, info);
+    layout->row_bytes = png_get_rowbytes(png, info);
+    return true;
+}
+
+bool ReadPngRows(png_structp png, png_bytep* rows) {
+    if (setjmp(png_jmpbuf(png))) return false;
+    png_read_image(png, rows);
+    png_read_end(png, nullptr);
+    return true;
+}
+
+}  // namespace
+
 geometry::Image ReadPNG(const std::string& filename) {
     FILE* file = std::fopen(filename.c_str(), "rb");
     if (!file) core::ThrowError("cannot open PNG '{}'", filename);
@@ -126,49 +164,24 @@ geometry::Image ReadPNG(const std::string& filename) {
     PngErrorState state;
     png_structp png = png_create_read_struct(PNG_LIBPNG_VER_STRING, &state, PngError, PngWarning);
     png_infop info = png ? png_create_info_struct(png) : nullptr;
-    if (!png || !info) {
+    auto fail = [&](const char* what) {
         png_destroy_read_struct(&png, &info, nullptr);
         std::fclose(file);
-        core::ThrowError("libpng could not be initialised for '{}'", filename);
-    }
-    // Filled before the rows are read; a longjmp only lands here from inside libpng.
-    geometry::Image image;
-    std::vector<png_bytep> rows;
-    if (setjmp(png_jmpbuf(png))) {
-        png_destroy_read_struct(&png, &info, nullptr);
-        std::fclose(file);
-        core::ThrowError("failed to read PNG '{}': {}", filename, state.message);
-    }
-    png_init_io(png, file);
-    png_set_sig_bytes(png, 8);
-    png_read_info(png, info);
-    const int color_type = png_get_color_type(png, info);
-    const int bit_depth = png_get_bit_depth(png, info);
-    if (color_type == PNG_COLOR_TYPE_PALETTE) png_set_palette_to_rgb(png);
-    if (color_type == PNG_COLOR_TYPE_GRAY && bit_depth < 8) png_set_expand_gray_1_2_4_to_8(png);
-    if (png_get_valid(png, info, PNG_INFO_tRNS)) png_set_tRNS_to_alpha(png);
-    if (bit_depth == 16) png_set_swap(png);
-    png_read_update_info(png, info);
-    const int width = static_cast<int>(png_get_image_width(png, info));
-    const int height = static_cast<int>(png_get_image_height(png, info));
-    const int channels = png_get_channels(png, info);
-    const int out_depth = png_get_bit_depth(png, info);
-    const size_t row_bytes = png_get_rowbytes(png, info);
-    // A longjmp must not skip a destructor: C++ objects that libpng calls may jump over are
-    // created before this second setjmp, so they stay live in this frame and unwind normally.
-    std::vector<uint8_t> buffer(row_bytes * height);
-    rows.resize(height);
-    for (int y = 0; y < height; ++y) rows[y] = buffer.data() + y * row_bytes;
-    if (setjmp(png_jmpbuf(png))) {
-        png_destroy_read_struct(&png, &info, nullptr);
-        std::fclose(file);
-        core::ThrowError("failed to read PNG '{}': {}", filename, state.message);
-    }
-    png_read_image(png, rows.data());
-    png_read_end(png, nullptr);
+        core::ThrowError("failed to read PNG '{}': {}", filename, what);
+    };
+    if (!png || !info) fail("libpng could not be initialised");
+    PngLayout layout;
+    if (!ReadPngLayout(png, info, file, &layout)) fail(state.message);
+    std::vector<uint8_t> buffer(layout.row_bytes * layout.height);
+    std::vector<png_bytep> rows(layout.height);
+    for (int y = 0; y < layout.height; ++y) rows[y] = buffer.data() + y * layout.row_bytes;
+    if (!ReadPngRows(png, rows.data())) fail(state.message);
     png_destroy_read_struct(&png, &info, nullptr);
     std::fclose(file);
 
+    const int width = layout.width, height = layout.height, channels = layout.channels;
+    const int out_depth = layout.depth;
+    geometry::Image image;
     if (out_depth == 16) {
         image = geometry::Image(height, width, channels, core::Dtype::Float32);
         float* dst = image.Data<float>();

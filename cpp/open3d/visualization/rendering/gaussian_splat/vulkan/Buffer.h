@@ -1,0 +1,77 @@
+// A VkBuffer with its own memory allocation (written by hand: one allocation per buffer,
+// which suits the few large buffers of the splat pipeline), and BufferRange, the
+// non-owning view that recorders take so they work on buffers of any owner.
+#pragma once
+
+#include <vulkan/vulkan.h>
+
+#include <cstdint>
+#include <utility>
+
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/VulkanHandle.h"
+
+namespace open3d {
+namespace visualization {
+namespace rendering {
+namespace vulkan {
+
+class VulkanContext;
+
+/// A byte range of a buffer that someone else owns.
+struct BufferRange {
+    VkBuffer buffer = VK_NULL_HANDLE;
+    VkDeviceSize offset = 0;
+    VkDeviceSize size = VK_WHOLE_SIZE;
+};
+
+enum class MemoryUsage {
+    /// GPU-only memory (DEVICE_LOCAL).
+    kDevice,
+    /// HOST_VISIBLE | HOST_COHERENT, persistently mapped: uploads and small parameters.
+    kHostUpload,
+    /// HOST_VISIBLE | HOST_COHERENT, preferably HOST_CACHED, persistently mapped: readback.
+    kHostReadback,
+};
+
+class Buffer {
+public:
+    Buffer() = default;
+    /// Creates a buffer of `size` bytes (> 0) with `usage` and binds fresh memory to it.
+    /// Throws core::Open3DError when the allocation fails.
+    Buffer(const VulkanContext& context, VkDeviceSize size, VkBufferUsageFlags usage,
+           MemoryUsage memory);
+
+    Buffer(Buffer&& other) noexcept
+        : memory_(std::move(other.memory_)),
+          buffer_(std::move(other.buffer_)),
+          size_(std::exchange(other.size_, 0)),
+          mapped_(std::exchange(other.mapped_, nullptr)) {}
+    Buffer& operator=(Buffer&& other) noexcept {
+        buffer_ = std::move(other.buffer_);  // buffer before memory, as in the destructor
+        memory_ = std::move(other.memory_);
+        size_ = std::exchange(other.size_, 0);
+        mapped_ = std::exchange(other.mapped_, nullptr);
+        return *this;
+    }
+    ~Buffer() = default;
+
+    VkBuffer Get() const { return buffer_.Get(); }
+    VkDeviceSize GetSize() const { return size_; }
+    /// The whole buffer, or [offset, offset + size).
+    BufferRange Range(VkDeviceSize offset = 0, VkDeviceSize size = VK_WHOLE_SIZE) const;
+    /// Host pointer of a kHostUpload / kHostReadback buffer, nullptr for kDevice.
+    void* GetMapped() const { return mapped_; }
+    explicit operator bool() const { return static_cast<bool>(buffer_); }
+
+private:
+    // Declared first so the buffer is destroyed before its memory is freed.
+    UniqueDeviceMemory memory_;
+    UniqueBuffer buffer_;
+    VkDeviceSize size_ = 0;
+    void* mapped_ = nullptr;  // unmapped implicitly by vkFreeMemory
+};
+
+}  // namespace vulkan
+}  // namespace rendering
+}  // namespace visualization
+}  // namespace open3d

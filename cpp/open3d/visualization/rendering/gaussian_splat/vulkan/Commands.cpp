@@ -1,0 +1,96 @@
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/Commands.h"
+
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/VulkanContext.h"
+
+namespace open3d {
+namespace visualization {
+namespace rendering {
+namespace vulkan {
+
+void CommandBuffer::Begin() const {
+    VkCommandBufferBeginInfo info =
+        MakeInfo<VkCommandBufferBeginInfo>(VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO);
+    info.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
+    CheckVk(vkBeginCommandBuffer(buffer_, &info), "vkBeginCommandBuffer");
+}
+
+void CommandBuffer::End() const { CheckVk(vkEndCommandBuffer(buffer_), "vkEndCommandBuffer"); }
+
+void CommandBuffer::Reset() {
+    if (buffer_ != VK_NULL_HANDLE) vkFreeCommandBuffers(device_, pool_, 1, &buffer_);
+    buffer_ = VK_NULL_HANDLE;
+}
+
+CommandPool::CommandPool(const VulkanContext& context) {
+    VkCommandPoolCreateInfo info =
+        MakeInfo<VkCommandPoolCreateInfo>(VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO);
+    info.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
+    info.queueFamilyIndex = context.GetQueueFamilyIndex();
+    VkCommandPool pool = VK_NULL_HANDLE;
+    CheckVk(vkCreateCommandPool(context.GetDevice(), &info, nullptr, &pool), "vkCreateCommandPool");
+    pool_ = UniqueCommandPool(context.GetDevice(), pool);
+}
+
+CommandBuffer CommandPool::Allocate() const {
+    VkCommandBufferAllocateInfo info =
+        MakeInfo<VkCommandBufferAllocateInfo>(VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO);
+    info.commandPool = pool_.Get();
+    info.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
+    info.commandBufferCount = 1;
+    VkCommandBuffer buffer = VK_NULL_HANDLE;
+    CheckVk(vkAllocateCommandBuffers(pool_.GetDevice(), &info, &buffer),
+            "vkAllocateCommandBuffers");
+    return CommandBuffer(pool_.GetDevice(), pool_.Get(), buffer);
+}
+
+UniqueFence CreateFence(const VulkanContext& context) {
+    VkFenceCreateInfo info = MakeInfo<VkFenceCreateInfo>(VK_STRUCTURE_TYPE_FENCE_CREATE_INFO);
+    VkFence fence = VK_NULL_HANDLE;
+    CheckVk(vkCreateFence(context.GetDevice(), &info, nullptr, &fence), "vkCreateFence");
+    return UniqueFence(context.GetDevice(), fence);
+}
+
+void Submit(const VulkanContext& context, VkCommandBuffer cmd, VkFence fence) {
+    VkCommandBufferSubmitInfo cmd_info =
+        MakeInfo<VkCommandBufferSubmitInfo>(VK_STRUCTURE_TYPE_COMMAND_BUFFER_SUBMIT_INFO);
+    cmd_info.commandBuffer = cmd;
+    VkSubmitInfo2 submit = MakeInfo<VkSubmitInfo2>(VK_STRUCTURE_TYPE_SUBMIT_INFO_2);
+    submit.commandBufferInfoCount = 1;
+    submit.pCommandBufferInfos = &cmd_info;
+    CheckVk(vkQueueSubmit2(context.GetQueue(), 1, &submit, fence), "vkQueueSubmit2");
+}
+
+void Wait(const VulkanContext& context, VkFence fence) {
+    CheckVk(vkWaitForFences(context.GetDevice(), 1, &fence, VK_TRUE, UINT64_MAX),
+            "vkWaitForFences");
+}
+
+void SubmitAndWait(const VulkanContext& context, const CommandPool& pool,
+                   const std::function<void(VkCommandBuffer)>& record) {
+    CommandBuffer cmd = pool.Allocate();
+    cmd.Begin();
+    record(cmd.Get());
+    cmd.End();
+    UniqueFence fence = CreateFence(context);
+    Submit(context, cmd.Get(), fence.Get());
+    Wait(context, fence.Get());
+}
+
+void RecordMemoryBarrier(VkCommandBuffer cmd, VkPipelineStageFlags2 src_stages,
+                         VkAccessFlags2 src_access, VkPipelineStageFlags2 dst_stages,
+                         VkAccessFlags2 dst_access) {
+    VkMemoryBarrier2 barrier = MakeInfo<VkMemoryBarrier2>(VK_STRUCTURE_TYPE_MEMORY_BARRIER_2);
+    barrier.srcStageMask = src_stages;
+    barrier.srcAccessMask = src_access;
+    barrier.dstStageMask = dst_stages;
+    barrier.dstAccessMask = dst_access;
+    VkDependencyInfo dependency = MakeInfo<VkDependencyInfo>(VK_STRUCTURE_TYPE_DEPENDENCY_INFO);
+    dependency.memoryBarrierCount = 1;
+    dependency.pMemoryBarriers = &barrier;
+    vkCmdPipelineBarrier2(cmd, &dependency);
+}
+
+}  // namespace vulkan
+}  // namespace rendering
+}  // namespace visualization
+}  // namespace open3d

@@ -1,0 +1,89 @@
+// Command pools, command buffers, fences and the barrier helper the recorders share.
+#pragma once
+
+#include <vulkan/vulkan.h>
+
+#include <cstdint>
+#include <functional>
+#include <utility>
+
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/VulkanHandle.h"
+
+namespace open3d {
+namespace visualization {
+namespace rendering {
+namespace vulkan {
+
+class VulkanContext;
+
+/// A primary command buffer; freed back to its pool on destruction.
+class CommandBuffer {
+public:
+    CommandBuffer() = default;
+    CommandBuffer(VkDevice device, VkCommandPool pool, VkCommandBuffer buffer)
+        : device_(device), pool_(pool), buffer_(buffer) {}
+    ~CommandBuffer() { Reset(); }
+    CommandBuffer(const CommandBuffer&) = delete;
+    CommandBuffer& operator=(const CommandBuffer&) = delete;
+    CommandBuffer(CommandBuffer&& other) noexcept
+        : device_(other.device_),
+          pool_(other.pool_),
+          buffer_(std::exchange(other.buffer_, VK_NULL_HANDLE)) {}
+    CommandBuffer& operator=(CommandBuffer&& other) noexcept {
+        if (this != &other) {
+            Reset();
+            device_ = other.device_;
+            pool_ = other.pool_;
+            buffer_ = std::exchange(other.buffer_, VK_NULL_HANDLE);
+        }
+        return *this;
+    }
+
+    VkCommandBuffer Get() const { return buffer_; }
+    /// vkBeginCommandBuffer with ONE_TIME_SUBMIT.
+    void Begin() const;
+    void End() const;
+
+private:
+    void Reset();
+
+    VkDevice device_ = VK_NULL_HANDLE;
+    VkCommandPool pool_ = VK_NULL_HANDLE;
+    VkCommandBuffer buffer_ = VK_NULL_HANDLE;
+};
+
+/// A command pool of the context's queue family (not thread-safe, like every pool).
+class CommandPool {
+public:
+    explicit CommandPool(const VulkanContext& context);
+    /// A primary command buffer that can be reset and re-recorded.
+    CommandBuffer Allocate() const;
+    VkCommandPool Get() const { return pool_.Get(); }
+
+private:
+    UniqueCommandPool pool_;
+};
+
+/// An unsignaled fence.
+UniqueFence CreateFence(const VulkanContext& context);
+
+/// Submits one command buffer to the context's queue, signalling `fence` when done.
+void Submit(const VulkanContext& context, VkCommandBuffer cmd, VkFence fence);
+
+/// Waits for `fence` (no timeout: a hung GPU surfaces as VK_ERROR_DEVICE_LOST).
+void Wait(const VulkanContext& context, VkFence fence);
+
+/// Records `record` into a fresh command buffer of `pool`, submits it and waits. For setup,
+/// uploads and tests; frames submit without waiting.
+void SubmitAndWait(const VulkanContext& context, const CommandPool& pool,
+                   const std::function<void(VkCommandBuffer)>& record);
+
+/// One global memory barrier (synchronization2).
+void RecordMemoryBarrier(VkCommandBuffer cmd, VkPipelineStageFlags2 src_stages,
+                         VkAccessFlags2 src_access, VkPipelineStageFlags2 dst_stages,
+                         VkAccessFlags2 dst_access);
+
+}  // namespace vulkan
+}  // namespace rendering
+}  // namespace visualization
+}  // namespace open3d

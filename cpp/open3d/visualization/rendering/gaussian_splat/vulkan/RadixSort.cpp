@@ -1,0 +1,205 @@
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/RadixSort.h"
+
+#include <algorithm>
+#include <array>
+
+#include "open3d/core/Exception.h"
+#include "open3d/visualization/rendering/gaussian_splat/RenderConfig.h"
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/Commands.h"
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/ComputePipeline.h"
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/EmbeddedShaders.h"
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/VulkanContext.h"
+#include "shaders/GaussianSplatContract.h"
+
+namespace open3d {
+namespace visualization {
+namespace rendering {
+namespace vulkan {
+
+namespace {
+
+using namespace shader;  // the contract's constants and structs
+
+static_assert(kErrorEntriesDropped == rendering::kEntriesDropped);
+static_assert(kErrorCountsClamped == rendering::kCountsClamped);
+static_assert(RadixSort::kMaxCount / kRadixSortBlockSize <= 65535u,
+              "blocks of the largest sort fit one dispatch (maxComputeWorkGroupCount >= 65535)");
+static_assert(offsetof(RadixSortParams, dispatch_x) == offsetof(VkDispatchIndirectCommand, x) &&
+                  offsetof(RadixSortParams, dispatch_z) == offsetof(VkDispatchIndirectCommand, z),
+              "params start with the indirect dispatch arguments");
+
+VkDeviceSize Words(uint64_t n) { return VkDeviceSize(std::max<uint64_t>(n, 1)) * 4; }
+
+uint32_t NumBlocks(uint32_t count) {
+    return static_cast<uint32_t>((uint64_t(count) + kRadixSortBlockSize - 1) / kRadixSortBlockSize);
+}
+
+}  // namespace
+
+RadixSort::RadixSort(const VulkanContext& context) : context_(&context) {
+    const auto& info = context.GetDeviceInfo();
+    const uint32_t min_subgroup = kRadixSortWorkgroupSize / kRadixSortMaxSubgroups;
+    if (info.min_subgroup_size < min_subgroup) {
+        core::ThrowError(
+            "Vulkan: the radix sort needs subgroups of at least {} invocations; {} "
+            "may use {}",
+            min_subgroup, info.name, info.min_subgroup_size);
+    }
+    set_layout_ = CreateStorageBufferPushLayout(context, kRadixSortNumBindings);
+    pipeline_layout_ =
+        CreatePipelineLayout(context, set_layout_.Get(), sizeof(RadixSortPushConstants));
+    VkPipelineLayout layout = pipeline_layout_.Get();
+    setup_ = CreateComputePipeline(context, layout, spirv::kRadixSortSetup, "radix_sort_setup");
+    histogram_ =
+        CreateComputePipeline(context, layout, spirv::kRadixSortHistogram, "radix_sort_histogram");
+    scan_ = CreateComputePipeline(context, layout, spirv::kRadixSortScan, "radix_sort_scan");
+    scatter_ =
+        CreateComputePipeline(context, layout, spirv::kRadixSortScatter, "radix_sort_scatter");
+    copy_ = CreateComputePipeline(context, layout, spirv::kRadixSortCopy, "radix_sort_copy");
+}
+
+RadixSortStorageRequirements RadixSort::GetStorageRequirements(uint32_t max_count) {
+    if (max_count > kMaxCount) {
+        core::ThrowError("RadixSort: max_count {} exceeds the supported {}", max_count, kMaxCount);
+    }
+    RadixSortStorageRequirements requirements;
+    requirements.keys_alt_bytes = Words(max_count);
+    requirements.values_alt_bytes = Words(max_count);
+    requirements.histogram_bytes =
+        Words(kRadixSortBins + uint64_t(kRadixSortBins) * NumBlocks(max_count));
+    requirements.params_bytes = sizeof(RadixSortParams);
+    return requirements;
+}
+
+void RadixSort::CheckArguments(const BufferRange& keys, const BufferRange& values,
+                               const RadixSortScratch& scratch, const BufferRange& count,
+                               uint32_t max_count, uint32_t num_bits) const {
+    if (num_bits > 32) core::ThrowError("RadixSort: num_bits is {}, at most 32", num_bits);
+    const RadixSortStorageRequirements need = GetStorageRequirements(max_count);
+    const VkDeviceSize alignment = context_->GetDeviceInfo().min_storage_buffer_offset_alignment;
+    struct Check {
+        const char* name;
+        const BufferRange& range;
+        VkDeviceSize bytes;
+    };
+    const std::array<Check, 6> checks{
+        {{"keys", keys, Words(max_count)},
+         {"values", values, Words(max_count)},
+         {"scratch.keys_alt", scratch.keys_alt, need.keys_alt_bytes},
+         {"scratch.values_alt", scratch.values_alt, need.values_alt_bytes},
+         {"scratch.histogram", scratch.histogram, need.histogram_bytes},
+         {"scratch.params", scratch.params, need.params_bytes}}};
+    for (const Check& check : checks) {
+        if (check.range.buffer == VK_NULL_HANDLE) {
+            core::ThrowError("RadixSort: {} has no buffer", check.name);
+        }
+        if (check.range.offset % alignment != 0) {
+            core::ThrowError(
+                "RadixSort: {} offset {} is not a multiple of "
+                "minStorageBufferOffsetAlignment {}",
+                check.name, check.range.offset, alignment);
+        }
+        if (check.range.size != VK_WHOLE_SIZE && check.range.size < check.bytes) {
+            core::ThrowError("RadixSort: {} holds {} bytes, {} are needed for max_count {}",
+                             check.name, check.range.size, check.bytes, max_count);
+        }
+    }
+    if (count.buffer == VK_NULL_HANDLE || count.offset % 4 != 0) {
+        core::ThrowError("RadixSort: count needs a buffer and a 4-byte aligned offset");
+    }
+}
+
+void RadixSort::Record(VkCommandBuffer cmd, const BufferRange& keys, const BufferRange& values,
+                       const RadixSortScratch& scratch, const BufferRange& count,
+                       uint32_t max_count, uint32_t num_bits) const {
+    CheckArguments(keys, values, scratch, count, max_count, num_bits);
+    const uint32_t num_passes = GetNumPasses(num_bits);
+    if (num_passes == 0) return;  // no key bits: every order is sorted
+
+    // The count may sit at any 4-byte offset: bind from the aligned offset below it and
+    // index the uint with a push constant.
+    const VkDeviceSize alignment = context_->GetDeviceInfo().min_storage_buffer_offset_alignment;
+    const VkDeviceSize count_binding_offset = count.offset - count.offset % alignment;
+    RadixSortPushConstants push{};
+    push.count_index = static_cast<uint32_t>((count.offset - count_binding_offset) / 4);
+    push.max_count = max_count;
+
+    const VkPipelineLayout layout = pipeline_layout_.Get();
+    const auto bind = [&](const BufferRange& keys_in, const BufferRange& values_in,
+                          const BufferRange& keys_out, const BufferRange& values_out) {
+        std::array<VkDescriptorBufferInfo, kRadixSortNumBindings> buffers{};
+        buffers[kRadixSortParamsBinding] = {scratch.params.buffer, scratch.params.offset,
+                                            sizeof(RadixSortParams)};
+        buffers[kRadixSortCountBinding] = {count.buffer, count_binding_offset, VK_WHOLE_SIZE};
+        buffers[kRadixSortKeysInBinding] = {keys_in.buffer, keys_in.offset, Words(max_count)};
+        buffers[kRadixSortValuesInBinding] = {values_in.buffer, values_in.offset, Words(max_count)};
+        buffers[kRadixSortKeysOutBinding] = {keys_out.buffer, keys_out.offset, Words(max_count)};
+        buffers[kRadixSortValuesOutBinding] = {values_out.buffer, values_out.offset,
+                                               Words(max_count)};
+        buffers[kRadixSortHistogramBinding] = {scratch.histogram.buffer, scratch.histogram.offset,
+                                               GetStorageRequirements(max_count).histogram_bytes};
+        std::array<VkWriteDescriptorSet, kRadixSortNumBindings> writes{};
+        for (uint32_t i = 0; i < kRadixSortNumBindings; ++i) {
+            writes[i].sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET;
+            writes[i].dstBinding = i;
+            writes[i].descriptorCount = 1;
+            writes[i].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+            writes[i].pBufferInfo = &buffers[i];
+        }
+        context_->GetCmdPushDescriptorSet()(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, layout, 0,
+                                            kRadixSortNumBindings, writes.data());
+    };
+    const auto push_constants = [&]() {
+        vkCmdPushConstants(cmd, layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(push), &push);
+    };
+    // Every dispatch reads what the previous one wrote, including indirect arguments.
+    const auto barrier = [&]() {
+        RecordMemoryBarrier(
+            cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
+            VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_DRAW_INDIRECT_BIT,
+            VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT |
+                VK_ACCESS_2_INDIRECT_COMMAND_READ_BIT);
+    };
+    const VkBuffer params_buffer = scratch.params.buffer;
+    const VkDeviceSize params_offset = scratch.params.offset;
+
+    bind(keys, values, scratch.keys_alt, scratch.values_alt);
+    push_constants();
+    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, setup_.Get());
+    vkCmdDispatch(cmd, 1, 1, 1);
+    barrier();
+
+    if (max_count == 0) return;  // params now say count 0; nothing to move
+
+    for (uint32_t pass = 0; pass < num_passes; ++pass) {
+        // Ping-pong: even passes read the caller's buffers, odd passes the scratch.
+        if (pass % 2 == 0) {
+            bind(keys, values, scratch.keys_alt, scratch.values_alt);
+        } else {
+            bind(scratch.keys_alt, scratch.values_alt, keys, values);
+        }
+        push.shift = pass * kRadixSortDigitBits;
+        push.digit_bits = std::min(kRadixSortDigitBits, num_bits - push.shift);
+        push_constants();
+        vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, histogram_.Get());
+        vkCmdDispatchIndirect(cmd, params_buffer, params_offset);
+        barrier();
+        // One workgroup per digit; rows of digits above digit_bits are all zero.
+        vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, scan_.Get());
+        vkCmdDispatch(cmd, kRadixSortBins, 1, 1);
+        barrier();
+        vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, scatter_.Get());
+        vkCmdDispatchIndirect(cmd, params_buffer, params_offset);
+        if (pass + 1 < num_passes || num_passes % 2 == 1) barrier();
+    }
+    if (num_passes % 2 == 1) {
+        bind(scratch.keys_alt, scratch.values_alt, keys, values);
+        vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, copy_.Get());
+        vkCmdDispatchIndirect(cmd, params_buffer, params_offset);
+    }
+}
+
+}  // namespace vulkan
+}  // namespace rendering
+}  // namespace visualization
+}  // namespace open3d

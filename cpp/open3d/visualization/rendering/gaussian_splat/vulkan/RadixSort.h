@@ -1,0 +1,99 @@
+// GPU radix sort of (uint32 key, uint32 value) pairs, a recorder (STYLE.md point 6): the
+// caller allocates the scratch buffers from GetStorageRequirements and Record() only
+// records commands. The element count is read on the GPU from the producer's buffer.
+//
+// Algorithm (docs/vulkan.md): LSD, 8-bit digits, ceil(num_bits / 8) passes. Per pass:
+// histogram (per-block digit counts) -> scan (one workgroup per digit) -> scatter (stable
+// in-workgroup ranking from subgroup scans), each per-block pass dispatched indirectly
+// with ceil(count / 4096) workgroups written by a setup shader. Stable for any subgroup
+// size; keys bits at and above num_bits are carried but do not affect the order.
+#pragma once
+
+#include <vulkan/vulkan.h>
+
+#include <cstdint>
+
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/Buffer.h"
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/VulkanHandle.h"
+
+namespace open3d {
+namespace visualization {
+namespace rendering {
+namespace vulkan {
+
+class VulkanContext;
+
+/// Bytes and usage of the scratch buffers a sort of up to max_count pairs needs.
+struct RadixSortStorageRequirements {
+    VkDeviceSize keys_alt_bytes = 0;    ///< uint32 [max_count]
+    VkDeviceSize values_alt_bytes = 0;  ///< uint32 [max_count]
+    VkDeviceSize histogram_bytes = 0;   ///< uint32 [256 + 256 * ceil(max_count / 4096)]
+    VkDeviceSize params_bytes = 0;      ///< shader::RadixSortParams
+    /// Usage of keys_alt, values_alt and histogram.
+    VkBufferUsageFlags scratch_usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
+    /// Usage of params (it holds the indirect dispatch arguments).
+    VkBufferUsageFlags params_usage =
+        VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT;
+};
+
+/// Scratch ranges, each at least as large as required and with an offset that is a
+/// multiple of minStorageBufferOffsetAlignment. They may share one buffer, not overlap.
+struct RadixSortScratch {
+    BufferRange keys_alt;
+    BufferRange values_alt;
+    BufferRange histogram;
+    /// After the sort (unless num_bits == 0, which records nothing), shader::RadixSortParams:
+    /// `count` is the number sorted and `flags` has kErrorCountsClamped when the producer's
+    /// count exceeded max_count.
+    BufferRange params;
+};
+
+class RadixSort {
+public:
+    /// Largest max_count: ceil(max_count / 4096) workgroups must fit one dispatch.
+    static constexpr uint32_t kMaxCount = 65535u * 4096u;
+
+    /// Creates the pipelines. Throws core::Open3DError when the device's subgroups can be
+    /// smaller than 4 invocations (the shaders size shared arrays by subgroup count).
+    explicit RadixSort(const VulkanContext& context);
+
+    /// Scratch sizes for up to `max_count` pairs. Throws when max_count > kMaxCount.
+    static RadixSortStorageRequirements GetStorageRequirements(uint32_t max_count);
+    /// Passes for `num_bits` key bits: ceil(num_bits / 8).
+    static uint32_t GetNumPasses(uint32_t num_bits) { return (num_bits + 7u) / 8u; }
+
+    /// Records a stable sort of the first `count` pairs of (keys, values) by the low
+    /// `num_bits` (0..32) bits of the keys, count = min(the uint at `count`, max_count).
+    /// The result is in `keys` and `values`.
+    ///
+    /// Synchronisation: before Record, the caller makes its writes of keys, values and
+    /// count visible to COMPUTE_SHADER reads (and orders earlier uses of the scratch);
+    /// after it, results are COMPUTE_SHADER storage writes for the caller to barrier.
+    /// `keys`/`values` offsets must be multiples of minStorageBufferOffsetAlignment;
+    /// `count` only needs 4-byte alignment. Throws core::Open3DError on misuse.
+    void Record(VkCommandBuffer cmd,
+                const BufferRange& keys,    // uint32 [max_count], sorted in place
+                const BufferRange& values,  // uint32 [max_count], permuted with keys
+                const RadixSortScratch& scratch,
+                const BufferRange& count,  // uint32 written on the GPU by the producer
+                uint32_t max_count, uint32_t num_bits) const;
+
+private:
+    void CheckArguments(const BufferRange& keys, const BufferRange& values,
+                        const RadixSortScratch& scratch, const BufferRange& count,
+                        uint32_t max_count, uint32_t num_bits) const;
+
+    const VulkanContext* context_;  // outlives the sorter
+    UniqueDescriptorSetLayout set_layout_;
+    UniquePipelineLayout pipeline_layout_;
+    UniquePipeline setup_;
+    UniquePipeline histogram_;
+    UniquePipeline scan_;
+    UniquePipeline scatter_;
+    UniquePipeline copy_;
+};
+
+}  // namespace vulkan
+}  // namespace rendering
+}  // namespace visualization
+}  // namespace open3d

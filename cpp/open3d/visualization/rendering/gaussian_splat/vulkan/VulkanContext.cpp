@@ -1,0 +1,420 @@
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/VulkanContext.h"
+
+#include <cstdlib>
+#include <cstring>
+#include <optional>
+#include <string_view>
+#include <vector>
+
+#include "open3d/core/Exception.h"
+#include "open3d/core/Logging.h"
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/DebugMessenger.h"
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/VulkanHandle.h"
+
+namespace open3d {
+namespace visualization {
+namespace rendering {
+namespace vulkan {
+
+namespace {
+
+constexpr const char* kValidationLayer = "VK_LAYER_KHRONOS_validation";
+constexpr uint32_t kRequiredApiVersion = VK_API_VERSION_1_3;
+// What the compute shaders use: scans and reductions (arithmetic), subgroupElect (basic),
+// ballots and shuffles (ballot/shuffle, for the projection and composite shaders).
+constexpr VkSubgroupFeatureFlags kRequiredSubgroupOps =
+    VK_SUBGROUP_FEATURE_BASIC_BIT | VK_SUBGROUP_FEATURE_ARITHMETIC_BIT |
+    VK_SUBGROUP_FEATURE_BALLOT_BIT | VK_SUBGROUP_FEATURE_SHUFFLE_BIT;
+constexpr const char* kRequiredDeviceExtensions[] = {VK_KHR_PUSH_DESCRIPTOR_EXTENSION_NAME};
+
+const char* kInstallHint =
+    "Install a Vulkan 1.3 driver (Debian: mesa-vulkan-drivers gives the lavapipe CPU "
+    "device) and check the output of `vulkaninfo --summary`";
+
+std::optional<std::string> GetEnv(const char* name) {
+    const char* value = std::getenv(name);
+    if (value == nullptr) return std::nullopt;
+    return std::string(value);
+}
+
+std::string VersionString(uint32_t version) {
+    return fmt::format("{}.{}.{}", VK_API_VERSION_MAJOR(version), VK_API_VERSION_MINOR(version),
+                       VK_API_VERSION_PATCH(version));
+}
+
+const char* DeviceTypeName(VkPhysicalDeviceType type) {
+    switch (type) {
+        case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU:
+            return "discrete GPU";
+        case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU:
+            return "integrated GPU";
+        case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU:
+            return "virtual GPU";
+        case VK_PHYSICAL_DEVICE_TYPE_CPU:
+            return "CPU";
+        default:
+            return "other";
+    }
+}
+
+int DeviceTypeRank(VkPhysicalDeviceType type) {
+    switch (type) {
+        case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU:
+            return 4;
+        case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU:
+            return 3;
+        case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU:
+            return 2;
+        case VK_PHYSICAL_DEVICE_TYPE_CPU:
+            return 1;
+        default:
+            return 0;
+    }
+}
+
+bool HasInstanceLayer(const char* name) {
+    uint32_t count = 0;
+    vkEnumerateInstanceLayerProperties(&count, nullptr);
+    std::vector<VkLayerProperties> layers(count);
+    vkEnumerateInstanceLayerProperties(&count, layers.data());
+    for (const auto& layer : layers) {
+        if (std::strcmp(layer.layerName, name) == 0) return true;
+    }
+    return false;
+}
+
+bool HasInstanceExtension(const char* name) {
+    uint32_t count = 0;
+    vkEnumerateInstanceExtensionProperties(nullptr, &count, nullptr);
+    std::vector<VkExtensionProperties> extensions(count);
+    vkEnumerateInstanceExtensionProperties(nullptr, &count, extensions.data());
+    for (const auto& extension : extensions) {
+        if (std::strcmp(extension.extensionName, name) == 0) return true;
+    }
+    return false;
+}
+
+/// Everything queried about one physical device.
+struct DeviceQuery {
+    VkPhysicalDeviceProperties2 properties =
+        MakeInfo<VkPhysicalDeviceProperties2>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2);
+    VkPhysicalDeviceSubgroupProperties subgroup = MakeInfo<VkPhysicalDeviceSubgroupProperties>(
+        VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SUBGROUP_PROPERTIES);
+    VkPhysicalDeviceSubgroupSizeControlProperties size_control =
+        MakeInfo<VkPhysicalDeviceSubgroupSizeControlProperties>(
+            VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SUBGROUP_SIZE_CONTROL_PROPERTIES);
+    VkPhysicalDeviceDriverProperties driver = MakeInfo<VkPhysicalDeviceDriverProperties>(
+        VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_DRIVER_PROPERTIES);
+    VkPhysicalDeviceFeatures2 features =
+        MakeInfo<VkPhysicalDeviceFeatures2>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2);
+    VkPhysicalDeviceVulkan13Features features13 = MakeInfo<VkPhysicalDeviceVulkan13Features>(
+        VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES);
+    std::vector<VkQueueFamilyProperties> queue_families;
+    std::vector<VkExtensionProperties> extensions;
+
+    explicit DeviceQuery(VkPhysicalDevice device) {
+        properties.pNext = &subgroup;
+        subgroup.pNext = &size_control;
+        size_control.pNext = &driver;
+        vkGetPhysicalDeviceProperties2(device, &properties);
+        features.pNext = &features13;
+        vkGetPhysicalDeviceFeatures2(device, &features);
+        uint32_t count = 0;
+        vkGetPhysicalDeviceQueueFamilyProperties(device, &count, nullptr);
+        queue_families.resize(count);
+        vkGetPhysicalDeviceQueueFamilyProperties(device, &count, queue_families.data());
+        count = 0;
+        vkEnumerateDeviceExtensionProperties(device, nullptr, &count, nullptr);
+        extensions.resize(count);
+        vkEnumerateDeviceExtensionProperties(device, nullptr, &count, extensions.data());
+    }
+
+    bool HasExtension(const char* name) const {
+        for (const auto& extension : extensions) {
+            if (std::strcmp(extension.extensionName, name) == 0) return true;
+        }
+        return false;
+    }
+
+    std::optional<uint32_t> FindQueueFamily() const {
+        constexpr VkQueueFlags kNeeded = VK_QUEUE_GRAPHICS_BIT | VK_QUEUE_COMPUTE_BIT;
+        for (uint32_t i = 0; i < queue_families.size(); ++i) {
+            if ((queue_families[i].queueFlags & kNeeded) == kNeeded) return i;
+        }
+        return std::nullopt;
+    }
+
+    /// Empty when the device can run the shaders, otherwise why not.
+    std::string WhyUnsuitable() const {
+        std::vector<std::string> missing;
+        if (properties.properties.apiVersion < kRequiredApiVersion) {
+            missing.push_back(fmt::format("Vulkan 1.3 (has {})",
+                                          VersionString(properties.properties.apiVersion)));
+            return missing.front();  // the structs below are not filled in for older devices
+        }
+        if (!FindQueueFamily()) missing.push_back("a queue family with graphics and compute");
+        if (!(subgroup.supportedStages & VK_SHADER_STAGE_COMPUTE_BIT)) {
+            missing.push_back("subgroup operations in compute shaders");
+        }
+        if ((subgroup.supportedOperations & kRequiredSubgroupOps) != kRequiredSubgroupOps) {
+            missing.push_back("subgroup basic/arithmetic/ballot/shuffle operations");
+        }
+        if (!features13.maintenance4) missing.push_back("the maintenance4 feature");
+        if (!features13.synchronization2) missing.push_back("the synchronization2 feature");
+        for (const char* extension : kRequiredDeviceExtensions) {
+            if (!HasExtension(extension)) missing.push_back(extension);
+        }
+        std::string reason;
+        for (const auto& item : missing) reason += (reason.empty() ? "" : ", ") + item;
+        return reason.empty() ? reason : "lacks " + reason;
+    }
+};
+
+}  // namespace
+
+VulkanContext::VulkanContext() = default;
+
+VulkanContext::~VulkanContext() {
+    if (!owns_handles_) return;
+    if (device_ != VK_NULL_HANDLE) {
+        vkDeviceWaitIdle(device_);
+        vkDestroyDevice(device_, nullptr);
+    }
+    if (messenger_) messenger_->Detach();
+    if (instance_ != VK_NULL_HANDLE) vkDestroyInstance(instance_, nullptr);
+}
+
+std::unique_ptr<VulkanContext> VulkanContext::CreateHeadless(const VulkanContextOptions& options) {
+    bool validation = options.enable_validation;
+    if (auto env = GetEnv("OPEN3D_VULKAN_VALIDATION")) validation = (*env != "0");
+    std::string device_filter = GetEnv("OPEN3D_VULKAN_DEVICE").value_or(options.device_name_filter);
+
+    uint32_t loader_version = VK_API_VERSION_1_0;
+    vkEnumerateInstanceVersion(&loader_version);
+    if (loader_version < kRequiredApiVersion) {
+        core::ThrowError("Vulkan: the loader supports Vulkan {}, 1.3 is needed; update libvulkan1",
+                         VersionString(loader_version));
+    }
+
+    std::unique_ptr<VulkanContext> context(new VulkanContext());
+    context->owns_handles_ = true;
+
+    std::vector<const char*> layers;
+    std::vector<const char*> extensions;
+    VkInstanceCreateFlags flags = 0;
+    // Lets the loader list portability devices (MoltenVK) as well.
+    if (HasInstanceExtension(VK_KHR_PORTABILITY_ENUMERATION_EXTENSION_NAME)) {
+        extensions.push_back(VK_KHR_PORTABILITY_ENUMERATION_EXTENSION_NAME);
+        flags |= VK_INSTANCE_CREATE_ENUMERATE_PORTABILITY_BIT_KHR;
+    }
+    VkDebugUtilsMessengerCreateInfoEXT messenger_info{};
+    VkValidationFeaturesEXT validation_features =
+        MakeInfo<VkValidationFeaturesEXT>(VK_STRUCTURE_TYPE_VALIDATION_FEATURES_EXT);
+    const VkValidationFeatureEnableEXT sync_validation =
+        VK_VALIDATION_FEATURE_ENABLE_SYNCHRONIZATION_VALIDATION_EXT;
+    if (validation) {
+        if (!HasInstanceLayer(kValidationLayer)) {
+            core::ThrowError(
+                "Vulkan validation was requested but {} is not installed. Install it "
+                "(Debian: vulkan-validationlayers; elsewhere the Vulkan SDK) or set "
+                "OPEN3D_VULKAN_VALIDATION=0",
+                kValidationLayer);
+        }
+        layers.push_back(kValidationLayer);
+        extensions.push_back(VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
+        context->messenger_ = std::make_unique<DebugMessenger>();
+        messenger_info = context->messenger_->MakeCreateInfo();
+        if (options.enable_synchronization_validation) {
+            validation_features.enabledValidationFeatureCount = 1;
+            validation_features.pEnabledValidationFeatures = &sync_validation;
+            messenger_info.pNext = &validation_features;
+        }
+    }
+
+    VkApplicationInfo app = MakeInfo<VkApplicationInfo>(VK_STRUCTURE_TYPE_APPLICATION_INFO);
+    app.pApplicationName = "Open3D Gaussian splatting";
+    app.pEngineName = "Open3D";
+    app.apiVersion = kRequiredApiVersion;
+    VkInstanceCreateInfo instance_info =
+        MakeInfo<VkInstanceCreateInfo>(VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO);
+    instance_info.pNext = validation ? &messenger_info : nullptr;
+    instance_info.flags = flags;
+    instance_info.pApplicationInfo = &app;
+    instance_info.enabledLayerCount = static_cast<uint32_t>(layers.size());
+    instance_info.ppEnabledLayerNames = layers.data();
+    instance_info.enabledExtensionCount = static_cast<uint32_t>(extensions.size());
+    instance_info.ppEnabledExtensionNames = extensions.data();
+    VkResult result = vkCreateInstance(&instance_info, nullptr, &context->instance_);
+    if (result == VK_ERROR_INCOMPATIBLE_DRIVER) {
+        core::ThrowError("Vulkan: no driver (ICD) was found. {}", kInstallHint);
+    }
+    CheckVk(result, "vkCreateInstance");
+    if (context->messenger_) context->messenger_->Attach(context->instance_);
+
+    uint32_t count = 0;
+    vkEnumeratePhysicalDevices(context->instance_, &count, nullptr);
+    std::vector<VkPhysicalDevice> devices(count);
+    vkEnumeratePhysicalDevices(context->instance_, &count, devices.data());
+    if (devices.empty()) core::ThrowError("Vulkan: no physical device was found. {}", kInstallHint);
+
+    VkPhysicalDevice best = VK_NULL_HANDLE;
+    int best_rank = -1;
+    std::string rejected;
+    for (VkPhysicalDevice device : devices) {
+        DeviceQuery query(device);
+        std::string name = query.properties.properties.deviceName;
+        std::string why = query.WhyUnsuitable();
+        if (why.empty() && !device_filter.empty() &&
+            name.find(device_filter) == std::string::npos) {
+            why = fmt::format("does not match the device filter '{}'", device_filter);
+        }
+        if (!why.empty()) {
+            rejected += fmt::format("\n  {}: {}", name, why);
+            continue;
+        }
+        int rank = DeviceTypeRank(query.properties.properties.deviceType);
+        if (rank > best_rank) {
+            best = device;
+            best_rank = rank;
+        }
+    }
+    if (best == VK_NULL_HANDLE) {
+        core::ThrowError("Vulkan: no usable device.{}\n{}", rejected, kInstallHint);
+    }
+    context->InitDevice(best, *DeviceQuery(best).FindQueueFamily());
+    return context;
+}
+
+std::unique_ptr<VulkanContext> VulkanContext::CreateFromBorrowed(
+    const BorrowedVulkanHandles& handles) {
+    if (handles.instance == VK_NULL_HANDLE || handles.physical_device == VK_NULL_HANDLE ||
+        handles.device == VK_NULL_HANDLE || handles.queue == VK_NULL_HANDLE) {
+        core::ThrowError(
+            "Vulkan: borrowed handles must all be set (instance, physical device, "
+            "device, queue)");
+    }
+    DeviceQuery query(handles.physical_device);
+    std::string why = query.WhyUnsuitable();
+    if (!why.empty()) {
+        core::ThrowError("Vulkan: the host application's device {} {}",
+                         query.properties.properties.deviceName, why);
+    }
+    if (handles.queue_family_index >= query.queue_families.size() ||
+        (query.queue_families[handles.queue_family_index].queueFlags & VK_QUEUE_COMPUTE_BIT) == 0) {
+        core::ThrowError("Vulkan: borrowed queue family {} has no compute support",
+                         handles.queue_family_index);
+    }
+    std::unique_ptr<VulkanContext> context(new VulkanContext());
+    context->owns_handles_ = false;
+    context->instance_ = handles.instance;
+    context->physical_device_ = handles.physical_device;
+    context->device_ = handles.device;
+    context->queue_ = handles.queue;
+    context->InitDevice(handles.physical_device, handles.queue_family_index);
+    return context;
+}
+
+void VulkanContext::InitDevice(VkPhysicalDevice physical_device, uint32_t queue_family_index) {
+    physical_device_ = physical_device;
+    DeviceQuery query(physical_device);
+    if (owns_handles_) {
+        const float priority = 1.0f;
+        VkDeviceQueueCreateInfo queue_info =
+            MakeInfo<VkDeviceQueueCreateInfo>(VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO);
+        queue_info.queueFamilyIndex = queue_family_index;
+        queue_info.queueCount = 1;
+        queue_info.pQueuePriorities = &priority;
+        // maintenance4: glslang's vulkan1.3 SPIR-V declares workgroup sizes with
+        // LocalSizeId, which the validation layer rejects without it.
+        VkPhysicalDeviceVulkan13Features features13 = MakeInfo<VkPhysicalDeviceVulkan13Features>(
+            VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES);
+        features13.maintenance4 = VK_TRUE;
+        features13.synchronization2 = VK_TRUE;
+        VkPhysicalDeviceFeatures2 features =
+            MakeInfo<VkPhysicalDeviceFeatures2>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2);
+        features.pNext = &features13;
+        VkDeviceCreateInfo device_info =
+            MakeInfo<VkDeviceCreateInfo>(VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO);
+        device_info.pNext = &features;
+        device_info.queueCreateInfoCount = 1;
+        device_info.pQueueCreateInfos = &queue_info;
+        device_info.enabledExtensionCount =
+            static_cast<uint32_t>(std::size(kRequiredDeviceExtensions));
+        device_info.ppEnabledExtensionNames = kRequiredDeviceExtensions;
+        CheckVk(vkCreateDevice(physical_device, &device_info, nullptr, &device_), "vkCreateDevice");
+        vkGetDeviceQueue(device_, queue_family_index, 0, &queue_);
+    }
+    vkGetPhysicalDeviceMemoryProperties(physical_device, &memory_properties_);
+
+    const VkPhysicalDeviceProperties& properties = query.properties.properties;
+    info_.name = properties.deviceName;
+    info_.type = DeviceTypeName(properties.deviceType);
+    info_.driver_name = query.driver.driverName;
+    info_.driver_info = query.driver.driverInfo;
+    info_.api_version = properties.apiVersion;
+    info_.vendor_id = properties.vendorID;
+    info_.subgroup_size = query.subgroup.subgroupSize;
+    info_.min_subgroup_size = query.size_control.minSubgroupSize;
+    info_.max_subgroup_size = query.size_control.maxSubgroupSize;
+    info_.max_compute_shared_memory = properties.limits.maxComputeSharedMemorySize;
+    info_.min_storage_buffer_offset_alignment = properties.limits.minStorageBufferOffsetAlignment;
+    const auto& family = query.queue_families[queue_family_index];
+    info_.timestamp_period_ns =
+        family.timestampValidBits > 0 ? properties.limits.timestampPeriod : 0.0f;
+    info_.queue_family_index = queue_family_index;
+
+    LoadDeviceFunctions();
+    ReportDevice();
+}
+
+void VulkanContext::LoadDeviceFunctions() {
+    push_descriptor_set_ = reinterpret_cast<PFN_vkCmdPushDescriptorSetKHR>(
+        vkGetDeviceProcAddr(device_, "vkCmdPushDescriptorSetKHR"));
+    if (push_descriptor_set_ == nullptr) {
+        core::ThrowError(
+            "Vulkan: vkCmdPushDescriptorSetKHR is unavailable; the device must be "
+            "created with {}",
+            VK_KHR_PUSH_DESCRIPTOR_EXTENSION_NAME);
+    }
+}
+
+void VulkanContext::ReportDevice() const {
+    core::LogInfo(
+        "Vulkan device: {} ({}), driver {} [{}], Vulkan {}, subgroup size {} (range {}..{}), "
+        "{} KiB shared memory, queue family {}, validation {}{}",
+        info_.name, info_.type, info_.driver_name, info_.driver_info,
+        VersionString(info_.api_version), info_.subgroup_size, info_.min_subgroup_size,
+        info_.max_subgroup_size, info_.max_compute_shared_memory / 1024, info_.queue_family_index,
+        IsValidationEnabled() ? "on" : "off",
+        owns_handles_ ? "" : ", handles borrowed from the host application");
+}
+
+ValidationMessageCounts VulkanContext::GetValidationMessageCounts() const {
+    return messenger_ ? messenger_->GetCounts() : ValidationMessageCounts{};
+}
+
+uint32_t VulkanContext::FindMemoryType(uint32_t type_bits, VkMemoryPropertyFlags required,
+                                       VkMemoryPropertyFlags preferred) const {
+    std::optional<uint32_t> fallback;
+    for (uint32_t i = 0; i < memory_properties_.memoryTypeCount; ++i) {
+        if (!(type_bits & (1u << i))) continue;
+        VkMemoryPropertyFlags flags = memory_properties_.memoryTypes[i].propertyFlags;
+        if ((flags & required) != required) continue;
+        if ((flags & preferred) == preferred) return i;
+        if (!fallback) fallback = i;
+    }
+    if (!fallback) {
+        core::ThrowError(
+            "Vulkan: device {} has no memory type with properties {:#x} (allowed "
+            "types {:#x})",
+            info_.name, required, type_bits);
+    }
+    return *fallback;
+}
+
+void VulkanContext::WaitIdle() const { CheckVk(vkDeviceWaitIdle(device_), "vkDeviceWaitIdle"); }
+
+}  // namespace vulkan
+}  // namespace rendering
+}  // namespace visualization
+}  // namespace open3d

@@ -1,0 +1,131 @@
+// The Vulkan instance, device and compute queue that every Vulkan object of the splat
+// renderer is created from. No singleton: whoever needs one creates it and passes it on
+// (tests make their own). It either owns its handles (headless) or borrows them from a
+// host application, which then keeps them alive for the context's lifetime.
+#pragma once
+
+#include <vulkan/vulkan.h>
+
+#include <cstdint>
+#include <memory>
+#include <string>
+
+namespace open3d {
+namespace visualization {
+namespace rendering {
+namespace vulkan {
+
+class DebugMessenger;
+
+struct VulkanContextOptions {
+    /// Loads VK_LAYER_KHRONOS_validation and logs every message it sends (counted, see
+    /// GetValidationMessageCounts). The environment variable OPEN3D_VULKAN_VALIDATION=1
+    /// turns it on and =0 turns it off, whatever this says.
+    bool enable_validation = false;
+    /// Also asks the layer for synchronization validation (missing barriers); slower.
+    bool enable_synchronization_validation = false;
+    /// Uses the first suitable device whose name contains this text; empty picks the best
+    /// (discrete > integrated > virtual > CPU). Env OPEN3D_VULKAN_DEVICE overrides it.
+    std::string device_name_filter;
+};
+
+/// Handles owned by a host application that the context uses without destroying them.
+/// The device must have been created with Vulkan 1.3, the features `maintenance4` and
+/// `synchronization2` enabled and the extension VK_KHR_push_descriptor.
+struct BorrowedVulkanHandles {
+    VkInstance instance = VK_NULL_HANDLE;
+    VkPhysicalDevice physical_device = VK_NULL_HANDLE;
+    VkDevice device = VK_NULL_HANDLE;
+    uint32_t queue_family_index = 0;  ///< a family with graphics and compute
+    VkQueue queue = VK_NULL_HANDLE;   ///< a queue of that family
+};
+
+/// What the device is, as reported in the log at creation.
+struct VulkanDeviceInfo {
+    std::string name;
+    std::string type;         ///< "discrete GPU", "integrated GPU", "virtual GPU", "CPU", "other"
+    std::string driver_name;  ///< e.g. "llvmpipe", "NVIDIA"
+    std::string driver_info;  ///< e.g. "Mesa 22.3.6 (LLVM 15.0.6)"
+    uint32_t api_version = 0;
+    uint32_t vendor_id = 0;
+    uint32_t subgroup_size = 0;              ///< default size in compute shaders
+    uint32_t min_subgroup_size = 0;          ///< a SPIR-V 1.6 shader may run with any size in
+    uint32_t max_subgroup_size = 0;          ///< [min, max]
+    uint32_t max_compute_shared_memory = 0;  ///< bytes per workgroup
+    uint64_t min_storage_buffer_offset_alignment = 0;  ///< bytes
+    float timestamp_period_ns = 0.0f;                  ///< 0 when timestamps are unsupported
+    uint32_t queue_family_index = 0;
+};
+
+/// Validation messages seen since the context was created.
+struct ValidationMessageCounts {
+    uint64_t errors = 0;
+    uint64_t warnings = 0;
+    uint64_t infos = 0;  ///< info and verbose
+    /// Errors and warnings: what a test must keep at zero.
+    uint64_t Problems() const { return errors + warnings; }
+};
+
+class VulkanContext {
+public:
+    /// Creates its own instance and device. Throws core::Open3DError with what to install
+    /// or change when no loader, driver or suitable device exists, or when validation is
+    /// requested but the layer is missing.
+    static std::unique_ptr<VulkanContext> CreateHeadless(const VulkanContextOptions& options = {});
+    /// Wraps a host application's handles without owning them. Throws core::Open3DError
+    /// when the physical device lacks what the shaders need.
+    static std::unique_ptr<VulkanContext> CreateFromBorrowed(const BorrowedVulkanHandles& handles);
+
+    ~VulkanContext();
+    VulkanContext(const VulkanContext&) = delete;
+    VulkanContext& operator=(const VulkanContext&) = delete;
+    VulkanContext(VulkanContext&&) = delete;
+    VulkanContext& operator=(VulkanContext&&) = delete;
+
+    VkInstance GetInstance() const { return instance_; }
+    VkPhysicalDevice GetPhysicalDevice() const { return physical_device_; }
+    VkDevice GetDevice() const { return device_; }
+    VkQueue GetQueue() const { return queue_; }
+    uint32_t GetQueueFamilyIndex() const { return info_.queue_family_index; }
+    const VulkanDeviceInfo& GetDeviceInfo() const { return info_; }
+    /// False for a context made from borrowed handles.
+    bool OwnsHandles() const { return owns_handles_; }
+
+    bool IsValidationEnabled() const { return messenger_ != nullptr; }
+    /// Messages of the validation layer so far (all zero when validation is off).
+    ValidationMessageCounts GetValidationMessageCounts() const;
+
+    /// Index of a memory type allowed by `type_bits` with all `required` properties,
+    /// preferring one that also has `preferred`. Throws core::Open3DError when none fits.
+    uint32_t FindMemoryType(uint32_t type_bits, VkMemoryPropertyFlags required,
+                            VkMemoryPropertyFlags preferred = 0) const;
+
+    /// vkCmdPushDescriptorSetKHR of this device (an extension entry point).
+    PFN_vkCmdPushDescriptorSetKHR GetCmdPushDescriptorSet() const { return push_descriptor_set_; }
+
+    /// vkDeviceWaitIdle; for teardown and tests, not for frames.
+    void WaitIdle() const;
+
+private:
+    VulkanContext();
+    void InitDevice(VkPhysicalDevice physical_device, uint32_t queue_family_index);
+    void LoadDeviceFunctions();
+    void ReportDevice() const;
+
+    bool owns_handles_ = false;
+    // Declared before the instance: the messenger must outlive vkDestroyInstance, which
+    // may still report (e.g. leaked objects).
+    std::unique_ptr<DebugMessenger> messenger_;
+    VkInstance instance_ = VK_NULL_HANDLE;
+    VkPhysicalDevice physical_device_ = VK_NULL_HANDLE;
+    VkDevice device_ = VK_NULL_HANDLE;
+    VkQueue queue_ = VK_NULL_HANDLE;
+    VkPhysicalDeviceMemoryProperties memory_properties_{};
+    PFN_vkCmdPushDescriptorSetKHR push_descriptor_set_ = nullptr;
+    VulkanDeviceInfo info_;
+};
+
+}  // namespace vulkan
+}  // namespace rendering
+}  // namespace visualization
+}  // namespace open3d

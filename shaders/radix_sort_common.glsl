@@ -1,0 +1,87 @@
+// Shared by the radix-sort shaders: bindings, push constants and workgroup-wide scans that
+// are correct for any subgroup size and shape (8 on lavapipe, 32 NVIDIA/Apple, 64 AMD).
+#ifndef OPEN3D_RADIX_SORT_COMMON_GLSL
+#define OPEN3D_RADIX_SORT_COMMON_GLSL
+
+#extension GL_GOOGLE_include_directive : require
+#extension GL_KHR_shader_subgroup_basic : require
+#extension GL_KHR_shader_subgroup_arithmetic : require
+
+#include "GaussianSplatContract.h"
+
+layout(push_constant, std430) uniform PushConstantsBlock {
+    RadixSortPushConstants pc;
+};
+
+uint DigitOf(uint key) {
+    return (key >> pc.shift) & ((1u << pc.digit_bits) - 1u);
+}
+
+// Per-subgroup partial sums, indexed by gl_SubgroupID.
+shared uint s_subgroup_sum[kRadixSortMaxSubgroups];
+shared uvec4 s_subgroup_sum_lo[kRadixSortMaxSubgroups];
+shared uvec4 s_subgroup_sum_hi[kRadixSortMaxSubgroups];
+
+// The position of this invocation in the workgroup's scan order: subgroups in
+// gl_SubgroupID order, lanes in gl_SubgroupInvocationID order (the order of the subgroup
+// scans). Elements are loaded by this slot so that scan order equals element order, which
+// is what makes the sort stable; gl_LocalInvocationIndex need not follow that order and
+// subgroups may be partial, so the slot is counted, not computed.
+uint g_slot;
+
+void InitScanSlot() {
+    uint lanes = subgroupAdd(1u);
+    if (subgroupElect()) s_subgroup_sum[gl_SubgroupID] = lanes;
+    barrier();
+    uint base = 0u;
+    for (uint s = 0u; s < gl_SubgroupID; ++s) base += s_subgroup_sum[s];
+    g_slot = base + subgroupExclusiveAdd(1u);
+    barrier();
+}
+
+// Exclusive prefix sum of `value` over the workgroup in slot order; `total` gets the sum.
+uint WorkgroupExclusiveAdd(uint value, out uint total) {
+    uint inclusive_in_subgroup = subgroupInclusiveAdd(value);
+    if (gl_SubgroupInvocationID == subgroupMax(gl_SubgroupInvocationID)) {
+        s_subgroup_sum[gl_SubgroupID] = inclusive_in_subgroup;
+    }
+    barrier();
+    uint prefix = 0u;
+    uint sum = 0u;
+    for (uint s = 0u; s < gl_NumSubgroups; ++s) {
+        if (s == gl_SubgroupID) prefix = sum;
+        sum += s_subgroup_sum[s];
+    }
+    barrier();  // s_subgroup_sum is reused by the next scan
+    total = sum;
+    return prefix + inclusive_in_subgroup - value;
+}
+
+// The same for two uvec4 (sixteen 16-bit counters packed two per uint).
+void WorkgroupExclusiveAdd2(inout uvec4 lo, inout uvec4 hi, out uvec4 total_lo,
+                            out uvec4 total_hi) {
+    uvec4 inclusive_lo = subgroupInclusiveAdd(lo);
+    uvec4 inclusive_hi = subgroupInclusiveAdd(hi);
+    if (gl_SubgroupInvocationID == subgroupMax(gl_SubgroupInvocationID)) {
+        s_subgroup_sum_lo[gl_SubgroupID] = inclusive_lo;
+        s_subgroup_sum_hi[gl_SubgroupID] = inclusive_hi;
+    }
+    barrier();
+    uvec4 prefix_lo = uvec4(0u), prefix_hi = uvec4(0u);
+    uvec4 sum_lo = uvec4(0u), sum_hi = uvec4(0u);
+    for (uint s = 0u; s < gl_NumSubgroups; ++s) {
+        if (s == gl_SubgroupID) {
+            prefix_lo = sum_lo;
+            prefix_hi = sum_hi;
+        }
+        sum_lo += s_subgroup_sum_lo[s];
+        sum_hi += s_subgroup_sum_hi[s];
+    }
+    barrier();
+    total_lo = sum_lo;
+    total_hi = sum_hi;
+    lo = prefix_lo + inclusive_lo - lo;
+    hi = prefix_hi + inclusive_hi - hi;
+}
+
+#endif  // OPEN3D_RADIX_SORT_COMMON_GLSL

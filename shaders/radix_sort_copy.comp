@@ -1,0 +1,35 @@
+#version 460
+// After an odd number of passes the sorted pairs sit in the scratch buffers: copy the
+// first `count` of them back so the result always ends in the caller's buffers.
+#extension GL_GOOGLE_include_directive : require
+#include "radix_sort_common.glsl"
+
+layout(local_size_x = kRadixSortWorkgroupSize) in;
+
+layout(std430, set = 0, binding = kRadixSortParamsBinding) readonly buffer ParamsBlock {
+    RadixSortParams params;
+};
+layout(std430, set = 0, binding = kRadixSortKeysInBinding) readonly buffer KeysInBlock {
+    uint keys_in[];
+};
+layout(std430, set = 0, binding = kRadixSortValuesInBinding) readonly buffer ValuesInBlock {
+    uint values_in[];
+};
+layout(std430, set = 0, binding = kRadixSortKeysOutBinding) writeonly buffer KeysOutBlock {
+    uint keys_out[];
+};
+layout(std430, set = 0, binding = kRadixSortValuesOutBinding) writeonly buffer ValuesOutBlock {
+    uint values_out[];
+};
+
+void main() {
+    uint count = params.count;
+    uint block_begin = gl_WorkGroupID.x * kRadixSortBlockSize;
+    for (uint i = 0u; i < kRadixSortItemsPerInvocation; ++i) {
+        uint index = block_begin + i * kRadixSortWorkgroupSize + gl_LocalInvocationIndex;
+        if (index < count) {
+            keys_out[index] = keys_in[index];
+            values_out[index] = values_in[index];
+        }
+    }
+}

@@ -1,0 +1,34 @@
+#version 460
+// Pass 1 of a digit: per-block digit counts, stored digit-major so that one exclusive scan
+// per digit row (radix_sort_scan.comp) gives every block its output offset within a digit.
+#extension GL_GOOGLE_include_directive : require
+#include "radix_sort_common.glsl"
+
+layout(local_size_x = kRadixSortWorkgroupSize) in;
+
+layout(std430, set = 0, binding = kRadixSortParamsBinding) readonly buffer ParamsBlock {
+    RadixSortParams params;
+};
+layout(std430, set = 0, binding = kRadixSortKeysInBinding) readonly buffer KeysBlock {
+    uint keys_in[];
+};
+// [kRadixSortBins] digit totals, then [kRadixSortBins][num_blocks] block counts.
+layout(std430, set = 0, binding = kRadixSortHistogramBinding) writeonly buffer HistogramBlock {
+    uint histogram[];
+};
+
+shared uint s_counts[kRadixSortBins];
+
+void main() {
+    uint local = gl_LocalInvocationIndex;
+    s_counts[local] = 0u;
+    barrier();
+    uint count = params.count;
+    uint block_begin = gl_WorkGroupID.x * kRadixSortBlockSize;
+    for (uint i = 0u; i < kRadixSortItemsPerInvocation; ++i) {
+        uint index = block_begin + i * kRadixSortWorkgroupSize + local;
+        if (index < count) atomicAdd(s_counts[DigitOf(keys_in[index])], 1u);
+    }
+    barrier();
+    histogram[kRadixSortBins + local * params.num_blocks + gl_WorkGroupID.x] = s_counts[local];
+}

@@ -1,0 +1,321 @@
+// The GPU radix sort against std::stable_sort on (key, value) pairs: keys and values must
+// match exactly, for every count (0, 1, non-multiples of the workgroup and block sizes),
+// key pattern and number of key bits. Pairs beyond the count must stay untouched.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstring>
+#include <numeric>
+#include <ostream>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "VulkanTestFixture.h"
+#include "open3d/core/Exception.h"
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/Buffer.h"
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/RadixSort.h"
+#include "shaders/GaussianSplatContract.h"
+
+namespace open3d {
+namespace tests {
+namespace {
+
+using namespace visualization::rendering::vulkan;
+namespace shader = visualization::rendering::shader;
+
+enum class Pattern { kRandom, kSorted, kReverse, kAllEqual, kFewDistinct, kTiles };
+
+struct SortCase {
+    std::string name;
+    uint32_t count;
+    Pattern pattern;
+    uint32_t num_bits = 32;
+};
+
+// Readable parameter in test lists and failures (instead of the struct's bytes).
+void PrintTo(const SortCase& c, std::ostream* os) {
+    *os << c.name << " (" << c.count << " pairs, " << c.num_bits << " bits)";
+}
+
+std::vector<uint32_t> MakeKeys(const SortCase& c, uint32_t seed) {
+    std::mt19937 rng(seed);
+    std::vector<uint32_t> keys(c.count);
+    for (uint32_t i = 0; i < c.count; ++i) {
+        switch (c.pattern) {
+            case Pattern::kRandom:
+                keys[i] = rng();
+                break;
+            case Pattern::kSorted:
+                keys[i] = i * 7919u;
+                break;
+            case Pattern::kReverse:
+                keys[i] = ~(i * 7919u);
+                break;
+            case Pattern::kAllEqual:
+                keys[i] = 0xA5A5A5A5u;
+                break;
+            case Pattern::kFewDistinct:
+                keys[i] = (rng() % 4u) << 29 | 5u;
+                break;
+            // 1080p tile index in the low 13 bits, random bits above: a tile-only sort.
+            case Pattern::kTiles:
+                keys[i] = (rng() % 8160u) | (rng() << 13);
+                break;
+        }
+    }
+    return keys;
+}
+
+/// What the sort must produce: pairs stably ordered by the low num_bits of the key.
+void ReferenceSort(std::vector<uint32_t>& keys, std::vector<uint32_t>& values, uint32_t num_bits) {
+    const uint32_t mask = num_bits >= 32 ? ~0u : (1u << num_bits) - 1u;
+    std::vector<uint32_t> order(keys.size());
+    std::iota(order.begin(), order.end(), 0u);
+    std::stable_sort(order.begin(), order.end(),
+                     [&](uint32_t a, uint32_t b) { return (keys[a] & mask) < (keys[b] & mask); });
+    std::vector<uint32_t> sorted_keys(keys.size()), sorted_values(keys.size());
+    for (size_t i = 0; i < order.size(); ++i) {
+        sorted_keys[i] = keys[order[i]];
+        sorted_values[i] = values[order[i]];
+    }
+    keys.swap(sorted_keys);
+    values.swap(sorted_values);
+}
+
+struct GpuSortResult {
+    std::vector<uint32_t> keys;    // [capacity]
+    std::vector<uint32_t> values;  // [capacity]
+    shader::RadixSortParams params{};
+    double gpu_ms = 0.0;  // submit to fence, lavapipe wall time
+};
+
+class RadixSortTest : public VulkanTest {
+protected:
+    void SetUp() override {
+        VulkanTest::SetUp();
+        if (IsSkipped() || HasFatalFailure()) return;
+        if (!sort_) sort_ = std::make_unique<RadixSort>(Context());
+    }
+    static void TearDownTestSuite() {
+        sort_.reset();
+        VulkanTest::TearDownTestSuite();
+    }
+
+    /// Sorts keys/values (the whole vectors are the buffers' contents, capacity =
+    /// keys.size()) on the GPU with `gpu_count` written into the count buffer on the GPU.
+    GpuSortResult Sort(const std::vector<uint32_t>& keys, const std::vector<uint32_t>& values,
+                       uint32_t gpu_count, uint32_t num_bits) {
+        const auto capacity = static_cast<uint32_t>(keys.size());
+        const VkDeviceSize bytes = std::max<VkDeviceSize>(capacity, 1) * 4;
+        const VkBufferUsageFlags usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT |
+                                         VK_BUFFER_USAGE_TRANSFER_SRC_BIT |
+                                         VK_BUFFER_USAGE_TRANSFER_DST_BIT;
+        Buffer key_buffer(Context(), bytes, usage, MemoryUsage::kDevice);
+        Buffer value_buffer(Context(), bytes, usage, MemoryUsage::kDevice);
+        // The count sits at byte 20 of its buffer, as it would inside a producer's
+        // counter struct; it is written on the GPU, never read back by the sort.
+        Buffer count_buffer(Context(), 64, usage, MemoryUsage::kDevice);
+        const RadixSortStorageRequirements need = RadixSort::GetStorageRequirements(capacity);
+        Buffer keys_alt(Context(), need.keys_alt_bytes, need.scratch_usage, MemoryUsage::kDevice);
+        Buffer values_alt(Context(), need.values_alt_bytes, need.scratch_usage,
+                          MemoryUsage::kDevice);
+        Buffer histogram(Context(), need.histogram_bytes, need.scratch_usage, MemoryUsage::kDevice);
+        Buffer params(Context(), need.params_bytes,
+                      need.params_usage | VK_BUFFER_USAGE_TRANSFER_SRC_BIT, MemoryUsage::kDevice);
+        Buffer upload(Context(), 2 * bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
+                      MemoryUsage::kHostUpload);
+        Buffer readback(Context(), 2 * bytes + sizeof(shader::RadixSortParams),
+                        VK_BUFFER_USAGE_TRANSFER_DST_BIT, MemoryUsage::kHostReadback);
+        auto* up = static_cast<uint8_t*>(upload.GetMapped());
+        if (capacity > 0) {
+            std::memcpy(up, keys.data(), capacity * 4);
+            std::memcpy(up + bytes, values.data(), capacity * 4);
+        }
+        CommandPool& pool = Pool();
+        CommandBuffer cmd = pool.Allocate();
+        cmd.Begin();
+        VkCommandBuffer c = cmd.Get();
+        if (capacity > 0) {
+            VkBufferCopy region{0, 0, capacity * 4u};
+            vkCmdCopyBuffer(c, upload.Get(), key_buffer.Get(), 1, &region);
+            region.srcOffset = bytes;
+            vkCmdCopyBuffer(c, upload.Get(), value_buffer.Get(), 1, &region);
+        }
+        vkCmdFillBuffer(c, count_buffer.Get(), 20, 4, gpu_count);
+        RecordMemoryBarrier(
+            c, VK_PIPELINE_STAGE_2_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
+            VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+            VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
+        RadixSortScratch scratch{keys_alt.Range(), values_alt.Range(), histogram.Range(),
+                                 params.Range()};
+        sort_->Record(c, key_buffer.Range(), value_buffer.Range(), scratch,
+                      count_buffer.Range(20, 4), capacity, num_bits);
+        RecordMemoryBarrier(c, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                            VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, VK_PIPELINE_STAGE_2_TRANSFER_BIT,
+                            VK_ACCESS_2_TRANSFER_READ_BIT);
+        if (capacity > 0) {
+            VkBufferCopy region{0, 0, capacity * 4u};
+            vkCmdCopyBuffer(c, key_buffer.Get(), readback.Get(), 1, &region);
+            region.dstOffset = bytes;
+            vkCmdCopyBuffer(c, value_buffer.Get(), readback.Get(), 1, &region);
+        }
+        VkBufferCopy params_region{0, 2 * bytes, sizeof(shader::RadixSortParams)};
+        vkCmdCopyBuffer(c, params.Get(), readback.Get(), 1, &params_region);
+        RecordMemoryBarrier(c, VK_PIPELINE_STAGE_2_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                            VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT);
+        cmd.End();
+
+        UniqueFence fence = CreateFence(Context());
+        const auto start = std::chrono::steady_clock::now();
+        Submit(Context(), c, fence.Get());
+        Wait(Context(), fence.Get());
+        GpuSortResult result;
+        result.gpu_ms =
+            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+                .count();
+        const auto* down = static_cast<const uint8_t*>(readback.GetMapped());
+        result.keys.resize(capacity);
+        result.values.resize(capacity);
+        if (capacity > 0) {
+            std::memcpy(result.keys.data(), down, capacity * 4);
+            std::memcpy(result.values.data(), down + bytes, capacity * 4);
+        }
+        std::memcpy(&result.params, down + 2 * bytes, sizeof(result.params));
+        return result;
+    }
+
+    /// Sorts `count` pairs inside buffers of count + padding pairs and checks everything.
+    void CheckSort(const SortCase& c, uint32_t padding, uint32_t seed = 1) {
+        std::vector<uint32_t> keys = MakeKeys(c, seed);
+        std::vector<uint32_t> values(c.count);
+        for (uint32_t i = 0; i < c.count; ++i) values[i] = i * 2654435761u + 12345u;  // distinct
+        // Pairs past the count: the sort must neither read them into the result nor move them.
+        for (uint32_t i = 0; i < padding; ++i) {
+            keys.push_back(i);  // small keys that would sort first if they leaked in
+            values.push_back(0xDEAD0000u + i);
+        }
+        GpuSortResult gpu = Sort(keys, values, c.count, c.num_bits);
+
+        std::vector<uint32_t> want_keys(keys.begin(), keys.begin() + c.count);
+        std::vector<uint32_t> want_values(values.begin(), values.begin() + c.count);
+        ReferenceSort(want_keys, want_values, c.num_bits);
+        want_keys.insert(want_keys.end(), keys.begin() + c.count, keys.end());
+        want_values.insert(want_values.end(), values.begin() + c.count, values.end());
+
+        if (c.num_bits > 0) {
+            EXPECT_EQ(gpu.params.count, c.count);
+            EXPECT_EQ(gpu.params.flags, 0u);
+        }
+        ASSERT_EQ(gpu.keys.size(), want_keys.size());
+        for (size_t i = 0; i < want_keys.size(); ++i) {
+            ASSERT_EQ(gpu.keys[i], want_keys[i]) << "key " << i << " of " << c.count;
+            ASSERT_EQ(gpu.values[i], want_values[i]) << "value " << i << " of " << c.count;
+        }
+        if (c.count >= 65536) {
+            std::cout << "[ timing   ] " << c.name << ": " << c.count << " pairs, " << c.num_bits
+                      << " bits, " << gpu.gpu_ms << " ms submit-to-fence (incl. copies)\n";
+        }
+    }
+
+    static std::unique_ptr<RadixSort> sort_;
+};
+
+std::unique_ptr<RadixSort> RadixSortTest::sort_;
+
+class RadixSortCaseTest : public RadixSortTest, public ::testing::WithParamInterface<SortCase> {};
+
+TEST_P(RadixSortCaseTest, MatchesStableSort) {
+    CheckSort(GetParam(), /*padding=*/0);
+    if (GetParam().count < 100000) CheckSort(GetParam(), /*padding=*/37, /*seed=*/2);
+}
+
+INSTANTIATE_TEST_SUITE_P(Counts, RadixSortCaseTest,
+                         ::testing::Values(SortCase{"Random0", 0, Pattern::kRandom},
+                                           SortCase{"Random1", 1, Pattern::kRandom},
+                                           SortCase{"Random2", 2, Pattern::kRandom},
+                                           SortCase{"Random255", 255, Pattern::kRandom},
+                                           SortCase{"Random256", 256, Pattern::kRandom},
+                                           SortCase{"Random257", 257, Pattern::kRandom},
+                                           SortCase{"Random1000", 1000, Pattern::kRandom},
+                                           SortCase{"Random4095", 4095, Pattern::kRandom},
+                                           SortCase{"Random4097", 4097, Pattern::kRandom},
+                                           SortCase{"Random65537", 65537, Pattern::kRandom},
+                                           SortCase{"Random1000000", 1000000, Pattern::kRandom},
+                                           SortCase{"Sorted65537", 65537, Pattern::kSorted},
+                                           SortCase{"Reverse65537", 65537, Pattern::kReverse},
+                                           SortCase{"AllEqual65537", 65537, Pattern::kAllEqual},
+                                           SortCase{"FewDistinct1000", 1000, Pattern::kFewDistinct},
+                                           SortCase{"FewDistinct100000", 100000,
+                                                    Pattern::kFewDistinct}),
+                         [](const auto& info) { return info.param.name; });
+
+INSTANTIATE_TEST_SUITE_P(KeyBits, RadixSortCaseTest,
+                         ::testing::Values(SortCase{"Bits0", 1000, Pattern::kRandom, 0},
+                                           SortCase{"Bits1", 5000, Pattern::kRandom, 1},
+                                           SortCase{"Bits5", 5000, Pattern::kRandom, 5},
+                                           SortCase{"Bits8", 5000, Pattern::kRandom, 8},
+                                           SortCase{"Bits13Tiles", 70000, Pattern::kTiles, 13},
+                                           SortCase{"Bits16", 5000, Pattern::kRandom, 16},
+                                           SortCase{"Bits24", 20000, Pattern::kRandom, 24},
+                                           SortCase{"Bits31", 5000, Pattern::kRandom, 31},
+                                           SortCase{"Bits4FewDistinct", 20000,
+                                                    Pattern::kFewDistinct, 4}),
+                         [](const auto& info) { return info.param.name; });
+
+TEST_F(RadixSortTest, CountAboveCapacityIsClampedAndFlagged) {
+    std::vector<uint32_t> keys = MakeKeys({"", 3000, Pattern::kRandom}, 7);
+    std::vector<uint32_t> values(keys.size());
+    std::iota(values.begin(), values.end(), 0u);
+    GpuSortResult gpu = Sort(keys, values, /*gpu_count=*/5000, 32);
+    EXPECT_EQ(gpu.params.count, 3000u);
+    EXPECT_EQ(gpu.params.flags, shader::kErrorCountsClamped);
+    ReferenceSort(keys, values, 32);
+    EXPECT_EQ(gpu.keys, keys);
+    EXPECT_EQ(gpu.values, values);
+}
+
+TEST_F(RadixSortTest, ReusesScratchAcrossSorts) {
+    // The same sorter records many sorts; results must not depend on earlier ones.
+    for (uint32_t seed = 10; seed < 13; ++seed) CheckSort({"", 9000, Pattern::kRandom}, 5, seed);
+}
+
+TEST_F(RadixSortTest, StorageRequirements) {
+    const auto need = RadixSort::GetStorageRequirements(10000);
+    EXPECT_EQ(need.keys_alt_bytes, 40000u);
+    EXPECT_EQ(need.values_alt_bytes, 40000u);
+    EXPECT_EQ(need.histogram_bytes, (256u + 256u * 3u) * 4u);  // ceil(10000 / 4096) = 3 blocks
+    EXPECT_EQ(need.params_bytes, sizeof(shader::RadixSortParams));
+    EXPECT_TRUE(need.params_usage & VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT);
+    EXPECT_GT(RadixSort::GetStorageRequirements(0).keys_alt_bytes, 0u);  // no empty buffers
+    EXPECT_THROW(RadixSort::GetStorageRequirements(RadixSort::kMaxCount + 1), core::Open3DError);
+    EXPECT_EQ(RadixSort::GetNumPasses(32), 4u);
+    EXPECT_EQ(RadixSort::GetNumPasses(13), 2u);
+    EXPECT_EQ(RadixSort::GetNumPasses(0), 0u);
+}
+
+TEST_F(RadixSortTest, RejectsMisuse) {
+    Buffer buffer(Context(), 1 << 16,
+                  VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT,
+                  MemoryUsage::kDevice);
+    RadixSortScratch scratch{buffer.Range(0, 4096), buffer.Range(4096, 4096),
+                             buffer.Range(8192, 8192), buffer.Range(16384, 256)};
+    CommandBuffer cmd = Pool().Allocate();
+    cmd.Begin();
+    // Nothing is recorded when the arguments are wrong.
+    EXPECT_THROW(sort_->Record(cmd.Get(), buffer.Range(32768, 4096), buffer.Range(40960, 4096),
+                               scratch, buffer.Range(60000, 4), 1000, 33),
+                 core::Open3DError);
+    EXPECT_THROW(sort_->Record(cmd.Get(), buffer.Range(32768, 4096), buffer.Range(40960, 4096),
+                               scratch, buffer.Range(60000, 4), 2000, 32),
+                 core::Open3DError);  // 8000 bytes needed, 4096 given
+    EXPECT_THROW(sort_->Record(cmd.Get(), buffer.Range(32772, 4000), buffer.Range(40960, 4096),
+                               scratch, buffer.Range(60000, 4), 1000, 32),
+                 core::Open3DError);  // misaligned keys
+    cmd.End();
+}
+
+}  // namespace
+}  // namespace tests
+}  // namespace open3d

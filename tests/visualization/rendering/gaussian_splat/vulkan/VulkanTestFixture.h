@@ -1,0 +1,46 @@
+// Fixture of the Vulkan tests: one headless context per test suite with validation on
+// (creating one per test would cost more than most tests), a GTEST_SKIP with the reason
+// when no Vulkan device exists, and a failure when the validation layer sent any warning
+// or error during a test or while the suite's context was destroyed.
+//
+// Environment: OPEN3D_TEST_REQUIRE_VULKAN=1 turns "no device" into a failure (for CI
+// machines that must run these tests); OPEN3D_VULKAN_VALIDATION=0 runs them without the
+// validation layer (machines without it, e.g. a GPU box with only the loader).
+#pragma once
+
+#include <gtest/gtest.h>
+
+#include <memory>
+#include <string>
+
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/Commands.h"
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/VulkanContext.h"
+
+namespace open3d {
+namespace tests {
+
+class VulkanTest : public ::testing::Test {
+protected:
+    static void SetUpTestSuite();
+    static void TearDownTestSuite();
+    void SetUp() override;
+    void TearDown() override;
+
+    static visualization::rendering::vulkan::VulkanContext& Context() { return *context_; }
+    static visualization::rendering::vulkan::CommandPool& Pool() { return *pool_; }
+
+    /// Creates a context as the fixture does; on failure returns nullptr and sets
+    /// `skip_reason` (no device) or `failure` (device present, validation layer missing).
+    static std::unique_ptr<visualization::rendering::vulkan::VulkanContext> CreateTestContext(
+        std::string& skip_reason, std::string& failure);
+
+private:
+    static std::unique_ptr<visualization::rendering::vulkan::VulkanContext> context_;
+    static std::unique_ptr<visualization::rendering::vulkan::CommandPool> pool_;
+    static std::string skip_reason_;
+    static std::string failure_;
+    uint64_t problems_before_ = 0;
+};
+
+}  // namespace tests
+}  // namespace open3d
