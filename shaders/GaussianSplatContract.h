@@ -119,3 +119,185 @@ static_assert(offsetof(RadixSortPushConstants, max_count) == 12);
 
 #undef OPEN3D_SHADER_CONST
 #endif  // OPEN3D_SHADERS_GAUSSIAN_SPLAT_CONTRACT_H
+
+// ---- Projection (Stage A) ----
+// Appended by the projection work (vulkan/GaussianProjection.*, GaussianSplatDataPacking.*):
+// view parameters, packed splat attributes, projected splats, Stage A counters, bindings.
+// Kept as its own guarded block so the section above can change independently.
+#ifndef OPEN3D_SHADERS_GAUSSIAN_SPLAT_CONTRACT_PROJECTION_H
+#define OPEN3D_SHADERS_GAUSSIAN_SPLAT_CONTRACT_PROJECTION_H
+
+#ifdef __cplusplus
+namespace open3d {
+namespace visualization {
+namespace rendering {
+namespace shader {
+#define OPEN3D_SHADER_CONST inline constexpr
+#else
+#define OPEN3D_SHADER_CONST const
+#endif
+
+// Side of the square screen tiles in pixels (== RenderConfig.h kTileSize, asserted there).
+OPEN3D_SHADER_CONST uint kGaussianTileSize = 16u;
+// Workgroup sizes of the Stage A passes (one invocation per splat / per visible splat).
+OPEN3D_SHADER_CONST uint kProjectWorkgroupSize = 256u;
+OPEN3D_SHADER_CONST uint kEmitWorkgroupSize = 256u;
+// The tile-count scan: a workgroup scans a block of 256 * 4 = 1024 counts.
+OPEN3D_SHADER_CONST uint kScanWorkgroupSize = 256u;
+OPEN3D_SHADER_CONST uint kScanItemsPerInvocation = 4u;
+OPEN3D_SHADER_CONST uint kScanBlockSize = 1024u;
+// Levels of the block-sum hierarchy: 1024^4 counts, far beyond any buffer we allocate.
+OPEN3D_SHADER_CONST uint kScanMaxLevels = 4u;
+// Prefix sums saturate here: the sum of all tile counts can exceed 2^32 (a camera inside
+// a large cloud), and min(a + b, S) of values <= S < 2^31 never wraps. Entry capacities
+// are kept below S, so a saturated offset always reads as "does not fit".
+OPEN3D_SHADER_CONST uint kScanSaturation = 0x7FFFFFFFu;
+
+// Precision of the packed attributes (specialisation constant kSpecPrecision).
+OPEN3D_SHADER_CONST uint kPrecisionExact = 0u;    // fp32 everything
+OPEN3D_SHADER_CONST uint kPrecisionCompact = 1u;  // fp16 scale, rotation, f_dc, SH
+// uint words per splat in the shape buffer: scale xyz, rotation wxyz, f_dc rgb.
+OPEN3D_SHADER_CONST uint kShapeWordsExact = 10u;   // 10 floats
+OPEN3D_SHADER_CONST uint kShapeWordsCompact = 5u;  // 10 halves
+
+// Specialisation constant ids of gaussian_project.comp.
+OPEN3D_SHADER_CONST uint kSpecShDegree = 0u;   // 0..3; 0 reads no SH buffer
+OPEN3D_SHADER_CONST uint kSpecAntialias = 1u;  // 0 / 1
+OPEN3D_SHADER_CONST uint kSpecPrecision = 2u;  // kPrecisionExact / kPrecisionCompact
+// Specialisation constant of gaussian_scan.comp: level 0 gathers the tile counts.
+OPEN3D_SHADER_CONST uint kSpecScanGather = 0u;
+
+// Descriptor set 0 of every Stage A projection pipeline (one push-descriptor layout; each
+// shader declares only the bindings it uses).
+OPEN3D_SHADER_CONST uint kStageAViewBinding = 0u;          // GaussianViewParams
+OPEN3D_SHADER_CONST uint kStageAPositionsBinding = 1u;     // vec4[N]: xyz, sigmoid(opacity)
+OPEN3D_SHADER_CONST uint kStageAShapeBinding = 2u;         // uint[N * shape words]
+OPEN3D_SHADER_CONST uint kStageAShBinding = 3u;            // uint[N * sh words]; unread at degree 0
+OPEN3D_SHADER_CONST uint kStageAVisibilityBinding = 4u;    // uint[ceil(N / 32)], bit i = splat i
+OPEN3D_SHADER_CONST uint kStageAProjectedBinding = 5u;     // GaussianProjectedSplat[N]
+OPEN3D_SHADER_CONST uint kStageACountersBinding = 6u;      // GaussianStageACounters
+OPEN3D_SHADER_CONST uint kStageADepthKeysBinding = 7u;     // uint[N]: visible depth keys
+OPEN3D_SHADER_CONST uint kStageASplatIndexBinding = 8u;    // uint[N]: visible splat indices
+OPEN3D_SHADER_CONST uint kStageAScanBinding = 9u;          // uint[scan words]: all levels
+OPEN3D_SHADER_CONST uint kStageAEntryKeysBinding = 10u;    // uint[capacity]: tile index
+OPEN3D_SHADER_CONST uint kStageAEntryValuesBinding = 11u;  // uint[capacity]: splat index
+OPEN3D_SHADER_CONST uint kStageANumBindings = 12u;
+
+// uint indices into GaussianStageACounters, used as the radix sorter's count_index.
+OPEN3D_SHADER_CONST uint kCounterVisibleIndex = 0u;
+OPEN3D_SHADER_CONST uint kCounterEntriesIndex = 2u;
+
+// Per-frame view parameters (a readonly storage buffer; only 16-byte members, so std430,
+// std140 and C++ agree).
+struct GaussianViewParams {
+    vec4 world_to_camera_row0;  // R row 0 | t.x: p_cam.x = dot(row0.xyz, p) + row0.w
+    vec4 world_to_camera_row1;
+    vec4 world_to_camera_row2;
+    vec4 camera_center;  // xyz: camera centre in world space (SH view direction)
+    vec4 intrinsics;     // fx, fy, cx, cy (pixels)
+    vec4 clip;           // guard band 1.3 tan(fov_x / 2), 1.3 tan(fov_y / 2), near plane, 0
+    uvec4 image;         // width, height, tiles_x, tiles_y
+    uvec4 limits;        // entry capacity used (<= allocated), max_tiles_per_splat,
+                         // max_tile_entries_total (clamped below 2^31), tile_bits
+    uvec4 scene;         // num_splats, sh_degree evaluated, antialias, sh_words_per_splat
+    uvec4 flags;         // scene depth present, precision, shape_words_per_splat,
+                         // entry capacity allocated
+};
+
+// One projected splat, written for visible splats only, indexed by splat index (std430).
+struct GaussianProjectedSplat {
+    vec4 center_depth_opacity;  // x, y (pixels), view-space z, opacity (antialias applied)
+    vec4 conic;                 // inverse dilated 2D covariance a, b, c; w = 0
+    vec4 color;                 // rgb = max(0, 0.5 + SH), not clamped above; w = 0
+    uvec4 tiles;                // rect min (x | y << 16), rect max (x | y << 16), tile
+                                // count, radius (pixels); rect is [min, max) in tiles
+};
+
+// Indirect dispatch of one scan level: (x, y, z) groups, then the level's element count.
+struct GaussianScanLevel {
+    uint dispatch_x;
+    uint dispatch_y;
+    uint dispatch_z;
+    uint count;
+};
+
+// GPU-side counts of Stage A (std430). Zeroed by the recorder before the projection;
+// read back after the fence for stats and error flags.
+struct GaussianStageACounters {
+    uint visible_count;      // splats that passed culling and the visibility mask
+    uint requested_entries;  // sum of tile counts (saturates at kScanSaturation)
+    uint entry_count;        // tile entries emitted (<= limits.x)
+    uint error_flags;        // kErrorEntriesDropped | kErrorCountsClamped
+    uint emit_dispatch_x;    // VkDispatchIndirectCommand of the emit pass
+    uint emit_dispatch_y;
+    uint emit_dispatch_z;
+    uint reserved;
+    GaussianScanLevel scan_levels[kScanMaxLevels];
+};
+
+// Push constants of gaussian_dispatch_args.comp.
+OPEN3D_SHADER_CONST uint kDispatchArgsAfterProject = 0u;  // sizes the scan and emit
+OPEN3D_SHADER_CONST uint kDispatchArgsAfterScan = 1u;     // counts the entries that fit
+struct GaussianDispatchArgsPushConstants {
+    uint mode;        // kDispatchArgsAfterProject / kDispatchArgsAfterScan
+    uint num_levels;  // scan levels recorded (1..kScanMaxLevels)
+    uint reserved0;
+    uint reserved1;
+};
+
+// Push constants of gaussian_scan.comp.
+struct GaussianScanPushConstants {
+    uint level;        // index into GaussianStageACounters::scan_levels
+    uint base;         // uint offset of this level's data in the scan buffer
+    uint sums_base;    // offset of the next level's data (block sums / scanned block sums)
+    uint add_pass;     // 0: scan blocks and write block sums; 1: add scanned block sums
+    uint write_total;  // 1 on the top level: its block sum is the grand total
+    uint reserved0;
+    uint reserved1;
+    uint reserved2;
+};
+
+#ifdef __cplusplus
+static_assert(kScanBlockSize == kScanWorkgroupSize * kScanItemsPerInvocation);
+static_assert(kCounterVisibleIndex * 4 == 0 && kCounterEntriesIndex * 4 == 8);
+
+static_assert(sizeof(GaussianViewParams) == 160);
+static_assert(offsetof(GaussianViewParams, world_to_camera_row0) == 0);
+static_assert(offsetof(GaussianViewParams, world_to_camera_row1) == 16);
+static_assert(offsetof(GaussianViewParams, world_to_camera_row2) == 32);
+static_assert(offsetof(GaussianViewParams, camera_center) == 48);
+static_assert(offsetof(GaussianViewParams, intrinsics) == 64);
+static_assert(offsetof(GaussianViewParams, clip) == 80);
+static_assert(offsetof(GaussianViewParams, image) == 96);
+static_assert(offsetof(GaussianViewParams, limits) == 112);
+static_assert(offsetof(GaussianViewParams, scene) == 128);
+static_assert(offsetof(GaussianViewParams, flags) == 144);
+
+static_assert(sizeof(GaussianProjectedSplat) == 64);
+static_assert(offsetof(GaussianProjectedSplat, center_depth_opacity) == 0);
+static_assert(offsetof(GaussianProjectedSplat, conic) == 16);
+static_assert(offsetof(GaussianProjectedSplat, color) == 32);
+static_assert(offsetof(GaussianProjectedSplat, tiles) == 48);
+
+static_assert(sizeof(GaussianScanLevel) == 16);
+static_assert(sizeof(GaussianStageACounters) == 32 + 16 * kScanMaxLevels);
+static_assert(offsetof(GaussianStageACounters, visible_count) == 4 * kCounterVisibleIndex);
+static_assert(offsetof(GaussianStageACounters, requested_entries) == 4);
+static_assert(offsetof(GaussianStageACounters, entry_count) == 4 * kCounterEntriesIndex);
+static_assert(offsetof(GaussianStageACounters, error_flags) == 12);
+static_assert(offsetof(GaussianStageACounters, emit_dispatch_x) == 16);
+static_assert(offsetof(GaussianStageACounters, scan_levels) == 32);
+
+static_assert(sizeof(GaussianDispatchArgsPushConstants) == 16);
+static_assert(offsetof(GaussianDispatchArgsPushConstants, num_levels) == 4);
+static_assert(sizeof(GaussianScanPushConstants) == 32);
+static_assert(offsetof(GaussianScanPushConstants, write_total) == 16);
+
+}  // namespace shader
+}  // namespace rendering
+}  // namespace visualization
+}  // namespace open3d
+#endif  // __cplusplus
+
+#undef OPEN3D_SHADER_CONST
+#endif  // OPEN3D_SHADERS_GAUSSIAN_SPLAT_CONTRACT_PROJECTION_H

@@ -41,9 +41,15 @@ TileLists BuildTileLists(const std::vector<ProjectedSplat>& splats, const TileGr
     uint64_t total = 0;
     for (uint32_t index : order) {
         const uint64_t tiles = static_cast<uint64_t>(splats[index].NumTiles());
-        if (tiles > config.max_tiles_per_splat || total + tiles > config.max_tile_entries_total) {
+        if (tiles > config.max_tiles_per_splat) {  // this splat alone emits nothing
             lists.error_flags |= kEntriesDropped;
             continue;
+        }
+        // The first splat that does not fit ends the list: the GPU keeps exactly this
+        // depth-order prefix (a parallel scan cannot let later, smaller splats in).
+        if (total + tiles > config.max_tile_entries_total) {
+            lists.error_flags |= kEntriesDropped;
+            break;
         }
         total += tiles;
         emitting.push_back(index);

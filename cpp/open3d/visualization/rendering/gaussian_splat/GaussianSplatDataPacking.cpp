@@ -1,0 +1,221 @@
+#include "open3d/visualization/rendering/gaussian_splat/GaussianSplatDataPacking.h"
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <limits>
+
+#include "open3d/core/Exception.h"
+#include "open3d/t/geometry/SphericalHarmonics.h"
+#include "open3d/visualization/rendering/gaussian_splat/cpu/Projection.h"
+
+namespace open3d {
+namespace visualization {
+namespace rendering {
+
+namespace gs = t::geometry::gs_attr;
+
+static_assert(shader::kGaussianTileSize == static_cast<uint32_t>(kTileSize));
+static_assert(shader::kErrorEntriesDropped == kEntriesDropped);
+static_assert(shader::kErrorCountsClamped == kCountsClamped);
+
+uint16_t FloatToHalf(float value) {
+    const uint32_t bits = std::bit_cast<uint32_t>(value);
+    const uint32_t sign = (bits >> 16) & 0x8000u;
+    const uint32_t exponent = (bits >> 23) & 0xFFu;
+    uint32_t mantissa = bits & 0x7FFFFFu;
+    if (exponent == 0xFFu) {  // inf, NaN (keep a quiet NaN payload bit)
+        return static_cast<uint16_t>(sign | 0x7C00u | (mantissa ? 0x200u : 0u));
+    }
+    const int half_exponent = static_cast<int>(exponent) - 127 + 15;
+    if (half_exponent >= 0x1F) return static_cast<uint16_t>(sign | 0x7C00u);  // overflow
+    if (half_exponent <= 0) {
+        // Subnormal half (or zero): shift the implicit-one mantissa into place.
+        if (half_exponent < -10) return static_cast<uint16_t>(sign);
+        mantissa |= 0x800000u;
+        const uint32_t shift = static_cast<uint32_t>(14 - half_exponent);
+        uint32_t half_mantissa = mantissa >> shift;
+        const uint32_t remainder = mantissa & ((1u << shift) - 1u);
+        const uint32_t halfway = 1u << (shift - 1u);
+        if (remainder > halfway || (remainder == halfway && (half_mantissa & 1u))) {
+            ++half_mantissa;  // may carry into the exponent: still the right encoding
+        }
+        return static_cast<uint16_t>(sign | half_mantissa);
+    }
+    uint32_t half = sign | (static_cast<uint32_t>(half_exponent) << 10) | (mantissa >> 13);
+    const uint32_t remainder = mantissa & 0x1FFFu;
+    if (remainder > 0x1000u || (remainder == 0x1000u && (half & 1u))) ++half;  // carry ok
+    return static_cast<uint16_t>(half);
+}
+
+float HalfToFloat(uint16_t half) {
+    const uint32_t sign = static_cast<uint32_t>(half & 0x8000u) << 16;
+    const uint32_t exponent = (half >> 10) & 0x1Fu;
+    const uint32_t mantissa = half & 0x3FFu;
+    if (exponent == 0) {  // zero or subnormal: mantissa * 2^-24
+        const float magnitude = std::ldexp(static_cast<float>(mantissa), -24);
+        return sign ? -magnitude : magnitude;
+    }
+    if (exponent == 0x1F) return std::bit_cast<float>(sign | 0x7F800000u | (mantissa << 13));
+    return std::bit_cast<float>(sign | ((exponent - 15 + 127) << 23) | (mantissa << 13));
+}
+
+uint64_t PackedGaussianSplats::BytesPerSplat() const {
+    return 4 * sizeof(float) + sizeof(uint32_t) * (shape_words_per_splat + sh_words_per_splat);
+}
+
+namespace {
+
+// Appends `values` as fp32 bits (exact) or fp16 pairs (compact, zero-padded to a word).
+void AppendWords(const double* values, int count, SplatPrecision precision,
+                 std::vector<uint32_t>& out) {
+    if (precision == SplatPrecision::kExact) {
+        for (int k = 0; k < count; ++k) {
+            out.push_back(std::bit_cast<uint32_t>(static_cast<float>(values[k])));
+        }
+        return;
+    }
+    for (int k = 0; k < count; k += 2) {
+        const uint32_t lo = FloatToHalf(static_cast<float>(values[k]));
+        const uint32_t hi = k + 1 < count ? FloatToHalf(static_cast<float>(values[k + 1])) : 0u;
+        out.push_back(lo | (hi << 16));
+    }
+}
+
+uint32_t WordsFor(int values, SplatPrecision precision) {
+    return precision == SplatPrecision::kExact ? static_cast<uint32_t>(values)
+                                               : static_cast<uint32_t>((values + 1) / 2);
+}
+
+}  // namespace
+
+PackedGaussianSplats PackGaussianSplatAttrs(const t::geometry::PointCloud& cloud,
+                                            SplatPrecision precision, int max_sh_degree) {
+    cloud.ValidateGaussianSplat();
+    const int64_t n = cloud.NumPoints();
+    if (n > static_cast<int64_t>(std::numeric_limits<uint32_t>::max())) {
+        core::ThrowError("PackGaussianSplatAttrs: {} splats, at most 2^32 - 1 fit a splat index",
+                         n);
+    }
+    const int scene_degree = cloud.GaussianSplatGetSHOrder();
+    const int64_t scene_rest = t::geometry::NumSHRestCoeffs(scene_degree);  // per channel
+
+    PackedGaussianSplats packed;
+    packed.precision = precision;
+    packed.num_splats = n;
+    packed.sh_degree = std::clamp(max_sh_degree, 0, scene_degree);
+    const int rest_values = 3 * t::geometry::NumSHRestCoeffs(packed.sh_degree);
+    packed.shape_words_per_splat = WordsFor(10, precision);
+    packed.sh_words_per_splat = WordsFor(rest_values, precision);
+    static_assert(shader::kShapeWordsExact == 10 && shader::kShapeWordsCompact == 5);
+
+    const float* positions = cloud.GetPointAttr(gs::kPositions).Data<float>();  // [N, 3]
+    const float* scales = cloud.GetPointAttr(gs::kScale).Data<float>();         // [N, 3]
+    const float* rots = cloud.GetPointAttr(gs::kRot).Data<float>();             // [N, 4]
+    const float* opacities = cloud.GetPointAttr(gs::kOpacity).Data<float>();    // [N, 1]
+    const float* f_dc = cloud.GetPointAttr(gs::kFDc).Data<float>();             // [N, 3]
+    const float* f_rest =
+        scene_degree > 0 ? cloud.GetPointAttr(gs::kFRest).Data<float>() : nullptr;  // [N,Nc,3]
+
+    packed.positions.reserve(4 * n);
+    packed.shape.reserve(packed.shape_words_per_splat * n);
+    packed.sh.reserve(packed.sh_words_per_splat * n);
+    std::vector<double> values(std::max(10, rest_values));
+    for (int64_t i = 0; i < n; ++i) {
+        for (int c = 0; c < 3; ++c) packed.positions.push_back(positions[3 * i + c]);
+        // The sigmoid in double, rounded once: within half an ulp of the reference's value.
+        const double logit = opacities[i];
+        packed.positions.push_back(static_cast<float>(1.0 / (1.0 + std::exp(-logit))));
+
+        for (int c = 0; c < 3; ++c) values[c] = scales[3 * i + c];
+        const float* q = rots + 4 * i;
+        const double norm = std::sqrt(double(q[0]) * q[0] + double(q[1]) * q[1] +
+                                      double(q[2]) * q[2] + double(q[3]) * q[3]);
+        // A zero quaternion stays zero: the shader's rotation formula then gives the
+        // identity, as Eigen's does for the CPU reference.
+        for (int c = 0; c < 4; ++c) values[3 + c] = norm > 0.0 ? q[c] / norm : 0.0;
+        for (int c = 0; c < 3; ++c) values[7 + c] = f_dc[3 * i + c];
+        AppendWords(values.data(), 10, precision, packed.shape);
+
+        if (rest_values > 0) {
+            // The scene's [Nc, 3] block starts with the packed degree's coefficients.
+            const float* rest = f_rest + i * scene_rest * 3;
+            for (int k = 0; k < rest_values; ++k) values[k] = rest[k];
+            AppendWords(values.data(), rest_values, precision, packed.sh);
+        }
+    }
+    packed.visibility.assign((n + 31) / 32, 0u);
+    SetSplatVisibility(packed.visibility, 0, n, true);
+    return packed;
+}
+
+void SetSplatVisibility(std::vector<uint32_t>& mask, int64_t begin, int64_t end, bool visible) {
+    for (int64_t i = begin; i < end; ++i) {
+        const uint32_t bit = 1u << (i & 31);
+        if (visible) {
+            mask[i >> 5] |= bit;
+        } else {
+            mask[i >> 5] &= ~bit;
+        }
+    }
+}
+
+int EvaluatedShDegree(const RenderConfig& config, int packed_sh_degree) {
+    return std::clamp(config.sh_degree, 0, packed_sh_degree);
+}
+
+uint32_t SortKeyTileBits(uint64_t num_tiles) {
+    // ceil(log2(n)) = bit width of n - 1: 4096 tiles (indices 0..4095) need 12 bits.
+    const uint32_t bits =
+        num_tiles <= 1 ? 0u : static_cast<uint32_t>(std::bit_width(num_tiles - 1));
+    return std::clamp(bits, shader::kSortKeyMinTileBits, shader::kSortKeyMaxTileBits);
+}
+
+shader::GaussianViewParams PackGaussianViewParams(const camera::PinholeCamera& camera,
+                                                  const RenderConfig& config,
+                                                  const ViewPackingInputs& inputs) {
+    camera.Validate();
+    const Eigen::Matrix3d r = camera.GetRotation();
+    const Eigen::Vector3d t = camera.GetTranslation();
+    const Eigen::Vector3d center = camera.GetCenter();
+    auto row = [&](int i) {
+        return shader::vec4{float(r(i, 0)), float(r(i, 1)), float(r(i, 2)), float(t(i))};
+    };
+    const cpu::TileGrid grid = cpu::TileGrid::ForImage(camera.width, camera.height);
+    if (grid.tiles_x > 0xFFFF || grid.tiles_y > 0xFFFF) {
+        core::ThrowError("PackGaussianViewParams: {}x{} tiles, at most 65535 per axis",
+                         grid.tiles_x, grid.tiles_y);
+    }
+    // Capacities stay below the scan's saturation value so "saturated" means "over".
+    const uint64_t saturation = shader::kScanSaturation;
+    const uint32_t config_limit =
+        static_cast<uint32_t>(std::min<uint64_t>(config.max_tile_entries_total, saturation - 1));
+    const uint32_t capacity = std::min(config_limit, inputs.entry_capacity);
+    const uint32_t words = inputs.precision == SplatPrecision::kExact ? shader::kShapeWordsExact
+                                                                      : shader::kShapeWordsCompact;
+
+    shader::GaussianViewParams p{};
+    p.world_to_camera_row0 = row(0);
+    p.world_to_camera_row1 = row(1);
+    p.world_to_camera_row2 = row(2);
+    p.camera_center = {float(center.x()), float(center.y()), float(center.z()), 0.0f};
+    p.intrinsics = {float(camera.fx), float(camera.fy), float(camera.cx), float(camera.cy)};
+    p.clip = {float(1.3 * camera.GetTanHalfFovX()), float(1.3 * camera.GetTanHalfFovY()),
+              float(config.near_plane), 0.0f};
+    p.image = {uint32_t(camera.width), uint32_t(camera.height), uint32_t(grid.tiles_x),
+               uint32_t(grid.tiles_y)};
+    p.limits = {capacity, config.max_tiles_per_splat, config_limit,
+                SortKeyTileBits(static_cast<uint64_t>(grid.NumTiles()))};
+    p.scene = {uint32_t(inputs.num_splats),
+               uint32_t(EvaluatedShDegree(config, inputs.packed_sh_degree)),
+               config.antialias ? 1u : 0u, inputs.sh_words_per_splat};
+    p.flags = {inputs.scene_depth_present ? 1u : 0u,
+               inputs.precision == SplatPrecision::kExact ? shader::kPrecisionExact
+                                                          : shader::kPrecisionCompact,
+               words, inputs.entry_capacity};
+    return p;
+}
+
+}  // namespace rendering
+}  // namespace visualization
+}  // namespace open3d

@@ -1,0 +1,90 @@
+// CPU-side packing of what the GPU projection reads (docs/vulkan-stage-a.md): per-splat
+// attribute buffers from a Gaussian splat cloud (once per scene change) and the per-frame
+// GaussianViewParams. No Vulkan here: the layouts are the contract header's, so the CPU,
+// Vulkan and Metal layers all pack the same bytes.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "open3d/camera/PinholeCamera.h"
+#include "open3d/t/geometry/PointCloud.h"
+#include "open3d/visualization/rendering/gaussian_splat/RenderConfig.h"
+#include "shaders/GaussianSplatContract.h"
+
+namespace open3d {
+namespace visualization {
+namespace rendering {
+
+/// How the per-splat attributes are stored on the GPU.
+enum class SplatPrecision {
+    /// fp32 everything (the default; the accuracy target against the CPU reference).
+    kExact,
+    /// fp16 scale, rotation, f_dc and SH; centre and opacity stay fp32 (<= 140 B/splat).
+    kCompact,
+};
+
+/// Per-splat GPU attributes of one cloud, ready to upload. Shapes use splats as rows.
+struct PackedGaussianSplats {
+    SplatPrecision precision = SplatPrecision::kExact;
+    int64_t num_splats = 0;
+    int sh_degree = 0;                   ///< degree packed: min(scene degree, max asked)
+    uint32_t shape_words_per_splat = 0;  ///< kShapeWordsExact / kShapeWordsCompact
+    uint32_t sh_words_per_splat = 0;     ///< 0 at degree 0
+    std::vector<float> positions;        ///< [N, 4]: x, y, z, sigmoid(opacity logit)
+    /// [N, shape words]: scale xyz (linear), unit quaternion wxyz, f_dc rgb; fp32 bits
+    /// (exact) or fp16 pairs, low half first (compact).
+    std::vector<uint32_t> shape;
+    /// [N, sh words]: f_rest as [Nc, 3] (coefficient-major, channel last) for the packed
+    /// degree; fp32 bits or fp16 pairs. Empty at degree 0: nothing to upload or bind.
+    std::vector<uint32_t> sh;
+    std::vector<uint32_t> visibility;  ///< [ceil(N / 32)]: bit i of word i / 32 = splat i shown
+
+    /// Bytes per splat of positions + shape + sh (the visibility mask adds 1/8).
+    uint64_t BytesPerSplat() const;
+};
+
+/// Packs a valid Gaussian splat cloud: the sigmoid is applied to the opacity logits and
+/// quaternions are normalised here (in double, then rounded), SH is cut to
+/// min(scene degree, max_sh_degree). Every splat starts visible. Throws core::Open3DError
+/// for an invalid cloud or more than 2^32 - 1 splats.
+PackedGaussianSplats PackGaussianSplatAttrs(const t::geometry::PointCloud& cloud,
+                                            SplatPrecision precision = SplatPrecision::kExact,
+                                            int max_sh_degree = 3);
+
+/// Sets (visible = true) or clears the bits of splats [begin, end) in a visibility mask.
+void SetSplatVisibility(std::vector<uint32_t>& mask, int64_t begin, int64_t end, bool visible);
+
+/// What the frame's view parameters depend on besides camera and config.
+struct ViewPackingInputs {
+    int64_t num_splats = 0;
+    int packed_sh_degree = 0;  ///< PackedGaussianSplats::sh_degree
+    SplatPrecision precision = SplatPrecision::kExact;
+    uint32_t sh_words_per_splat = 0;
+    uint32_t entry_capacity = 0;       ///< tile entries the caller allocated
+    bool scene_depth_present = false;  ///< a mesh is visible in this view (Stage B)
+};
+
+/// The per-frame view parameters: world-to-camera rows, intrinsics, guard band
+/// 1.3 tan(fov / 2) with tan(fov_x / 2) = W / (2 fx), near plane, image and tile grid,
+/// capacity limits (the entry limit is min(allocation, max_tile_entries_total), kept below
+/// shader::kScanSaturation), tile bits, SH degree evaluated = min(config, packed).
+shader::GaussianViewParams PackGaussianViewParams(const camera::PinholeCamera& camera,
+                                                  const RenderConfig& config,
+                                                  const ViewPackingInputs& inputs);
+
+/// SH degree the shader evaluates: config.sh_degree clamped to [0, packed degree].
+int EvaluatedShDegree(const RenderConfig& config, int packed_sh_degree);
+
+/// Key bits that hold a tile index: ceil(log2(num_tiles)), clamped to
+/// [shader::kSortKeyMinTileBits, shader::kSortKeyMaxTileBits].
+uint32_t SortKeyTileBits(uint64_t num_tiles);
+
+/// IEEE half from float, round to nearest even (overflow to inf, NaN kept).
+uint16_t FloatToHalf(float value);
+/// Float from IEEE half (exact).
+float HalfToFloat(uint16_t half);
+
+}  // namespace rendering
+}  // namespace visualization
+}  // namespace open3d

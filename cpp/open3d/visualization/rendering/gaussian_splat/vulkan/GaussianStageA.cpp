@@ -1,0 +1,235 @@
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/GaussianStageA.h"
+
+#include <algorithm>
+#include <bit>
+
+#include "open3d/core/Exception.h"
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/Commands.h"
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/ComputePipeline.h"
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/EmbeddedShaders.h"
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/VulkanContext.h"
+
+namespace open3d {
+namespace visualization {
+namespace rendering {
+namespace vulkan {
+
+namespace {
+
+using namespace shader;  // the contract's constants and structs
+
+static_assert(offsetof(GaussianStageACounters, emit_dispatch_x) % 4 == 0 &&
+                  offsetof(GaussianStageACounters, scan_levels) % 4 == 0,
+              "indirect dispatch arguments need 4-byte offsets");
+static_assert(offsetof(GaussianScanLevel, dispatch_x) == offsetof(VkDispatchIndirectCommand, x));
+static_assert(sizeof(GaussianViewParams) <= 65536, "vkCmdUpdateBuffer limit");
+
+VkDeviceSize Words(uint64_t n) { return VkDeviceSize(std::max<uint64_t>(n, 1)) * 4; }
+
+uint32_t DivCeil(uint64_t a, uint64_t b) { return static_cast<uint32_t>((a + b - 1) / b); }
+
+// Everything a Stage A dispatch may read next: storage data and indirect arguments.
+void ComputeBarrier(VkCommandBuffer cmd) {
+    RecordMemoryBarrier(
+        cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+        VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT | VK_ACCESS_2_SHADER_STORAGE_READ_BIT,
+        VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_DRAW_INDIRECT_BIT,
+        VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT |
+            VK_ACCESS_2_INDIRECT_COMMAND_READ_BIT);
+}
+
+}  // namespace
+
+GaussianStageA::GaussianStageA(const VulkanContext& context) : context_(context), sort_(context) {
+    set_layout_ = CreateStorageBufferPushLayout(context, kStageANumBindings);
+    const uint32_t push_bytes = static_cast<uint32_t>(
+        std::max(sizeof(GaussianScanPushConstants), sizeof(GaussianDispatchArgsPushConstants)));
+    pipeline_layout_ = CreatePipelineLayout(context, set_layout_.Get(), push_bytes);
+    const VkPipelineLayout layout = pipeline_layout_.Get();
+
+    const uint32_t gather = 1u;
+    const VkSpecializationMapEntry gather_entry{kSpecScanGather, 0, sizeof(uint32_t)};
+    const VkSpecializationInfo gather_info{1, &gather_entry, sizeof(uint32_t), &gather};
+    scan_ = CreateComputePipeline(context, layout, spirv::kGaussianScan, "gaussian_scan");
+    scan_gather_ = CreateComputePipeline(context, layout, spirv::kGaussianScan,
+                                         "gaussian_scan (gather)", &gather_info);
+    dispatch_args_ = CreateComputePipeline(context, layout, spirv::kGaussianDispatchArgs,
+                                           "gaussian_dispatch_args");
+    emit_ = CreateComputePipeline(context, layout, spirv::kGaussianEmit, "gaussian_emit");
+}
+
+StageAStorageRequirements GaussianStageA::GetStorageRequirements(uint32_t num_splats,
+                                                                 uint32_t entry_capacity) {
+    if (num_splats > RadixSort::kMaxCount || entry_capacity > RadixSort::kMaxCount) {
+        core::ThrowError("GaussianStageA: {} splats / {} tile entries exceed the sort limit {}",
+                         num_splats, entry_capacity, RadixSort::kMaxCount);
+    }
+    StageAStorageRequirements r;
+    r.view_params_bytes = sizeof(GaussianViewParams);
+    r.projected_bytes = VkDeviceSize(std::max(num_splats, 1u)) * sizeof(GaussianProjectedSplat);
+    r.counters_bytes = sizeof(GaussianStageACounters);
+    r.depth_keys_bytes = Words(num_splats);
+    r.splat_indices_bytes = Words(num_splats);
+    // Level l holds the counts (then offsets) of level l - 1's blocks; the top level is a
+    // single block. Its data follows the previous level's in one buffer.
+    uint64_t count = std::max(num_splats, 1u);
+    uint64_t words = 0;
+    r.num_scan_levels = 0;
+    while (true) {
+        r.scan_level_base[r.num_scan_levels++] = static_cast<uint32_t>(words);
+        words += count;
+        if (count <= kScanBlockSize) break;
+        count = DivCeil(count, kScanBlockSize);
+    }
+    r.scan_bytes = Words(words);
+    r.entry_keys_bytes = Words(entry_capacity);
+    r.entry_values_bytes = Words(entry_capacity);
+    r.sort = RadixSort::GetStorageRequirements(std::max(num_splats, entry_capacity));
+    return r;
+}
+
+VkPipeline GaussianStageA::GetProjectPipeline(uint32_t sh_degree, bool antialias,
+                                              SplatPrecision precision) {
+    const uint32_t precision_value =
+        precision == SplatPrecision::kExact ? kPrecisionExact : kPrecisionCompact;
+    const uint32_t key = sh_degree | (antialias ? 4u : 0u) | (precision_value << 3);
+    auto it = project_.find(key);
+    if (it != project_.end()) return it->second.Get();
+    const std::array<uint32_t, 3> values{sh_degree, antialias ? 1u : 0u, precision_value};
+    const std::array<VkSpecializationMapEntry, 3> entries{
+        {{kSpecShDegree, 0, 4}, {kSpecAntialias, 4, 4}, {kSpecPrecision, 8, 4}}};
+    const VkSpecializationInfo info{3, entries.data(), sizeof(values), values.data()};
+    UniquePipeline pipeline = CreateComputePipeline(
+        context_, pipeline_layout_.Get(), spirv::kGaussianProject, "gaussian_project", &info);
+    return project_.emplace(key, std::move(pipeline)).first->second.Get();
+}
+
+void GaussianStageA::PushBindings(VkCommandBuffer cmd, const StageASceneBuffers& scene,
+                                  const StageAViewBuffers& buffers) const {
+    const std::array<const BufferRange*, kStageANumBindings> ranges{
+        &buffers.view_params,   &scene.positions,   &scene.shape,        &scene.sh,
+        &scene.visibility,      &buffers.projected, &buffers.counters,   &buffers.depth_keys,
+        &buffers.splat_indices, &buffers.scan,      &buffers.entry_keys, &buffers.entry_values};
+    static_assert(kStageAViewBinding == 0 && kStageAPositionsBinding == 1 &&
+                      kStageAShapeBinding == 2 && kStageAShBinding == 3 &&
+                      kStageAVisibilityBinding == 4 && kStageAProjectedBinding == 5 &&
+                      kStageACountersBinding == 6 && kStageADepthKeysBinding == 7 &&
+                      kStageASplatIndexBinding == 8 && kStageAScanBinding == 9 &&
+                      kStageAEntryKeysBinding == 10 && kStageAEntryValuesBinding == 11,
+                  "ranges above are listed in binding order");
+    std::array<VkDescriptorBufferInfo, kStageANumBindings> infos{};
+    std::array<VkWriteDescriptorSet, kStageANumBindings> writes{};
+    for (uint32_t i = 0; i < kStageANumBindings; ++i) {
+        const BufferRange& range = *ranges[i];
+        if (range.buffer == VK_NULL_HANDLE) {
+            core::ThrowError("GaussianStageA: binding {} has no buffer", i);
+        }
+        infos[i] = {range.buffer, range.offset, range.size};
+        writes[i].sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET;
+        writes[i].dstBinding = i;
+        writes[i].descriptorCount = 1;
+        writes[i].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+        writes[i].pBufferInfo = &infos[i];
+    }
+    context_.GetCmdPushDescriptorSet()(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_layout_.Get(),
+                                       0, kStageANumBindings, writes.data());
+}
+
+void GaussianStageA::Record(VkCommandBuffer cmd, const StageASceneBuffers& scene,
+                            const StageAViewBuffers& buffers, const GaussianViewParams& params) {
+    const uint32_t n = scene.num_splats;
+    const uint32_t capacity = params.flags.w;  // entries allocated
+    if (params.scene.x != n || params.limits.x > capacity) {
+        core::ThrowError(
+            "GaussianStageA: view parameters for {} splats / capacity {} do not "
+            "match the scene ({} splats)",
+            params.scene.x, params.limits.x, n);
+    }
+    const StageAStorageRequirements need = GetStorageRequirements(n, capacity);
+    const VkPipelineLayout layout = pipeline_layout_.Get();
+    const VkBuffer counters = buffers.counters.buffer;
+    const VkDeviceSize counters_offset = buffers.counters.offset;
+    const auto counter_range = [&](uint32_t index) {
+        return BufferRange{counters, counters_offset + 4 * index, 4};
+    };
+
+    // Per-frame inputs, written in the command buffer: no mapped memory, no hidden upload.
+    vkCmdUpdateBuffer(cmd, buffers.view_params.buffer, buffers.view_params.offset, sizeof(params),
+                      &params);
+    vkCmdFillBuffer(cmd, counters, counters_offset, sizeof(GaussianStageACounters), 0u);
+    RecordMemoryBarrier(cmd, VK_PIPELINE_STAGE_2_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                        VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                        VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
+
+    // 1. Project: visible splats -> (depth key, splat index) list, visible_count.
+    PushBindings(cmd, scene, buffers);
+    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE,
+                      GetProjectPipeline(params.scene.y, params.scene.z != 0, scene.precision));
+    if (n > 0) vkCmdDispatch(cmd, DivCeil(n, kProjectWorkgroupSize), 1, 1);
+    ComputeBarrier(cmd);
+
+    // 2. Dispatch sizes of the scan levels and the emit pass from visible_count.
+    GaussianDispatchArgsPushConstants args{};
+    args.mode = kDispatchArgsAfterProject;
+    args.num_levels = need.num_scan_levels;
+    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, dispatch_args_.Get());
+    vkCmdPushConstants(cmd, layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(args), &args);
+    vkCmdDispatch(cmd, 1, 1, 1);
+    ComputeBarrier(cmd);
+
+    // 3. Exact depth order with ties by splat index: the list was appended in subgroup
+    // order, so first sort it by splat index (only the bits an index can have), then
+    // stably by the full 32-bit depth key. Keys and values swap roles between the sorts.
+    const uint32_t index_bits = n <= 1 ? 1u : static_cast<uint32_t>(std::bit_width(n - 1));
+    sort_.Record(cmd, buffers.splat_indices, buffers.depth_keys, buffers.sort_scratch,
+                 counter_range(kCounterVisibleIndex), std::max(n, 1u), index_bits);
+    ComputeBarrier(cmd);
+    sort_.Record(cmd, buffers.depth_keys, buffers.splat_indices, buffers.sort_scratch,
+                 counter_range(kCounterVisibleIndex), std::max(n, 1u), 32);
+    ComputeBarrier(cmd);
+
+    // 4. Exclusive scan of the tile counts in depth order, up the block levels and down.
+    PushBindings(cmd, scene, buffers);  // the sorts bound their own layout
+    GaussianScanPushConstants scan{};
+    const auto scan_level = [&](uint32_t level, bool add) {
+        scan.level = level;
+        scan.base = need.scan_level_base[level];
+        scan.sums_base = level + 1 < need.num_scan_levels ? need.scan_level_base[level + 1] : 0u;
+        scan.add_pass = add ? 1u : 0u;
+        scan.write_total = !add && level + 1 == need.num_scan_levels ? 1u : 0u;
+        vkCmdPushConstants(cmd, layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(scan), &scan);
+        vkCmdDispatchIndirect(cmd, counters,
+                              counters_offset + offsetof(GaussianStageACounters, scan_levels) +
+                                  level * sizeof(GaussianScanLevel));
+        ComputeBarrier(cmd);
+    };
+    for (uint32_t level = 0; level < need.num_scan_levels; ++level) {
+        vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE,
+                          level == 0 ? scan_gather_.Get() : scan_.Get());
+        scan_level(level, false);
+    }
+    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, scan_.Get());
+    for (uint32_t level = need.num_scan_levels - 1; level-- > 0;) scan_level(level, true);
+
+    // 5. How many entries fit (whole splats, front to back) -> entry_count, error flags.
+    args.mode = kDispatchArgsAfterScan;
+    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, dispatch_args_.Get());
+    vkCmdPushConstants(cmd, layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(args), &args);
+    vkCmdDispatch(cmd, 1, 1, 1);
+    ComputeBarrier(cmd);
+
+    // 6. Emit (tile, splat) entries in depth order at the scanned offsets.
+    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, emit_.Get());
+    vkCmdDispatchIndirect(cmd, counters,
+                          counters_offset + offsetof(GaussianStageACounters, emit_dispatch_x));
+    ComputeBarrier(cmd);
+
+    // 7. Stable sort by tile index only: each tile keeps the depth order of step 3.
+    sort_.Record(cmd, buffers.entry_keys, buffers.entry_values, buffers.sort_scratch,
+                 counter_range(kCounterEntriesIndex), std::max(capacity, 1u), params.limits.w);
+}
+
+}  // namespace vulkan
+}  // namespace rendering
+}  // namespace visualization
+}  // namespace open3d

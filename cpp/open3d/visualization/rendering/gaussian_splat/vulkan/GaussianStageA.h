@@ -1,0 +1,123 @@
+// Stage A of the Vulkan pipeline as a recorder (STYLE.md point 6): project the splats,
+// order the visible ones by exact float32 depth (ties by splat index), emit one entry
+// per touched tile in that order and stably sort the entries by tile. The caller
+// allocates from GetStorageRequirements; Record() only records commands (no allocation,
+// no submit). Pass sequence and buffers: docs/vulkan-stage-a.md.
+#pragma once
+
+#include <vulkan/vulkan.h>
+
+#include <array>
+#include <cstdint>
+#include <map>
+
+#include "open3d/visualization/rendering/gaussian_splat/GaussianSplatDataPacking.h"
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/Buffer.h"
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/RadixSort.h"
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/VulkanHandle.h"
+#include "shaders/GaussianSplatContract.h"
+
+namespace open3d {
+namespace visualization {
+namespace rendering {
+namespace vulkan {
+
+class VulkanContext;
+
+/// Bytes of every buffer Stage A needs for up to `num_splats` splats and
+/// `entry_capacity` tile entries. All are storage buffers; `counters` is also read by
+/// indirect dispatches and copied (TRANSFER_SRC / TRANSFER_DST), `view_params` is written
+/// with vkCmdUpdateBuffer (TRANSFER_DST).
+struct StageAStorageRequirements {
+    VkDeviceSize view_params_bytes = 0;    ///< shader::GaussianViewParams
+    VkDeviceSize projected_bytes = 0;      ///< shader::GaussianProjectedSplat [N]
+    VkDeviceSize counters_bytes = 0;       ///< shader::GaussianStageACounters
+    VkDeviceSize depth_keys_bytes = 0;     ///< uint32 [N]
+    VkDeviceSize splat_indices_bytes = 0;  ///< uint32 [N]
+    VkDeviceSize scan_bytes = 0;           ///< uint32 [N + block sums of every level]
+    VkDeviceSize entry_keys_bytes = 0;     ///< uint32 [entry_capacity]
+    VkDeviceSize entry_values_bytes = 0;   ///< uint32 [entry_capacity]
+    /// One scratch set shared by the three sorts (they run one after the other).
+    RadixSortStorageRequirements sort;
+    uint32_t num_scan_levels = 1;  ///< levels of the tile-count scan
+    std::array<uint32_t, shader::kScanMaxLevels> scan_level_base{};  ///< uint offsets
+    VkBufferUsageFlags usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
+    VkBufferUsageFlags counters_usage =
+        VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT |
+        VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
+    VkBufferUsageFlags view_params_usage =
+        VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
+};
+
+/// The packed scene (PackGaussianSplatAttrs) on the GPU.
+struct StageASceneBuffers {
+    BufferRange positions;  ///< vec4 [N]
+    BufferRange shape;      ///< uint32 [N, shape words]
+    /// uint32 [N, sh words]. At SH degree 0 nothing is read from it; any small buffer
+    /// serves (the binding must still name a valid buffer).
+    BufferRange sh;
+    BufferRange visibility;  ///< uint32 [ceil(N / 32)]
+    uint32_t num_splats = 0;
+    int packed_sh_degree = 0;
+    uint32_t sh_words_per_splat = 0;
+    SplatPrecision precision = SplatPrecision::kExact;
+};
+
+/// Per-view buffers, sized from StageAStorageRequirements (offsets aligned to
+/// minStorageBufferOffsetAlignment).
+struct StageAViewBuffers {
+    BufferRange view_params;
+    BufferRange projected;
+    BufferRange counters;
+    BufferRange depth_keys;
+    BufferRange splat_indices;  ///< after Record: visible splats in depth order
+    BufferRange scan;           ///< after Record: first visible_count words = entry offsets
+    BufferRange entry_keys;     ///< after Record: tile index per entry, ascending
+    BufferRange entry_values;   ///< after Record: splat index per entry, front to back
+    RadixSortScratch sort_scratch;
+};
+
+class GaussianStageA {
+public:
+    /// Creates the pipelines that do not depend on the scene (the projection pipelines,
+    /// specialised on SH degree / antialias / precision, are made on first use).
+    explicit GaussianStageA(const VulkanContext& context);
+
+    /// Sizes for up to `num_splats` splats and `entry_capacity` tile entries. Throws
+    /// core::Open3DError when a count exceeds what the sorts support.
+    static StageAStorageRequirements GetStorageRequirements(uint32_t num_splats,
+                                                            uint32_t entry_capacity);
+
+    /// Records Stage A for one view: writes `params` into buffers.view_params, zeroes the
+    /// counters, then project -> dispatch args -> sort visible by splat index, then by
+    /// depth (stable) -> scan tile counts -> dispatch args -> emit entries -> stable sort by
+    /// tile (params.limits.w bits). Every size after the projection comes from GPU-side
+    /// counts. `params` must come from PackGaussianViewParams for this scene and a
+    /// capacity <= the one the buffers were sized for.
+    ///
+    /// Synchronisation: the caller orders earlier uses of these buffers before Record (and
+    /// makes scene uploads visible to compute reads); afterwards all results are
+    /// COMPUTE_SHADER storage writes (the counters also) for the caller to barrier.
+    void Record(VkCommandBuffer cmd, const StageASceneBuffers& scene,
+                const StageAViewBuffers& buffers, const shader::GaussianViewParams& params);
+
+private:
+    VkPipeline GetProjectPipeline(uint32_t sh_degree, bool antialias, SplatPrecision precision);
+    void PushBindings(VkCommandBuffer cmd, const StageASceneBuffers& scene,
+                      const StageAViewBuffers& buffers) const;
+
+    const VulkanContext& context_;
+    RadixSort sort_;
+    UniqueDescriptorSetLayout set_layout_;
+    UniquePipelineLayout pipeline_layout_;
+    UniquePipeline scan_;
+    UniquePipeline scan_gather_;
+    UniquePipeline dispatch_args_;
+    UniquePipeline emit_;
+    std::map<uint32_t, UniquePipeline> project_;  // key: degree | antialias << 2 | precision << 3
+};
+
+}  // namespace vulkan
+}  // namespace rendering
+}  // namespace visualization
+}  // namespace open3d

@@ -1,0 +1,78 @@
+// A small synchronous driver around GaussianStageA for tests, tools and benchmarks: it
+// uploads a packed scene once, then per Run() records Stage A, submits, waits on the
+// fence and reads back the projected splats, the depth-ordered visible list, the sorted
+// tile entries and the counters. Frames of the real backend submit without waiting.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "open3d/camera/PinholeCamera.h"
+#include "open3d/visualization/rendering/gaussian_splat/GaussianSplatDataPacking.h"
+#include "open3d/visualization/rendering/gaussian_splat/RenderConfig.h"
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/Buffer.h"
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/Commands.h"
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/GaussianStageA.h"
+#include "shaders/GaussianSplatContract.h"
+
+namespace open3d {
+namespace visualization {
+namespace rendering {
+namespace vulkan {
+
+/// What one Stage A run produced, copied to the host after the fence.
+struct StageAReadback {
+    shader::GaussianStageACounters counters{};
+    int64_t num_splats = 0;
+    /// [N] (empty unless asked for); only entries of visible splats were written this run (others
+    /// hold stale data).
+    std::vector<shader::GaussianProjectedSplat> projected;
+    /// [visible_count]: splat indices, ascending float32 depth, ties by splat index.
+    std::vector<uint32_t> visible_in_depth_order;
+    /// [entry_count]: tile index per entry, ascending.
+    std::vector<uint32_t> entry_tiles;
+    /// [entry_count]: splat index per entry; front to back within each tile.
+    std::vector<uint32_t> entry_splats;
+    /// Wall-clock time from submit to fence of the Stage A command buffer.
+    double stage_a_ms = 0.0;
+
+    RenderStats ToStats() const;
+};
+
+class GaussianStageARunner {
+public:
+    /// Uploads `packed` and allocates per-view buffers for up to `entry_capacity` tile
+    /// entries. A degree-0 scene gets a 16-byte placeholder for the SH binding.
+    GaussianStageARunner(const VulkanContext& context, const PackedGaussianSplats& packed,
+                         uint32_t entry_capacity);
+
+    /// Replaces the visibility mask ([ceil(N / 32)] words, as in PackedGaussianSplats).
+    void SetVisibility(const std::vector<uint32_t>& mask);
+
+    /// Records, submits and waits for Stage A of one view, then reads everything back.
+    /// Each error flag is logged as a warning the first time this runner (one view) sees it.
+    StageAReadback Run(const camera::PinholeCamera& camera, const RenderConfig& config,
+                       bool read_projected = true);
+
+    /// Bytes of the scene buffers on the GPU (positions + shape + SH + mask).
+    uint64_t GetSceneBytes() const { return scene_bytes_; }
+
+private:
+    Buffer UploadBuffer(const void* data, VkDeviceSize bytes);
+
+    const VulkanContext& context_;
+    CommandPool pool_;
+    GaussianStageA stage_a_;
+    PackedGaussianSplats layout_;  // the packed scene's sizes (attribute vectors emptied)
+    uint32_t entry_capacity_ = 0;
+    uint64_t scene_bytes_ = 0;
+    Buffer positions_, shape_, sh_, visibility_;
+    Buffer view_params_, projected_, counters_, depth_keys_, splat_indices_, scan_;
+    Buffer entry_keys_, entry_values_, keys_alt_, values_alt_, histogram_, sort_params_;
+    uint32_t warned_flags_ = 0;
+};
+
+}  // namespace vulkan
+}  // namespace rendering
+}  // namespace visualization
+}  // namespace open3d

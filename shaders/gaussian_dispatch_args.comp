@@ -1,0 +1,81 @@
+#version 460
+// Stage A indirect sizes from GPU-side counts (no CPU readback between passes).
+// After the projection: the scan levels and the emit pass, from the visible count.
+// After the scan: how many entries fit. Splats emit whole or not at all, front to back, so
+// the emitting splats are a prefix of the depth order: the first splat whose inclusive
+// offset passes the capacity is found by binary search and everything from it is dropped.
+#extension GL_GOOGLE_include_directive : require
+#include "GaussianSplatContract.h"
+
+layout(local_size_x = 1) in;
+
+layout(push_constant, std430) uniform PushConstantsBlock {
+    GaussianDispatchArgsPushConstants pc;
+};
+
+layout(std430, set = 0, binding = kStageAViewBinding) readonly buffer ViewBlock {
+    GaussianViewParams view;
+};
+layout(std430, set = 0, binding = kStageACountersBinding) buffer CountersBlock {
+    GaussianStageACounters counters;
+};
+layout(std430, set = 0, binding = kStageAScanBinding) readonly buffer ScanBlock {
+    uint scan[];
+};
+
+uint DivCeil(uint a, uint b) {
+    return a / b + (a % b == 0u ? 0u : 1u);
+}
+
+void SizeScanAndEmit() {
+    uint visible = counters.visible_count;
+    counters.emit_dispatch_x = DivCeil(visible, kEmitWorkgroupSize);
+    counters.emit_dispatch_y = 1u;
+    counters.emit_dispatch_z = 1u;
+    uint count = visible;
+    for (uint level = 0u; level < kScanMaxLevels; ++level) {
+        uint blocks = DivCeil(count, kScanBlockSize);
+        bool recorded = level < pc.num_levels;
+        counters.scan_levels[level].dispatch_x = recorded ? blocks : 0u;
+        counters.scan_levels[level].dispatch_y = 1u;
+        counters.scan_levels[level].dispatch_z = 1u;
+        counters.scan_levels[level].count = recorded ? count : 0u;
+        count = blocks;
+    }
+}
+
+// Inclusive offset of sorted visible splat k: the next exclusive offset, or the total.
+uint InclusiveOffset(uint k, uint visible, uint total) {
+    return k + 1u < visible ? scan[k + 1u] : total;
+}
+
+void CountFittingEntries() {
+    uint visible = counters.visible_count;
+    uint total = counters.requested_entries;
+    uint capacity = view.limits.x;
+    // Smallest k whose inclusive offset exceeds the capacity (visible when none does).
+    uint lo = 0u, hi = visible;
+    while (lo < hi) {
+        uint mid = lo + (hi - lo) / 2u;
+        if (InclusiveOffset(mid, visible, total) > capacity) {
+            hi = mid;
+        } else {
+            lo = mid + 1u;
+        }
+    }
+    uint entries = lo < visible ? scan[lo] : total;
+    counters.entry_count = entries;
+    uint flags = 0u;
+    if (entries < total) flags |= kErrorEntriesDropped;
+    // The allocation, not RenderConfig::max_tile_entries_total, was the binding limit.
+    if (total > capacity && capacity < view.limits.z) flags |= kErrorCountsClamped;
+    if (flags != 0u) atomicOr(counters.error_flags, flags);
+}
+
+void main() {
+    if (pc.mode == kDispatchArgsAfterProject) {
+        SizeScanAndEmit();
+    } else {
+        CountFittingEntries();
+    }
+}

@@ -1,0 +1,220 @@
+#version 460
+// Stage A, pass 1: one invocation per splat. Exactly the 3DGS rasterizer's preprocess
+// (docs/DESIGN.md section 3, mirrored from cpu/Projection.cpp) in float32: near cull,
+// guard-band clamped Jacobian, +0.3 dilation, optional antialias compensation, det == 0
+// cull, 3-sigma radius with the 0.1 eigenvalue floor, tile rectangle, SH colour. Visible
+// splats write their GaussianProjectedSplat and append (depth key, splat index) to the
+// visible list with one atomicAdd per subgroup.
+#extension GL_GOOGLE_include_directive : require
+#extension GL_KHR_shader_subgroup_basic : require
+#extension GL_KHR_shader_subgroup_arithmetic : require
+#extension GL_KHR_shader_subgroup_ballot : require
+#include "GaussianSplatContract.h"
+
+layout(local_size_x = kProjectWorkgroupSize) in;
+
+// Specialisation: a degree-0 scene never touches the SH binding; antialias off skips the
+// compensation; the precision picks how the shape and SH words decode.
+layout(constant_id = kSpecShDegree) const uint kShDegree = 3u;
+layout(constant_id = kSpecAntialias) const uint kAntialias = 0u;
+layout(constant_id = kSpecPrecision) const uint kPrecision = kPrecisionExact;
+
+layout(std430, set = 0, binding = kStageAViewBinding) readonly buffer ViewBlock {
+    GaussianViewParams view;
+};
+layout(std430, set = 0, binding = kStageAPositionsBinding) readonly buffer PositionsBlock {
+    vec4 positions[];  // xyz, sigmoid(opacity)
+};
+layout(std430, set = 0, binding = kStageAShapeBinding) readonly buffer ShapeBlock {
+    uint shape[];
+};
+layout(std430, set = 0, binding = kStageAShBinding) readonly buffer ShBlock {
+    uint sh[];
+};
+layout(std430, set = 0, binding = kStageAVisibilityBinding) readonly buffer VisibilityBlock {
+    uint visibility[];
+};
+layout(std430, set = 0, binding = kStageAProjectedBinding) writeonly buffer ProjectedBlock {
+    GaussianProjectedSplat projected[];
+};
+layout(std430, set = 0, binding = kStageACountersBinding) buffer CountersBlock {
+    GaussianStageACounters counters;
+};
+layout(std430, set = 0, binding = kStageADepthKeysBinding) writeonly buffer DepthKeysBlock {
+    uint depth_keys[];
+};
+layout(std430, set = 0, binding = kStageASplatIndexBinding) writeonly buffer SplatIndexBlock {
+    uint splat_indices[];
+};
+
+const float kSH_C0 = 0.28209479177387814;
+const float kSH_C1 = 0.4886025119029199;
+const float kSH_C2[5] = float[5](1.0925484305920792, -1.0925484305920792, 0.31539156525252005,
+                                 -1.0925484305920792, 0.5462742152960396);
+const float kSH_C3[7] = float[7](-0.5900435899266435, 2.890611442640554, -0.4570457994644658,
+                                 0.3731763325901154, -0.4570457994644658, 1.445305721320277,
+                                 -0.5900435899266435);
+
+// Halves k and k + 1 of a compact record start at word `base`.
+float HalfAt(uint base, uint k, bool from_sh) {
+    uint word = from_sh ? sh[base + k / 2u] : shape[base + k / 2u];
+    vec2 pair = unpackHalf2x16(word);
+    return (k & 1u) == 0u ? pair.x : pair.y;
+}
+
+// Shape value k (0-2 scale, 3-6 rotation wxyz, 7-9 f_dc) of splat i.
+float ShapeValue(uint i, uint k) {
+    if (kPrecision == kPrecisionCompact) return HalfAt(i * kShapeWordsCompact, k, false);
+    return uintBitsToFloat(shape[i * kShapeWordsExact + k]);
+}
+
+// SH rest coefficient j (1-based basis index), channel c of splat i; layout [Nc, 3].
+float ShValue(uint i, uint j, uint c) {
+    uint k = (j - 1u) * 3u + c;
+    uint base = i * view.scene.w;
+    if (kPrecision == kPrecisionCompact) return HalfAt(base, k, true);
+    return uintBitsToFloat(sh[base + k]);
+}
+
+// R diag(s^2) R^T for a (w, x, y, z) quaternion normalised at packing; the formula is the
+// one Eigen's toRotationMatrix uses, so a zero quaternion gives the identity as on the CPU.
+mat3 Covariance3D(vec3 s, vec4 q) {
+    float tx = 2.0 * q.y, ty = 2.0 * q.z, tz = 2.0 * q.w;
+    float twx = tx * q.x, twy = ty * q.x, twz = tz * q.x;
+    float txx = tx * q.y, txy = ty * q.y, txz = tz * q.y;
+    float tyy = ty * q.z, tyz = tz * q.z, tzz = tz * q.w;
+    // Column-major constructor: r[col][row].
+    mat3 r = mat3(1.0 - (tyy + tzz), txy + twz, txz - twy,  // column 0
+                  txy - twz, 1.0 - (txx + tzz), tyz + twx,  // column 1
+                  txz + twy, tyz - twx, 1.0 - (txx + tyy));  // column 2
+    mat3 m = r * mat3(s.x, 0.0, 0.0, 0.0, s.y, 0.0, 0.0, 0.0, s.z);
+    return m * transpose(m);
+}
+
+vec3 ShColor(uint i, vec3 position) {
+    vec3 dc = vec3(ShapeValue(i, 7u), ShapeValue(i, 8u), ShapeValue(i, 9u));
+    vec3 rgb = kSH_C0 * dc;
+    if (kShDegree >= 1u) {
+        vec3 d = normalize(position - view.camera_center.xyz);
+        float x = d.x, y = d.y, z = d.z;
+        float basis[16];
+        basis[1] = -kSH_C1 * y;
+        basis[2] = kSH_C1 * z;
+        basis[3] = -kSH_C1 * x;
+        if (kShDegree >= 2u) {
+            float xx = x * x, yy = y * y, zz = z * z;
+            float xy = x * y, yz = y * z, xz = x * z;
+            basis[4] = kSH_C2[0] * xy;
+            basis[5] = kSH_C2[1] * yz;
+            basis[6] = kSH_C2[2] * (2.0 * zz - xx - yy);
+            basis[7] = kSH_C2[3] * xz;
+            basis[8] = kSH_C2[4] * (xx - yy);
+            if (kShDegree >= 3u) {
+                basis[9] = kSH_C3[0] * y * (3.0 * xx - yy);
+                basis[10] = kSH_C3[1] * xy * z;
+                basis[11] = kSH_C3[2] * y * (4.0 * zz - xx - yy);
+                basis[12] = kSH_C3[3] * z * (2.0 * zz - 3.0 * xx - 3.0 * yy);
+                basis[13] = kSH_C3[4] * x * (4.0 * zz - xx - yy);
+                basis[14] = kSH_C3[5] * z * (xx - yy);
+                basis[15] = kSH_C3[6] * x * (xx - 3.0 * yy);
+            }
+        }
+        uint num_basis = (kShDegree + 1u) * (kShDegree + 1u);
+        for (uint j = 1u; j < num_basis; ++j) {
+            rgb += basis[j] * vec3(ShValue(i, j, 0u), ShValue(i, j, 1u), ShValue(i, j, 2u));
+        }
+    }
+    return max(vec3(0.0), 0.5 + rgb);
+}
+
+// 3DGS getRect for one bound: (int)(v / 16) clamped to [0, tiles]; the float is clamped
+// before the conversion so huge or non-finite values cannot overflow it.
+uint TileBound(float v, uint tiles) {
+    float t = v / float(kGaussianTileSize);
+    if (!(t > 0.0)) return 0u;
+    return uint(min(t, float(tiles)));
+}
+
+// Returns true (and writes the record) when splat i is visible.
+bool Project(uint i, out float depth) {
+    depth = 0.0;
+    if ((visibility[i >> 5u] & (1u << (i & 31u))) == 0u) return false;
+    vec4 position_opacity = positions[i];
+    vec3 p = position_opacity.xyz;
+    vec3 v = vec3(dot(view.world_to_camera_row0.xyz, p) + view.world_to_camera_row0.w,
+                  dot(view.world_to_camera_row1.xyz, p) + view.world_to_camera_row1.w,
+                  dot(view.world_to_camera_row2.xyz, p) + view.world_to_camera_row2.w);
+    if (!(v.z > view.clip.z)) return false;  // near plane (also NaN)
+    float fx = view.intrinsics.x, fy = view.intrinsics.y;
+    float px = fx * v.x / v.z + view.intrinsics.z;
+    float py = fy * v.y / v.z + view.intrinsics.w;
+
+    // Jacobian at the guard-band clamped position (keeps off-screen footprints bounded).
+    float tx = clamp(v.x / v.z, -view.clip.x, view.clip.x) * v.z;
+    float ty = clamp(v.y / v.z, -view.clip.y, view.clip.y) * v.z;
+    float z2 = v.z * v.z;
+    // Rows of J (2x3) times W (the world-to-camera rotation): T = J W.
+    vec3 w0 = view.world_to_camera_row0.xyz, w1 = view.world_to_camera_row1.xyz,
+         w2 = view.world_to_camera_row2.xyz;
+    vec3 t0 = (fx / v.z) * w0 + (-fx * tx / z2) * w2;
+    vec3 t1 = (fy / v.z) * w1 + (-fy * ty / z2) * w2;
+    vec3 scale = vec3(ShapeValue(i, 0u), ShapeValue(i, 1u), ShapeValue(i, 2u));
+    vec4 rot = vec4(ShapeValue(i, 3u), ShapeValue(i, 4u), ShapeValue(i, 5u), ShapeValue(i, 6u));
+    mat3 sigma = Covariance3D(scale, rot);
+    vec3 s_t0 = sigma * t0, s_t1 = sigma * t1;
+    float cov_a = dot(t0, s_t0), cov_b = dot(t0, s_t1), cov_c = dot(t1, s_t1);
+
+    // Low-pass dilation, conic, antialias factor, 3-sigma radius (ComputeScreenEllipse).
+    float det_raw = cov_a * cov_c - cov_b * cov_b;
+    cov_a += 0.3;
+    cov_c += 0.3;
+    float det = cov_a * cov_c - cov_b * cov_b;
+    if (det == 0.0) return false;
+    float opacity_scale = 1.0;
+    if (kAntialias != 0u) opacity_scale = sqrt(max(0.000025, det_raw / det));
+    vec3 conic = vec3(cov_c / det, -cov_b / det, cov_a / det);
+    float mid = 0.5 * (cov_a + cov_c);
+    float lambda1 = mid + sqrt(max(0.1, mid * mid - det));
+    float lambda2 = mid - sqrt(max(0.1, mid * mid - det));
+    uint radius = uint(ceil(3.0 * sqrt(max(lambda1, lambda2))));
+
+    uint tiles_x = view.image.z, tiles_y = view.image.w;
+    float r = float(radius);
+    uvec2 rect_min = uvec2(TileBound(px - r, tiles_x), TileBound(py - r, tiles_y));
+    uvec2 rect_max = uvec2(TileBound(px + r + float(kGaussianTileSize - 1u), tiles_x),
+                           TileBound(py + r + float(kGaussianTileSize - 1u), tiles_y));
+    uint num_tiles = (rect_max.x - rect_min.x) * (rect_max.y - rect_min.y);
+    if (num_tiles == 0u) return false;
+
+    vec3 color = ShColor(i, p);
+    GaussianProjectedSplat out_splat;
+    out_splat.center_depth_opacity = vec4(px, py, v.z, position_opacity.w * opacity_scale);
+    out_splat.conic = vec4(conic, 0.0);
+    out_splat.color = vec4(color, 0.0);
+    out_splat.tiles = uvec4(rect_min.x | (rect_min.y << 16u), rect_max.x | (rect_max.y << 16u),
+                            num_tiles, radius);
+    projected[i] = out_splat;
+    depth = v.z;
+    return true;
+}
+
+void main() {
+    uint i = gl_GlobalInvocationID.x;
+    float depth = 0.0;
+    bool visible = i < view.scene.x && Project(i, depth);
+
+    // One atomicAdd per subgroup reserves the slots of all its visible splats.
+    uint flag = visible ? 1u : 0u;
+    uint subgroup_count = subgroupAdd(flag);
+    uint rank = subgroupExclusiveAdd(flag);
+    uint base = 0u;
+    if (subgroupElect() && subgroup_count > 0u) {
+        base = atomicAdd(counters.visible_count, subgroup_count);
+    }
+    base = subgroupBroadcastFirst(base);
+    if (visible) {
+        // depth > near plane > 0, so the float bits order like the depths.
+        depth_keys[base + rank] = floatBitsToUint(depth);
+        splat_indices[base + rank] = i;
+    }
+}

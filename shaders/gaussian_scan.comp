@@ -1,0 +1,103 @@
+#version 460
+// Stage A, exclusive prefix sum of the per-splat tile counts in depth order, one level of
+// a block hierarchy (kScanBlockSize counts per workgroup). Scan passes write exclusive
+// offsets in place and each block's total one level up; add passes add the scanned block
+// totals back down. Additions saturate at kScanSaturation (the total of a frame can pass
+// 2^32), and the workgroup scan runs in shared memory by local index, so the result does
+// not depend on the subgroup size or shape. Level 0 with kScanGather reads its counts
+// from the depth-sorted visible list (splats over max_tiles_per_splat count 0 and flag).
+#extension GL_GOOGLE_include_directive : require
+#include "GaussianSplatContract.h"
+
+layout(local_size_x = kScanWorkgroupSize) in;
+
+layout(constant_id = kSpecScanGather) const uint kGather = 0u;
+
+layout(push_constant, std430) uniform PushConstantsBlock {
+    GaussianScanPushConstants pc;
+};
+
+layout(std430, set = 0, binding = kStageAViewBinding) readonly buffer ViewBlock {
+    GaussianViewParams view;
+};
+layout(std430, set = 0, binding = kStageAProjectedBinding) readonly buffer ProjectedBlock {
+    GaussianProjectedSplat projected[];
+};
+layout(std430, set = 0, binding = kStageACountersBinding) buffer CountersBlock {
+    GaussianStageACounters counters;
+};
+layout(std430, set = 0, binding = kStageASplatIndexBinding) readonly buffer SplatIndexBlock {
+    uint splat_indices[];
+};
+layout(std430, set = 0, binding = kStageAScanBinding) buffer ScanBlock {
+    uint scan[];
+};
+
+shared uint s_sums[kScanWorkgroupSize];
+
+uint SatAdd(uint a, uint b) {
+    return min(min(a, kScanSaturation) + min(b, kScanSaturation), kScanSaturation);
+}
+
+uint LoadCount(uint index) {
+    if (kGather == 0u) return scan[pc.base + index];
+    uint count = projected[splat_indices[index]].tiles.z;
+    if (count > view.limits.y) {  // over max_tiles_per_splat: the splat emits nothing
+        atomicOr(counters.error_flags, kErrorEntriesDropped);
+        return 0u;
+    }
+    return count;
+}
+
+void ScanBlockPass(uint count) {
+    uint local = gl_LocalInvocationIndex;
+    uint first = gl_WorkGroupID.x * kScanBlockSize + local * kScanItemsPerInvocation;
+    uint values[kScanItemsPerInvocation];
+    uint sum = 0u;
+    for (uint k = 0u; k < kScanItemsPerInvocation; ++k) {
+        uint index = first + k;
+        uint value = index < count ? LoadCount(index) : 0u;
+        values[k] = sum;  // exclusive within this invocation
+        sum = SatAdd(sum, value);
+    }
+    // Hillis-Steele inclusive scan of the invocation sums, in local-index order.
+    s_sums[local] = sum;
+    barrier();
+    for (uint offset = 1u; offset < kScanWorkgroupSize; offset <<= 1u) {
+        uint other = local >= offset ? s_sums[local - offset] : 0u;
+        barrier();
+        s_sums[local] = SatAdd(s_sums[local], other);
+        barrier();
+    }
+    uint prefix = local > 0u ? s_sums[local - 1u] : 0u;
+    for (uint k = 0u; k < kScanItemsPerInvocation; ++k) {
+        uint index = first + k;
+        if (index < count) scan[pc.base + index] = SatAdd(prefix, values[k]);
+    }
+    if (local == kScanWorkgroupSize - 1u) {
+        uint block_total = s_sums[local];
+        if (pc.write_total != 0u) {
+            counters.requested_entries = block_total;
+        } else {
+            scan[pc.sums_base + gl_WorkGroupID.x] = block_total;
+        }
+    }
+}
+
+void AddBlockPass(uint count) {
+    uint block_offset = scan[pc.sums_base + gl_WorkGroupID.x];
+    uint first = gl_WorkGroupID.x * kScanBlockSize;
+    for (uint k = 0u; k < kScanItemsPerInvocation; ++k) {
+        uint index = first + k * kScanWorkgroupSize + gl_LocalInvocationIndex;
+        if (index < count) scan[pc.base + index] = SatAdd(scan[pc.base + index], block_offset);
+    }
+}
+
+void main() {
+    uint count = counters.scan_levels[pc.level].count;
+    if (pc.add_pass != 0u) {
+        AddBlockPass(count);
+    } else {
+        ScanBlockPass(count);
+    }
+}

@@ -1,0 +1,140 @@
+// CPU-side Stage A pieces: the contract layouts, attribute and view-parameter
+// packing, fp16 conversion and the tile bits of the sort key. No Vulkan device
+// needed.
+#include <gtest/gtest.h>
+
+#include <bit>
+#include <cmath>
+#include <cstddef>
+
+#include "open3d/visualization/rendering/gaussian_splat/GaussianSplatDataPacking.h"
+#include "shaders/GaussianSplatContract.h"
+#include "visualization/rendering/gaussian_splat/cpu/SplatTestScene.h"
+
+namespace open3d {
+namespace tests {
+namespace {
+
+using namespace visualization::rendering;
+namespace shader = visualization::rendering::shader;
+
+TEST(StageAPacking, ContractLayoutsArePinned) {
+    // The same numbers as the static_asserts in the contract header, checked at
+    // run time too so a layout change shows up as a named test failure.
+    EXPECT_EQ(sizeof(shader::GaussianViewParams), 160u);
+    EXPECT_EQ(offsetof(shader::GaussianViewParams, limits), 112u);
+    EXPECT_EQ(sizeof(shader::GaussianProjectedSplat), 64u);
+    EXPECT_EQ(offsetof(shader::GaussianProjectedSplat, tiles), 48u);
+    EXPECT_EQ(sizeof(shader::GaussianStageACounters), 32u + 16u * shader::kScanMaxLevels);
+    EXPECT_EQ(offsetof(shader::GaussianStageACounters, entry_count),
+              4u * shader::kCounterEntriesIndex);
+    EXPECT_EQ(sizeof(shader::GaussianScanPushConstants), 32u);
+    EXPECT_EQ(shader::kGaussianTileSize, static_cast<uint32_t>(kTileSize));
+}
+
+TEST(StageAPacking, SortKeyTileBits) {
+    // Real viewports (16x16 tiles): 1080p 120x68, 4K 240x135, 8K 480x270.
+    EXPECT_EQ(SortKeyTileBits(120 * 68), 13u);   // 8,160 tiles
+    EXPECT_EQ(SortKeyTileBits(240 * 135), 15u);  // 32,400
+    EXPECT_EQ(SortKeyTileBits(480 * 270), 17u);  // 129,600
+    // Exact powers of two: indices 0..2^k - 1 need k bits, one more tile needs k
+    // + 1.
+    for (uint32_t k = 1; k < 31; ++k) {
+        EXPECT_EQ(SortKeyTileBits(uint64_t(1) << k), k) << k;
+        EXPECT_EQ(SortKeyTileBits((uint64_t(1) << k) + 1), k + 1) << k;
+    }
+    EXPECT_EQ(SortKeyTileBits(1), shader::kSortKeyMinTileBits);  // clamped up to 1
+    EXPECT_EQ(SortKeyTileBits(uint64_t(1) << 40), shader::kSortKeyMaxTileBits);
+}
+
+TEST(StageAPacking, HalfConversion) {
+    for (float v : {0.0f, 1.0f, -2.5f, 65504.0f, 6.1035156e-05f, 5.9604645e-08f, 0.1f}) {
+        const float back = HalfToFloat(FloatToHalf(v));
+        EXPECT_NEAR(back, v, std::abs(v) * 1e-3 + 1e-8) << v;
+    }
+    EXPECT_EQ(FloatToHalf(1.0f), 0x3C00u);
+    EXPECT_EQ(FloatToHalf(-2.0f), 0xC000u);
+    EXPECT_EQ(FloatToHalf(1e6f), 0x7C00u);                   // overflow to inf
+    EXPECT_EQ(FloatToHalf(1.0f + 1.0f / 2048.0f), 0x3C00u);  // tie to even (down)
+    EXPECT_EQ(FloatToHalf(1.0f + 3.0f / 2048.0f), 0x3C02u);  // tie to even (up)
+    EXPECT_TRUE(std::isnan(HalfToFloat(FloatToHalf(std::nanf("")))));
+    // Every half survives a round trip through float exactly.
+    for (uint32_t h = 0; h < 0x10000u; ++h) {
+        if ((h & 0x7C00u) == 0x7C00u && (h & 0x3FFu)) continue;  // NaN payloads
+        ASSERT_EQ(FloatToHalf(HalfToFloat(uint16_t(h))), h) << h;
+    }
+}
+
+TEST(StageAPacking, ExactAttributes) {
+    TestSplat s;
+    s.position = {1, 2, 3};
+    s.scale = {0.1, 0.2, 0.3};
+    s.rot = {2, 0, 0, 0};  // not normalised: packing normalises
+    s.opacity = 0.25;
+    s.f_rest.resize(15 * 3);
+    for (size_t k = 0; k < s.f_rest.size(); ++k) s.f_rest[k] = 0.01 * double(k);
+    const auto cloud = MakeCloud({s, s}, 3);
+    const PackedGaussianSplats p = PackGaussianSplatAttrs(cloud);
+    ASSERT_EQ(p.num_splats, 2);
+    EXPECT_EQ(p.sh_degree, 3);
+    EXPECT_EQ(p.shape_words_per_splat, shader::kShapeWordsExact);
+    EXPECT_EQ(p.sh_words_per_splat, 45u);
+    EXPECT_EQ(p.BytesPerSplat(), 16u + 40u + 180u);
+    EXPECT_FLOAT_EQ(p.positions[2], 3.0f);
+    EXPECT_FLOAT_EQ(p.positions[3],
+                    float(StoredOpacity(0.25)));  // sigmoid applied
+    const auto word = [&](size_t k) { return std::bit_cast<float>(p.shape[k]); };
+    EXPECT_FLOAT_EQ(word(1), 0.2f);
+    EXPECT_FLOAT_EQ(word(3), 1.0f);  // w of the normalised quaternion
+    EXPECT_FLOAT_EQ(word(4), 0.0f);
+    // SH: [Nc, 3] coefficient-major, channel last, as in the cloud.
+    EXPECT_FLOAT_EQ(std::bit_cast<float>(p.sh[45 + 4]), float(0.04));
+    EXPECT_EQ(p.visibility, std::vector<uint32_t>{0x3u});
+    // Cut to degree 1: only the first 3 coefficients per channel.
+    const PackedGaussianSplats d1 = PackGaussianSplatAttrs(cloud, SplatPrecision::kExact, 1);
+    EXPECT_EQ(d1.sh_words_per_splat, 9u);
+    EXPECT_FLOAT_EQ(std::bit_cast<float>(d1.sh[9 + 8]), float(0.08));
+}
+
+TEST(StageAPacking, CompactAttributesFitTheBudget) {
+    TestSplat s;
+    s.f_rest.assign(45, 0.5);
+    const PackedGaussianSplats p =
+        PackGaussianSplatAttrs(MakeCloud({s}, 3), SplatPrecision::kCompact);
+    EXPECT_EQ(p.shape_words_per_splat, shader::kShapeWordsCompact);
+    EXPECT_EQ(p.sh_words_per_splat, 23u);  // 45 halves, padded to a word
+    EXPECT_LE(p.BytesPerSplat(), 140u);
+    EXPECT_EQ(p.BytesPerSplat(), 16u + 20u + 92u);
+    EXPECT_FLOAT_EQ(HalfToFloat(uint16_t(p.sh[0] & 0xFFFF)), 0.5f);
+}
+
+TEST(StageAPacking, ViewParams) {
+    const auto cam = MakeTestCamera(100, 75);  // fx = fy = 100, principal point (32, 32)
+    RenderConfig config;
+    config.sh_degree = 2;
+    config.antialias = true;
+    ViewPackingInputs inputs;
+    inputs.num_splats = 7;
+    inputs.packed_sh_degree = 3;
+    inputs.entry_capacity = 1000;
+    const shader::GaussianViewParams v = PackGaussianViewParams(cam, config, inputs);
+    EXPECT_FLOAT_EQ(v.clip.x, float(1.3 * 100 / 200.0));  // 1.3 tan(fov_x / 2) = 1.3 W / 2 fx
+    EXPECT_FLOAT_EQ(v.clip.y, float(1.3 * 75 / 200.0));
+    EXPECT_FLOAT_EQ(v.clip.z, 0.2f);
+    EXPECT_EQ(v.image.z, 7u);  // ceil(100 / 16)
+    EXPECT_EQ(v.image.w, 5u);  // ceil(75 / 16)
+    EXPECT_EQ(v.limits.x,
+              1000u);  // the allocation is below max_tile_entries_total
+    EXPECT_EQ(v.limits.z, uint32_t(config.max_tile_entries_total));
+    EXPECT_EQ(v.limits.w, SortKeyTileBits(35));
+    EXPECT_EQ(v.scene.x, 7u);
+    EXPECT_EQ(v.scene.y, 2u);  // min(config 2, packed 3)
+    EXPECT_EQ(v.scene.z, 1u);
+    config.max_tile_entries_total = uint64_t(1) << 40;  // clamped below the scan saturation
+    inputs.entry_capacity = 0xFFFFFFFFu;
+    EXPECT_LT(PackGaussianViewParams(cam, config, inputs).limits.x, shader::kScanSaturation);
+}
+
+}  // namespace
+}  // namespace tests
+}  // namespace open3d
