@@ -128,6 +128,8 @@ static_assert(offsetof(RadixSortPushConstants, max_count) == 12);
 #define OPEN3D_SHADERS_GAUSSIAN_SPLAT_CONTRACT_PROJECTION_H
 
 #ifdef __cplusplus
+#include <bit>
+
 namespace open3d {
 namespace visualization {
 namespace rendering {
@@ -166,6 +168,11 @@ OPEN3D_SHADER_CONST uint kSpecAntialias = 1u;  // 0 / 1
 OPEN3D_SHADER_CONST uint kSpecPrecision = 2u;  // kPrecisionExact / kPrecisionCompact
 // Specialisation constant of gaussian_scan.comp: level 0 gathers the tile counts.
 OPEN3D_SHADER_CONST uint kSpecScanGather = 0u;
+// Specialisation constant of gaussian_emit.comp: what the pass writes into the entry keys.
+OPEN3D_SHADER_CONST uint kSpecEmitMode = 0u;
+OPEN3D_SHADER_CONST uint kEmitTileKeys = 0u;    // exact order: key = tile index
+OPEN3D_SHADER_CONST uint kEmitPackedKeys = 1u;  // packed option: key = PackedSortKey(...)
+OPEN3D_SHADER_CONST uint kEmitUnpackKeys = 2u;  // after the packed sort: key >>= depth bits
 
 // Descriptor set 0 of every Stage A projection pipeline (one push-descriptor layout; each
 // shader declares only the bindings it uses).
@@ -195,7 +202,8 @@ struct GaussianViewParams {
     vec4 world_to_camera_row2;
     vec4 camera_center;  // xyz: camera centre in world space (SH view direction)
     vec4 intrinsics;     // fx, fy, cx, cy (pixels)
-    vec4 clip;           // guard band 1.3 tan(fov_x / 2), 1.3 tan(fov_y / 2), near plane, 0
+    vec4 clip;           // guard band 1.3 tan(fov_x / 2), 1.3 tan(fov_y / 2), near plane,
+                         // packed-key depth scale 1 / (far - near); 0 = exact depth order
     uvec4 image;         // width, height, tiles_x, tiles_y
     uvec4 limits;        // entry capacity used (<= allocated), max_tiles_per_splat,
                          // max_tile_entries_total (clamped below 2^31), tile_bits
@@ -257,6 +265,36 @@ struct GaussianScanPushConstants {
     uint reserved2;
 };
 
+// The seed's packed 32-bit sort key (RenderConfig::sort_mode == kPackedKey32), shared by
+// gaussian_emit.comp and the C++ tests so both compute the same bits.
+#ifdef __cplusplus
+#define OPEN3D_SHADER_FUNC inline
+#define OPEN3D_SHADER_PRECISE
+inline uint floatBitsToUint(float value) { return std::bit_cast<uint>(value); }
+#else
+#define OPEN3D_SHADER_FUNC
+#define OPEN3D_SHADER_PRECISE precise
+#endif
+
+// Normalised depth (z - near) / (far - near) clamped to [0, 1] (NaN -> 0), computed as
+// (z - near) * scale with scale = GaussianViewParams::clip.w. A subtraction and a
+// multiplication are correctly rounded in Vulkan and C++ alike, and `precise` forbids the
+// driver to fuse or reorder them, so the host reproduces the GPU's keys bit for bit.
+OPEN3D_SHADER_FUNC float PackedSortKeyDepth(float z, float near_plane, float scale) {
+    OPEN3D_SHADER_PRECISE float d = (z - near_plane) * scale;
+    return d > 1.0f ? 1.0f : (d > 0.0f ? d : 0.0f);
+}
+
+// (tile << D) | ((floatBitsToUint(norm_depth) << 1) >> T), T = tile_bits in [1, 31],
+// D = 32 - T: the sign bit (always 0) is dropped and the top D of the remaining 31 bits
+// (8 exponent, D - 8 mantissa) are kept, so keys ascend with (tile, truncated depth).
+OPEN3D_SHADER_FUNC uint PackedSortKey(uint tile, float norm_depth, uint tile_bits) {
+    uint depth_field = (floatBitsToUint(norm_depth) << 1u) >> tile_bits;
+    return (tile << (kSortKeyBits - tile_bits)) | depth_field;
+}
+#undef OPEN3D_SHADER_FUNC
+#undef OPEN3D_SHADER_PRECISE
+
 #ifdef __cplusplus
 static_assert(kScanBlockSize == kScanWorkgroupSize * kScanItemsPerInvocation);
 static_assert(kCounterVisibleIndex * 4 == 0 && kCounterEntriesIndex * 4 == 8);
@@ -301,3 +339,4 @@ static_assert(offsetof(GaussianScanPushConstants, write_total) == 16);
 
 #undef OPEN3D_SHADER_CONST
 #endif  // OPEN3D_SHADERS_GAUSSIAN_SPLAT_CONTRACT_PROJECTION_H
+

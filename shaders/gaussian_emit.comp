@@ -1,12 +1,18 @@
 #version 460
-// Stage A, tile entries: one invocation per visible splat in depth order writes
-// (tile index, splat index) for every tile of its rectangle at its scanned offset. A
-// splat whose entries would pass the capacity writes none (the dispatch-args pass has
-// flagged it). Entries leave here in depth order; a stable sort by tile keeps that order.
+// Stage A, tile entries: one invocation per visible splat in list order writes
+// (key, splat index) for every tile of its rectangle at its scanned offset. A splat whose
+// entries would pass the capacity writes none (the dispatch-args pass has flagged it).
+// Exact order (kEmitTileKeys): the list is in depth order and the key is the tile index;
+// a stable sort by tile keeps that order. Packed option (kEmitPackedKeys): the list is in
+// the projection's append order and the key is the seed's packed (tile, truncated depth)
+// key, sorted on all 32 bits; kEmitUnpackKeys then turns the sorted keys back into tile
+// indices, so later stages read the same layout in both modes.
 #extension GL_GOOGLE_include_directive : require
 #include "GaussianSplatContract.h"
 
 layout(local_size_x = kEmitWorkgroupSize) in;
+
+layout(constant_id = kSpecEmitMode) const uint kEmitMode = kEmitTileKeys;
 
 layout(std430, set = 0, binding = kStageAViewBinding) readonly buffer ViewBlock {
     GaussianViewParams view;
@@ -23,14 +29,29 @@ layout(std430, set = 0, binding = kStageASplatIndexBinding) readonly buffer Spla
 layout(std430, set = 0, binding = kStageAScanBinding) readonly buffer ScanBlock {
     uint scan[];
 };
-layout(std430, set = 0, binding = kStageAEntryKeysBinding) writeonly buffer EntryKeysBlock {
+layout(std430, set = 0, binding = kStageAEntryKeysBinding) buffer EntryKeysBlock {
     uint entry_keys[];
 };
 layout(std430, set = 0, binding = kStageAEntryValuesBinding) writeonly buffer EntryValuesBlock {
     uint entry_values[];
 };
 
+// Sorted packed keys -> tile indices. Dispatched with the emit pass's indirect size (one
+// invocation per visible splat, rounded up), so it strides over the entries.
+void UnpackKeys() {
+    uint depth_bits = kSortKeyBits - view.limits.w;
+    uint count = counters.entry_count;
+    uint stride = gl_NumWorkGroups.x * kEmitWorkgroupSize;
+    for (uint i = gl_GlobalInvocationID.x; i < count; i += stride) {
+        entry_keys[i] = entry_keys[i] >> depth_bits;
+    }
+}
+
 void main() {
+    if (kEmitMode == kEmitUnpackKeys) {
+        UnpackKeys();
+        return;
+    }
     uint k = gl_GlobalInvocationID.x;
     uint visible = counters.visible_count;
     if (k >= visible) return;
@@ -42,10 +63,18 @@ void main() {
     uint min_x = tiles.x & 0xFFFFu, min_y = tiles.x >> 16u;
     uint max_x = tiles.y & 0xFFFFu, max_y = tiles.y >> 16u;
     uint tiles_x = view.image.z;
+    // The same float32 view depth the exact order sorts by (the projection's output).
+    float norm_depth = kEmitMode == kEmitPackedKeys
+                           ? PackedSortKeyDepth(projected[splat].center_depth_opacity.z,
+                                                view.clip.z, view.clip.w)
+                           : 0.0;
+    uint tile_bits = view.limits.w;
     uint out_index = begin;
     for (uint ty = min_y; ty < max_y; ++ty) {
         for (uint tx = min_x; tx < max_x; ++tx) {
-            entry_keys[out_index] = ty * tiles_x + tx;
+            uint tile = ty * tiles_x + tx;
+            entry_keys[out_index] =
+                kEmitMode == kEmitPackedKeys ? PackedSortKey(tile, norm_depth, tile_bits) : tile;
             entry_values[out_index] = splat;
             ++out_index;
         }

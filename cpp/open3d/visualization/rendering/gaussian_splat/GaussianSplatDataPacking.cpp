@@ -123,6 +123,9 @@ PackedGaussianSplats PackGaussianSplatAttrs(const t::geometry::PointCloud& cloud
     std::vector<double> values(std::max(10, rest_values));
     for (int64_t i = 0; i < n; ++i) {
         for (int c = 0; c < 3; ++c) packed.positions.push_back(positions[3 * i + c]);
+        const Eigen::Vector3d center(positions[3 * i], positions[3 * i + 1], positions[3 * i + 2]);
+        packed.center_min = packed.center_min.cwiseMin(center);
+        packed.center_max = packed.center_max.cwiseMax(center);
         // The sigmoid in double, rounded once: within half an ulp of the reference's value.
         const double logit = opacities[i];
         packed.positions.push_back(static_cast<float>(1.0 / (1.0 + std::exp(-logit))));
@@ -171,6 +174,25 @@ uint32_t SortKeyTileBits(uint64_t num_tiles) {
     return std::clamp(bits, shader::kSortKeyMinTileBits, shader::kSortKeyMaxTileBits);
 }
 
+double PackedSortKeyFar(const camera::PinholeCamera& camera, double near_plane,
+                        const Eigen::Vector3d& center_min, const Eigen::Vector3d& center_max) {
+    const Eigen::Matrix3d r = camera.GetRotation();
+    const double t_z = camera.GetTranslation().z();
+    double far = -std::numeric_limits<double>::infinity();
+    if ((center_min.array() <= center_max.array()).all()) {
+        for (int corner = 0; corner < 8; ++corner) {
+            const Eigen::Vector3d p((corner & 1) ? center_max.x() : center_min.x(),
+                                    (corner & 2) ? center_max.y() : center_min.y(),
+                                    (corner & 4) ? center_max.z() : center_min.z());
+            far = std::max(far, r.row(2).dot(p) + t_z);
+        }
+    }
+    // Nothing can be visible then; any far > near keeps the scale finite and positive.
+    return std::isfinite(far) && far > near_plane ? far : near_plane + 1.0;
+}
+
+bool UsesPackedSortKey(const shader::GaussianViewParams& params) { return params.clip.w > 0.0f; }
+
 shader::GaussianViewParams PackGaussianViewParams(const camera::PinholeCamera& camera,
                                                   const RenderConfig& config,
                                                   const ViewPackingInputs& inputs) {
@@ -200,8 +222,16 @@ shader::GaussianViewParams PackGaussianViewParams(const camera::PinholeCamera& c
     p.world_to_camera_row2 = row(2);
     p.camera_center = {float(center.x()), float(center.y()), float(center.z()), 0.0f};
     p.intrinsics = {float(camera.fx), float(camera.fy), float(camera.cx), float(camera.cy)};
+    // clip.w > 0 selects the packed key: its depth scale, kept finite for a tiny range.
+    float depth_scale = 0.0f;
+    if (config.sort_mode == SortMode::kPackedKey32) {
+        const double far =
+            PackedSortKeyFar(camera, config.near_plane, inputs.center_min, inputs.center_max);
+        depth_scale = static_cast<float>(
+            std::min<double>(1.0 / (far - config.near_plane), std::numeric_limits<float>::max()));
+    }
     p.clip = {float(1.3 * camera.GetTanHalfFovX()), float(1.3 * camera.GetTanHalfFovY()),
-              float(config.near_plane), 0.0f};
+              float(config.near_plane), depth_scale};
     p.image = {uint32_t(camera.width), uint32_t(camera.height), uint32_t(grid.tiles_x),
                uint32_t(grid.tiles_y)};
     p.limits = {capacity, config.max_tiles_per_splat, config_limit,

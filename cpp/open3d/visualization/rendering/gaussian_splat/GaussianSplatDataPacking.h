@@ -4,7 +4,9 @@
 // Vulkan and Metal layers all pack the same bytes.
 #pragma once
 
+#include <Eigen/Core>
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 #include "open3d/camera/PinholeCamera.h"
@@ -39,6 +41,10 @@ struct PackedGaussianSplats {
     /// degree; fp32 bits or fp16 pairs. Empty at degree 0: nothing to upload or bind.
     std::vector<uint32_t> sh;
     std::vector<uint32_t> visibility;  ///< [ceil(N / 32)]: bit i of word i / 32 = splat i shown
+    /// Axis-aligned box of the splat centres (min > max when there are none): bounds the
+    /// view depth of every splat for the packed sort key's far plane.
+    Eigen::Vector3d center_min = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+    Eigen::Vector3d center_max = -center_min;
 
     /// Bytes per splat of positions + shape + sh (the visibility mask adds 1/8).
     uint64_t BytesPerSplat() const;
@@ -63,12 +69,18 @@ struct ViewPackingInputs {
     uint32_t sh_words_per_splat = 0;
     uint32_t entry_capacity = 0;       ///< tile entries the caller allocated
     bool scene_depth_present = false;  ///< a mesh is visible in this view (Stage B)
+    /// PackedGaussianSplats::center_min / center_max; only RenderConfig::sort_mode ==
+    /// kPackedKey32 reads them (PackedSortKeyFar).
+    Eigen::Vector3d center_min = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+    Eigen::Vector3d center_max = -center_min;
 };
 
 /// The per-frame view parameters: world-to-camera rows, intrinsics, guard band
 /// 1.3 tan(fov / 2) with tan(fov_x / 2) = W / (2 fx), near plane, image and tile grid,
 /// capacity limits (the entry limit is min(allocation, max_tile_entries_total), kept below
 /// shader::kScanSaturation), tile bits, SH degree evaluated = min(config, packed).
+/// config.sort_mode == kPackedKey32 sets clip.w = 1 / (far - near) with far from
+/// PackedSortKeyFar (a positive value selects the packed key); kExact leaves clip.w = 0.
 shader::GaussianViewParams PackGaussianViewParams(const camera::PinholeCamera& camera,
                                                   const RenderConfig& config,
                                                   const ViewPackingInputs& inputs);
@@ -79,6 +91,16 @@ int EvaluatedShDegree(const RenderConfig& config, int packed_sh_degree);
 /// Key bits that hold a tile index: ceil(log2(num_tiles)), clamped to
 /// [shader::kSortKeyMinTileBits, shader::kSortKeyMaxTileBits].
 uint32_t SortKeyTileBits(uint64_t num_tiles);
+
+/// Far plane of the packed key's depth normalisation: the largest view depth of the eight
+/// corners of the centre box [center_min, center_max], so no splat centre lies beyond it
+/// (the exact largest visible depth would need a GPU readback or a pass over all splats
+/// per frame). near_plane + 1 when the box is empty or wholly behind the near plane.
+double PackedSortKeyFar(const camera::PinholeCamera& camera, double near_plane,
+                        const Eigen::Vector3d& center_min, const Eigen::Vector3d& center_max);
+
+/// True when `params` select the packed 32-bit key (clip.w > 0), false for exact order.
+bool UsesPackedSortKey(const shader::GaussianViewParams& params);
 
 /// IEEE half from float, round to nearest even (overflow to inf, NaN kept).
 uint16_t FloatToHalf(float value);

@@ -12,6 +12,17 @@ namespace rendering {
 /// Side of the square screen tiles (pixels), as in the 3DGS rasterizer (BLOCK_X = BLOCK_Y).
 inline constexpr int kTileSize = 16;
 
+/// Depth order of each tile's splats (GPU backends; the CPU reference is always exact).
+enum class SortMode {
+    /// Exact float32 view depth, ties by splat index: the reference's order.
+    kExact,
+    /// The seed's single 32-bit key per entry: tile index in the top ceil(log2(tiles)) bits,
+    /// the truncated bits of the normalised depth below, ties in the projection's
+    /// (nondeterministic) append order. Only 7-11 mantissa bits of depth at 1080p-8K, so
+    /// near splats can swap: a measured option (docs/vulkan.md, "Packed 32-bit key option").
+    kPackedKey32,
+};
+
 struct RenderConfig {
     /// Splats with view-space z <= near_plane are culled (3DGS: 0.2).
     double near_plane = 0.2;
@@ -26,6 +37,15 @@ struct RenderConfig {
     uint32_t max_tiles_per_splat = 1u << 16;
     /// Entries beyond this total are dropped, farthest splats first (flag kEntriesDropped).
     uint64_t max_tile_entries_total = 1ull << 26;
+    /// Exact depth order (default) or the seed's packed 32-bit key; see SortMode.
+    SortMode sort_mode = SortMode::kExact;
+    /// GPU storage of the splat attributes: false = `exact` (fp32 where it matters), true =
+    /// `compact` (fp16 scale, rotation, colour and SH; <= 140 B/splat at SH degree 3). GPU
+    /// backends re-upload the scene when it changes; the CPU reference ignores it.
+    bool compact_storage = false;
+    /// GPU backends skip Stage A when the scene, the camera and this config are unchanged
+    /// since the last frame; benchmarks turn it off to time the whole pipeline every frame.
+    bool reuse_geometry = true;
 };
 
 /// Bits of RenderStats::error_flags (the same bits the GPU backends read back).
@@ -40,6 +60,15 @@ struct RenderStats {
     uint32_t error_flags = 0;      ///< kEntriesDropped | kCountsClamped
     double geometry_ms = 0.0;      ///< project + tile entries + sort
     double composite_ms = 0.0;
+    /// GPU time per pass from timestamp queries (GPU backends only; 0 where not measured).
+    double gpu_project_ms = 0.0;    ///< projection (+ dispatch arguments)
+    double gpu_sort_ms = 0.0;       ///< depth sort, scan, emission and tile sort
+    double gpu_composite_ms = 0.0;  ///< Stage B composite
+    double gpu_merge_ms = 0.0;      ///< depth merge (offscreen depth readback only)
+    /// Bytes the backend keeps on the GPU for the scene between frames (0 for the CPU).
+    int64_t gpu_scene_bytes = 0;
+    /// True when Stage A was reused because neither the scene nor the view changed.
+    bool geometry_reused = false;
 };
 
 }  // namespace rendering

@@ -56,6 +56,15 @@ GaussianStageA::GaussianStageA(const VulkanContext& context) : context_(context)
     dispatch_args_ = CreateComputePipeline(context, layout, spirv::kGaussianDispatchArgs,
                                            "gaussian_dispatch_args");
     emit_ = CreateComputePipeline(context, layout, spirv::kGaussianEmit, "gaussian_emit");
+    const VkSpecializationMapEntry emit_entry{kSpecEmitMode, 0, sizeof(uint32_t)};
+    const uint32_t packed_mode = kEmitPackedKeys;
+    const uint32_t unpack_mode = kEmitUnpackKeys;
+    const VkSpecializationInfo packed_info{1, &emit_entry, sizeof(uint32_t), &packed_mode};
+    const VkSpecializationInfo unpack_info{1, &emit_entry, sizeof(uint32_t), &unpack_mode};
+    emit_packed_ = CreateComputePipeline(context, layout, spirv::kGaussianEmit,
+                                         "gaussian_emit (packed keys)", &packed_info);
+    unpack_keys_ = CreateComputePipeline(context, layout, spirv::kGaussianEmit,
+                                         "gaussian_emit (unpack keys)", &unpack_info);
 }
 
 StageAStorageRequirements GaussianStageA::GetStorageRequirements(uint32_t num_splats,
@@ -139,6 +148,7 @@ void GaussianStageA::Record(VkCommandBuffer cmd, const StageASceneBuffers& scene
                             const StageAViewBuffers& buffers, const GaussianViewParams& params) {
     const uint32_t n = scene.num_splats;
     const uint32_t capacity = params.flags.w;  // entries allocated
+    const bool packed_key = UsesPackedSortKey(params);
     if (params.scene.x != n || params.limits.x > capacity) {
         core::ThrowError(
             "GaussianStageA: view parameters for {} splats / capacity {} do not "
@@ -180,13 +190,17 @@ void GaussianStageA::Record(VkCommandBuffer cmd, const StageASceneBuffers& scene
     // 3. Exact depth order with ties by splat index: the list was appended in subgroup
     // order, so first sort it by splat index (only the bits an index can have), then
     // stably by the full 32-bit depth key. Keys and values swap roles between the sorts.
-    const uint32_t index_bits = n <= 1 ? 1u : static_cast<uint32_t>(std::bit_width(n - 1));
-    sort_.Record(cmd, buffers.splat_indices, buffers.depth_keys, buffers.sort_scratch,
-                 counter_range(kCounterVisibleIndex), std::max(n, 1u), index_bits);
-    ComputeBarrier(cmd);
-    sort_.Record(cmd, buffers.depth_keys, buffers.splat_indices, buffers.sort_scratch,
-                 counter_range(kCounterVisibleIndex), std::max(n, 1u), 32);
-    ComputeBarrier(cmd);
+    // The packed key, like the seed, keeps the append order: its one entry sort decides
+    // the depth order, and measuring its error means not helping it here.
+    if (!packed_key) {
+        const uint32_t index_bits = n <= 1 ? 1u : static_cast<uint32_t>(std::bit_width(n - 1));
+        sort_.Record(cmd, buffers.splat_indices, buffers.depth_keys, buffers.sort_scratch,
+                     counter_range(kCounterVisibleIndex), std::max(n, 1u), index_bits);
+        ComputeBarrier(cmd);
+        sort_.Record(cmd, buffers.depth_keys, buffers.splat_indices, buffers.sort_scratch,
+                     counter_range(kCounterVisibleIndex), std::max(n, 1u), 32);
+        ComputeBarrier(cmd);
+    }
 
     // 4. Exclusive scan of the tile counts in depth order, up the block levels and down.
     PushBindings(cmd, scene, buffers);  // the sorts bound their own layout
@@ -218,15 +232,26 @@ void GaussianStageA::Record(VkCommandBuffer cmd, const StageASceneBuffers& scene
     vkCmdDispatch(cmd, 1, 1, 1);
     ComputeBarrier(cmd);
 
-    // 6. Emit (tile, splat) entries in depth order at the scanned offsets.
-    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, emit_.Get());
-    vkCmdDispatchIndirect(cmd, counters,
-                          counters_offset + offsetof(GaussianStageACounters, emit_dispatch_x));
+    // 6. Emit (tile, splat) entries in list order at the scanned offsets: tile keys in
+    // depth order, or packed (tile, truncated depth) keys.
+    const VkDeviceSize emit_args =
+        counters_offset + offsetof(GaussianStageACounters, emit_dispatch_x);
+    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE,
+                      packed_key ? emit_packed_.Get() : emit_.Get());
+    vkCmdDispatchIndirect(cmd, counters, emit_args);
     ComputeBarrier(cmd);
 
-    // 7. Stable sort by tile index only: each tile keeps the depth order of step 3.
+    // 7. Stable sort by tile index only: each tile keeps the depth order of step 3. The
+    // packed key sorts all 32 bits (4 passes, as the seed), then shifts back to tiles.
     sort_.Record(cmd, buffers.entry_keys, buffers.entry_values, buffers.sort_scratch,
-                 counter_range(kCounterEntriesIndex), std::max(capacity, 1u), params.limits.w);
+                 counter_range(kCounterEntriesIndex), std::max(capacity, 1u),
+                 packed_key ? kSortKeyBits : params.limits.w);
+    if (packed_key) {
+        ComputeBarrier(cmd);
+        PushBindings(cmd, scene, buffers);  // the sort bound its own layout
+        vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, unpack_keys_.Get());
+        vkCmdDispatchIndirect(cmd, counters, emit_args);
+    }
 }
 
 }  // namespace vulkan

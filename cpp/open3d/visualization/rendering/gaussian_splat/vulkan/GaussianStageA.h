@@ -1,6 +1,7 @@
 // Stage A of the Vulkan pipeline as a recorder (STYLE.md point 6): project the splats,
 // order the visible ones by exact float32 depth (ties by splat index), emit one entry
-// per touched tile in that order and stably sort the entries by tile. The caller
+// per touched tile in that order and stably sort the entries by tile. The seed's packed
+// 32-bit (tile, truncated depth) key is an option (RenderConfig::sort_mode). The caller
 // allocates from GetStorageRequirements; Record() only records commands (no allocation,
 // no submit). Pass sequence and buffers: docs/vulkan-stage-a.md.
 #pragma once
@@ -95,6 +96,11 @@ public:
     /// counts. `params` must come from PackGaussianViewParams for this scene and a
     /// capacity <= the one the buffers were sized for.
     ///
+    /// With the packed key (UsesPackedSortKey(params)): no sort of the visible list (scan
+    /// and emit follow the append order), entries keyed by shader::PackedSortKey, one
+    /// stable 32-bit sort, then the keys are shifted back to tile indices. The outputs have
+    /// the same layout in both modes.
+    ///
     /// Synchronisation: the caller orders earlier uses of these buffers before Record (and
     /// makes scene uploads visible to compute reads); afterwards all results are
     /// COMPUTE_SHADER storage writes (the counters also) for the caller to barrier.
@@ -114,6 +120,8 @@ private:
     UniquePipeline scan_gather_;
     UniquePipeline dispatch_args_;
     UniquePipeline emit_;
+    UniquePipeline emit_packed_;                  // kEmitPackedKeys
+    UniquePipeline unpack_keys_;                  // kEmitUnpackKeys
     std::map<uint32_t, UniquePipeline> project_;  // key: degree | antialias << 2 | precision << 3
 };
 

@@ -75,6 +75,8 @@ GaussianStageARunner::GaussianStageARunner(const VulkanContext& context,
     layout_.sh_degree = packed.sh_degree;
     layout_.shape_words_per_splat = packed.shape_words_per_splat;
     layout_.sh_words_per_splat = packed.sh_words_per_splat;
+    layout_.center_min = packed.center_min;
+    layout_.center_max = packed.center_max;
     const uint32_t n = static_cast<uint32_t>(packed.num_splats);
 
     positions_ = UploadBuffer(packed.positions.data(), packed.positions.size() * sizeof(float));
@@ -137,6 +139,8 @@ StageAReadback GaussianStageARunner::Run(const camera::PinholeCamera& camera,
     inputs.precision = layout_.precision;
     inputs.sh_words_per_splat = layout_.sh_words_per_splat;
     inputs.entry_capacity = entry_capacity_;
+    inputs.center_min = layout_.center_min;
+    inputs.center_max = layout_.center_max;
     const shader::GaussianViewParams params = PackGaussianViewParams(camera, config, inputs);
 
     StageASceneBuffers scene;

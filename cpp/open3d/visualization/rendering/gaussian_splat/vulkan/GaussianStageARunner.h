@@ -27,11 +27,13 @@ struct StageAReadback {
     /// [N] (empty unless asked for); only entries of visible splats were written this run (others
     /// hold stale data).
     std::vector<shader::GaussianProjectedSplat> projected;
-    /// [visible_count]: splat indices, ascending float32 depth, ties by splat index.
+    /// [visible_count]: splat indices, ascending float32 depth, ties by splat index
+    /// (SortMode::kPackedKey32: the projection's append order, not sorted).
     std::vector<uint32_t> visible_in_depth_order;
     /// [entry_count]: tile index per entry, ascending.
     std::vector<uint32_t> entry_tiles;
-    /// [entry_count]: splat index per entry; front to back within each tile.
+    /// [entry_count]: splat index per entry; front to back within each tile (kPackedKey32:
+    /// by truncated depth, ties in append order).
     std::vector<uint32_t> entry_splats;
     /// Wall-clock time from submit to fence of the Stage A command buffer.
     double stage_a_ms = 0.0;
