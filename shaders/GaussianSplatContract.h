@@ -340,3 +340,109 @@ static_assert(offsetof(GaussianScanPushConstants, write_total) == 16);
 #undef OPEN3D_SHADER_CONST
 #endif  // OPEN3D_SHADERS_GAUSSIAN_SPLAT_CONTRACT_PROJECTION_H
 
+// ---- Composite (Stage B) ----
+// Appended by the composite work (vulkan/GaussianStageB.*, shaders/gaussian_composite*.comp,
+// shaders/gaussian_depth_merge.comp): bindings, push constants, the work-stealing state and
+// the blending thresholds. Kept as its own guarded block like the Stage A section.
+#ifndef OPEN3D_SHADERS_GAUSSIAN_SPLAT_CONTRACT_COMPOSITE_H
+#define OPEN3D_SHADERS_GAUSSIAN_SPLAT_CONTRACT_COMPOSITE_H
+
+#ifdef __cplusplus
+namespace open3d {
+namespace visualization {
+namespace rendering {
+namespace shader {
+#define OPEN3D_SHADER_CONST inline constexpr
+#else
+#define OPEN3D_SHADER_CONST const
+#endif
+
+// One composite workgroup per 16x16 tile, one invocation per pixel; the tile's splats are
+// loaded into shared memory in batches of one splat per invocation (48 B each: 12 KiB).
+OPEN3D_SHADER_CONST uint kCompositeTileSize = 16u;  // == kGaussianTileSize (asserted in C++)
+OPEN3D_SHADER_CONST uint kCompositeWorkgroupSize = 256u;
+OPEN3D_SHADER_CONST uint kCompositeBatchSize = 256u;
+// The depth merge runs 16x16 pixels per workgroup.
+OPEN3D_SHADER_CONST uint kDepthMergeWorkgroupSize = 16u;
+
+// The 3DGS blending thresholds as float32 (docs/DESIGN.md section 3; == cpu::kMaxAlpha etc.).
+OPEN3D_SHADER_CONST float kCompositeMaxAlpha = 0.99f;
+OPEN3D_SHADER_CONST float kCompositeMinAlpha = 1.0f / 255.0f;
+OPEN3D_SHADER_CONST float kCompositeMinTransmittance = 0.0001f;
+
+// Specialisation constant of gaussian_composite*.comp and gaussian_depth_merge.comp:
+// 1 = a scene depth texture is bound and tested; 0 = it is never read.
+OPEN3D_SHADER_CONST uint kSpecSceneDepth = 0u;
+
+// Descriptor set 0 of the composite (push descriptors).
+OPEN3D_SHADER_CONST uint kCompositeProjectedBinding = 0u;    // GaussianProjectedSplat[N]
+OPEN3D_SHADER_CONST uint kCompositeEntryKeysBinding = 1u;    // uint[capacity]: tile, ascending
+OPEN3D_SHADER_CONST uint kCompositeEntryValuesBinding = 2u;  // uint[capacity]: splat index
+OPEN3D_SHADER_CONST uint kCompositeCountBinding = 3u;        // uint[]: entry count at count_index
+OPEN3D_SHADER_CONST uint kCompositeStateBinding = 4u;        // GaussianCompositeState
+OPEN3D_SHADER_CONST uint kCompositeColorBinding = 5u;        // image2D rgba32f / rgba16f
+OPEN3D_SHADER_CONST uint kCompositeDepthBinding = 6u;        // image2D r32f: expected view z
+OPEN3D_SHADER_CONST uint kCompositeAlphaBinding = 7u;        // image2D r32f: 1 - T
+OPEN3D_SHADER_CONST uint kCompositeMedianDepthBinding = 8u;  // image2D r32f: median view z
+OPEN3D_SHADER_CONST uint kCompositeSceneDepthBinding = 9u;   // texture2D, reversed-Z
+OPEN3D_SHADER_CONST uint kCompositeNumBindings = 10u;
+
+// Descriptor set 0 of the depth merge (push descriptors).
+OPEN3D_SHADER_CONST uint kDepthMergeSplatDepthBinding = 0u;  // image2D r32f: splat view z
+OPEN3D_SHADER_CONST uint kDepthMergeSplatAlphaBinding = 1u;  // image2D r32f: splat 1 - T
+OPEN3D_SHADER_CONST uint kDepthMergeSceneDepthBinding = 2u;  // texture2D, reversed-Z
+OPEN3D_SHADER_CONST uint kDepthMergeNormalizedBinding = 3u;  // uimage2D r16ui
+OPEN3D_SHADER_CONST uint kDepthMergeLinearBinding = 4u;      // image2D r32f: merged view z
+OPEN3D_SHADER_CONST uint kDepthMergeNumBindings = 5u;
+
+// Work-stealing state of one composite dispatch (std430): zeroed by the recorder
+// (vkCmdFillBuffer) before every dispatch; each workgroup claims tiles with atomicAdd.
+struct GaussianCompositeState {
+    uint next_tile;
+    uint reserved0;
+    uint reserved1;
+    uint reserved2;
+};
+
+// Push constants of the composite.
+struct GaussianCompositePushConstants {
+    uvec4 image;       // width, height, tiles_x, tiles_y
+    uvec4 entries;     // count_index (uint index in the count binding), capacity,
+                       // scene depth flip y (1: row 0 is the bottom row, GL), 0
+    vec4 background;   // rgb: out.rgb = C + T * background; w = 0
+    vec4 scene_depth;  // x: near of the reversed-Z depth (view z = near / d); y, z, w = 0
+};
+
+// Push constants of the depth merge.
+struct GaussianDepthMergePushConstants {
+    uvec4 image;  // width, height, scene depth flip y, 0
+    vec4 range;   // near, far of the normalisation, scene near (z = near / d),
+                  // min splat alpha for the splat depth to count
+};
+
+#ifdef __cplusplus
+static_assert(kCompositeTileSize == kGaussianTileSize);
+static_assert(kCompositeWorkgroupSize == kCompositeTileSize * kCompositeTileSize);
+static_assert(kCompositeBatchSize == kCompositeWorkgroupSize, "one splat load per invocation");
+
+static_assert(sizeof(GaussianCompositeState) == 16);
+static_assert(offsetof(GaussianCompositeState, next_tile) == 0);
+
+static_assert(sizeof(GaussianCompositePushConstants) == 64);
+static_assert(offsetof(GaussianCompositePushConstants, image) == 0);
+static_assert(offsetof(GaussianCompositePushConstants, entries) == 16);
+static_assert(offsetof(GaussianCompositePushConstants, background) == 32);
+static_assert(offsetof(GaussianCompositePushConstants, scene_depth) == 48);
+
+static_assert(sizeof(GaussianDepthMergePushConstants) == 32);
+static_assert(offsetof(GaussianDepthMergePushConstants, image) == 0);
+static_assert(offsetof(GaussianDepthMergePushConstants, range) == 16);
+
+}  // namespace shader
+}  // namespace rendering
+}  // namespace visualization
+}  // namespace open3d
+#endif  // __cplusplus
+
+#undef OPEN3D_SHADER_CONST
+#endif  // OPEN3D_SHADERS_GAUSSIAN_SPLAT_CONTRACT_COMPOSITE_H

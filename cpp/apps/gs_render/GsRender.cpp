@@ -16,6 +16,7 @@
 #include "open3d/t/io/PointCloudIO.h"
 #include "open3d/visualization/rendering/gaussian_splat/DefaultScene.h"
 #include "open3d/visualization/rendering/gaussian_splat/GaussianSplatRenderer.h"
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/GaussianSplatVulkanBackend.h"
 
 namespace {
 
@@ -28,7 +29,8 @@ struct Options {
     int view = 0;
     int width = 0;
     int height = 0;
-    std::string backend = "cpu";
+    std::string backend = "vulkan";
+    bool backend_given = false;
     std::string output = "render.png";
     std::string depth_output;
     std::string depth_kind = "expected";
@@ -133,11 +135,7 @@ camera::PinholeCamera ChooseCamera(const Options& opt, const t::geometry::PointC
 }
 
 int Run(const Options& opt) {
-    const auto names = rendering::GetGaussianSplatBackendNames();
-    if (std::find(names.begin(), names.end(), opt.backend) == names.end()) {
-        core::ThrowError("the '{}' backend is not built yet (available: {})", opt.backend,
-                         fmt::join(names, ", "));
-    }
+    rendering::vulkan::RegisterVulkanBackend();
     const auto start = std::chrono::steady_clock::now();
     t::geometry::PointCloud cloud;
     const bool default_scene = opt.input.empty();
@@ -159,7 +157,20 @@ int Run(const Options& opt) {
     config.near_plane = opt.near_plane;
     if (!opt.background.empty()) config.background = ToVec(opt.background);
 
-    auto backend = rendering::CreateGaussianSplatBackend(opt.backend);
+    std::string backend_name = opt.backend;
+    std::unique_ptr<rendering::GaussianSplatBackend> backend;
+    try {
+        backend = rendering::CreateGaussianSplatBackend(backend_name);
+    } catch (const core::Open3DError& e) {
+        // The default (Vulkan) falls back to the CPU reference; an explicit choice fails.
+        if (opt.backend_given || backend_name != "vulkan") throw;
+        std::fprintf(stderr,
+                     "gs-render: no usable Vulkan device, rendering with the CPU reference "
+                     "instead (slower; pass --backend cpu to silence this).\n  reason: %s\n",
+                     e.what());
+        backend_name = "cpu";
+        backend = rendering::CreateGaussianSplatBackend(backend_name);
+    }
     backend->SetScene(cloud);
     const auto render_start = std::chrono::steady_clock::now();
     backend->RenderGeometryStage(cam, config);
@@ -170,7 +181,7 @@ int Run(const Options& opt) {
     std::printf(
         "render: %dx%d, backend %s, %d threads: geometry %.1f ms, composite %.1f ms, "
         "total %.1f ms (%lld visible splats, %lld tile entries%s)\n",
-        cam.width, cam.height, opt.backend.c_str(), core::GetNumThreads(), s.geometry_ms,
+        cam.width, cam.height, backend_name.c_str(), core::GetNumThreads(), s.geometry_ms,
         s.composite_ms, render_ms, static_cast<long long>(s.num_visible),
         static_cast<long long>(s.num_tile_entries),
         s.error_flags ? ", ENTRIES DROPPED: raise the capacity limits" : "");
@@ -215,9 +226,12 @@ int main(int argc, char** argv) {
         ->check(CLI::Range(1, 16384));
     app.add_option("--height", opt.height, "Output height (default: the camera's)")
         ->check(CLI::Range(1, 16384));
-    app.add_option("--backend", opt.backend, "Rendering backend")
-        ->check(CLI::IsMember({"cpu", "vulkan", "placeholder"}))
-        ->capture_default_str();
+    auto* backend_option =
+        app.add_option("--backend", opt.backend,
+                       "Rendering backend (vulkan falls back to cpu with a message when no Vulkan "
+                       "device exists, unless given explicitly)")
+            ->check(CLI::IsMember({"cpu", "vulkan", "placeholder"}))
+            ->capture_default_str();
     app.add_option("-o,--output", opt.output, "Colour image: .png (RGB8) or .npy (float RGB)")
         ->capture_default_str();
     app.add_option("--depth-output", opt.depth_output,
@@ -253,6 +267,7 @@ int main(int argc, char** argv) {
     } catch (const CLI::ParseError& e) {
         return app.exit(e);
     }
+    opt.backend_given = backend_option->count() > 0;
     try {
         return Run(opt);
     } catch (const std::exception& e) {

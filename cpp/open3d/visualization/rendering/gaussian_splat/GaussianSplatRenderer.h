@@ -35,7 +35,8 @@ struct RenderOutput {
 /// Optional inputs to the composite stage.
 struct CompositeInputs {
     /// Float32 [H, W, 1] view-space z of opaque scene geometry (meshes), or empty for none.
-    /// A splat is skipped at a pixel when its depth is greater than the scene depth there.
+    /// A splat is skipped at a pixel when its depth is greater than the scene depth there;
+    /// values <= 0 mean no geometry at that pixel (as Filament's cleared depth does).
     const t::geometry::Image* scene_depth = nullptr;
 };
 

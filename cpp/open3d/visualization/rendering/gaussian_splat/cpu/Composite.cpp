@@ -65,7 +65,9 @@ void CompositeTiles(const std::vector<ProjectedSplat>& splats, const TileLists& 
             for (int py = ty * kTileSize; py < y_end; ++py) {
                 for (int px = tx * kTileSize; px < x_end; ++px) {
                     const int64_t pixel = static_cast<int64_t>(py) * width + px;
-                    const double limit_depth = scene ? scene[pixel] : HUGE_VAL;
+                    // Scene depth <= 0 means no geometry there (Filament clears to 0).
+                    const double limit_depth =
+                        scene && scene[pixel] > 0.0f ? scene[pixel] : HUGE_VAL;
                     double transmittance = 1.0;
                     double c[3] = {0.0, 0.0, 0.0};
                     double weighted_depth = 0.0;

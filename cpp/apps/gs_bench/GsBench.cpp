@@ -1,0 +1,338 @@
+// gs-bench: time against error. For each scene, resolution and accuracy/speed knob it
+// renders the cameras.json views (or the grid scene) with a backend, reports GPU time per
+// stage (timestamp queries), CPU time per frame, memory per splat and the error against
+// the CPU reference rendered in the same run. Runs headless (no window, no Filament).
+#include <CLI/CLI.hpp>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "BenchScenes.h"
+#include "open3d/camera/CamerasJson.h"
+#include "open3d/core/Exception.h"
+#include "open3d/core/ParallelFor.h"
+#include "open3d/t/geometry/ImageMetrics.h"
+#include "open3d/t/io/PointCloudIO.h"
+#include "open3d/visualization/rendering/gaussian_splat/GaussianSplatRenderer.h"
+#include "open3d/visualization/rendering/gaussian_splat/cpu/CpuBackend.h"
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/GaussianSplatVulkanBackend.h"
+
+namespace {
+
+using namespace open3d;
+namespace rendering = visualization::rendering;
+
+struct Options {
+    std::vector<std::string> inputs;
+    std::vector<std::string> cameras;
+    std::string views = "0";
+    std::vector<std::string> resolutions;
+    std::string backend = "vulkan";
+    int grid = 0;
+    std::string json;
+    int repeat = 10;
+    std::string knobs = "all";
+    int64_t reference_max_splats = 2000000;
+};
+
+struct Knob {
+    std::string name;
+    void (*apply)(rendering::RenderConfig&);
+};
+
+const std::vector<Knob> kKnobs = {
+    {"default", [](rendering::RenderConfig&) {}},
+    {"packed-key",
+     [](rendering::RenderConfig& c) { c.sort_mode = rendering::SortMode::kPackedKey32; }},
+    {"compact", [](rendering::RenderConfig& c) { c.compact_storage = true; }},
+    {"sh<=1", [](rendering::RenderConfig& c) { c.sh_degree = 1; }},
+    {"antialias", [](rendering::RenderConfig& c) { c.antialias = true; }},
+};
+
+struct Row {
+    std::string scene, resolution, knob;
+    int64_t splats = 0, visible = 0, entries = 0;
+    double project_ms = 0, sort_ms = 0, composite_ms = 0, gpu_total_ms = 0, cpu_frame_ms = 0;
+    double bytes_per_splat = 0;
+    bool has_error = false;
+    double psnr = 0, max_abs = 0, over_1_255 = 0, p999 = 0;
+    uint32_t error_flags = 0;
+};
+
+double MsSince(std::chrono::steady_clock::time_point t) {
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t).count();
+}
+
+std::pair<int, int> ParseResolution(const std::string& text) {
+    int w = 0, h = 0;
+    char x = 0;
+    if (std::sscanf(text.c_str(), "%d%c%d", &w, &x, &h) != 3 || (x != 'x' && x != 'X') || w < 1 ||
+        h < 1 || w > 16384 || h > 16384) {
+        core::ThrowError("--resolution '{}' must look like 1920x1080 (1..16384)", text);
+    }
+    return {w, h};
+}
+
+std::vector<int> ParseViews(const std::string& text, int available) {
+    std::vector<int> views;
+    if (text == "all") {
+        for (int i = 0; i < available; ++i) views.push_back(i);
+        return views;
+    }
+    size_t start = 0;
+    while (start <= text.size()) {
+        const size_t comma = text.find(',', start);
+        const std::string item = text.substr(start, comma - start);
+        char* end = nullptr;
+        const long v = std::strtol(item.c_str(), &end, 10);
+        if (item.empty() || *end != '\0' || v < 0 || v >= available) {
+            core::ThrowError("--views: '{}' is not a view index in 0..{}", item, available - 1);
+        }
+        views.push_back(static_cast<int>(v));
+        if (comma == std::string::npos) break;
+        start = comma + 1;
+    }
+    return views;
+}
+
+// 99.9th percentile of the per-element absolute colour difference.
+double Percentile999(const t::geometry::Image& a, const t::geometry::Image& b) {
+    const int64_t n = a.NumPixels() * a.GetChannels();
+    std::vector<float> diff(n);
+    const float* pa = a.Data<float>();
+    const float* pb = b.Data<float>();
+    for (int64_t i = 0; i < n; ++i) diff[i] = std::abs(pa[i] - pb[i]);
+    const int64_t k = std::min<int64_t>(n - 1, static_cast<int64_t>(std::ceil(0.999 * n)) - 1);
+    std::nth_element(diff.begin(), diff.begin() + std::max<int64_t>(k, 0), diff.end());
+    return diff[std::max<int64_t>(k, 0)];
+}
+
+struct SceneJob {
+    std::string name;
+    t::geometry::PointCloud cloud;
+    // One camera per view at the given resolution.
+    std::function<std::vector<camera::PinholeCamera>(int w, int h)> cameras;
+    std::pair<int, int> native{800, 800};
+};
+
+void PrintTable(const std::vector<Row>& rows) {
+    std::string last;
+    for (const Row& r : rows) {
+        const std::string head = r.scene + " @ " + r.resolution;
+        if (head != last) {
+            std::printf("\n%s: %lld splats\n", head.c_str(), static_cast<long long>(r.splats));
+            std::printf("%-11s %9s %10s %8s %8s %8s %9s %9s %7s %8s %9s %9s\n", "knob", "visible",
+                        "entries", "proj ms", "sort ms", "comp ms", "GPU ms", "CPU ms", "B/splat",
+                        "PSNR dB", "max err", ">1/255 %");
+            last = head;
+        }
+        char err[64] = "        -         -         -";
+        if (r.has_error) {
+            std::snprintf(err, sizeof(err), "%8.1f %9.2e %9.4f", r.psnr, r.max_abs,
+                          100.0 * r.over_1_255);
+        }
+        std::printf("%-11s %9lld %10lld %8.3f %8.3f %8.3f %9.3f %9.2f %7.1f %s%s\n", r.knob.c_str(),
+                    static_cast<long long>(r.visible), static_cast<long long>(r.entries),
+                    r.project_ms, r.sort_ms, r.composite_ms, r.gpu_total_ms, r.cpu_frame_ms,
+                    r.bytes_per_splat, err, r.error_flags ? "  (entries dropped!)" : "");
+    }
+}
+
+int Run(const Options& opt) {
+    rendering::vulkan::RegisterVulkanBackend();
+    std::vector<SceneJob> jobs;
+    if (opt.inputs.empty()) core::ThrowError("--input is required (a .ply or .splat scene)");
+    if (opt.grid > 0) {
+        if (opt.cameras.empty())
+            core::ThrowError("--grid needs --cameras (view 0 sets the rotation)");
+        t::geometry::PointCloud tile;
+        t::io::ReadPointCloud(opt.inputs[0], tile);
+        const auto view = camera::ReadCamerasJson(opt.cameras[0]).at(0).camera;
+        double spacing = 0;
+        SceneJob job;
+        job.cloud = bench::MakeGridScene(tile, opt.grid, &spacing);
+        job.name = fmt::format("grid{}x{}", opt.grid, opt.grid);
+        job.native = {1920, 1080};
+        job.cameras = [tile, view, k = opt.grid, spacing](int w, int h) {
+            return std::vector<camera::PinholeCamera>{
+                bench::MakeGridCamera(tile, view, k, spacing, w, h)};
+        };
+        jobs.push_back(std::move(job));
+    } else {
+        if (opt.cameras.size() != opt.inputs.size()) {
+            core::ThrowError("give one --cameras per --input ({} inputs, {} cameras)",
+                             opt.inputs.size(), opt.cameras.size());
+        }
+        for (size_t i = 0; i < opt.inputs.size(); ++i) {
+            SceneJob job;
+            t::io::ReadPointCloud(opt.inputs[i], job.cloud);
+            job.name = std::filesystem::path(opt.inputs[i]).filename().string();
+            std::vector<camera::PinholeCamera> views;
+            for (const auto& v : camera::ReadCamerasJson(opt.cameras[i])) views.push_back(v.camera);
+            const std::vector<int> chosen = ParseViews(opt.views, static_cast<int>(views.size()));
+            job.native = {views.at(0).width, views.at(0).height};
+            job.cameras = [views, chosen](int w, int h) {
+                std::vector<camera::PinholeCamera> out;
+                for (int v : chosen) out.push_back(bench::ScaleViewTo(views[v], w, h));
+                return out;
+            };
+            jobs.push_back(std::move(job));
+        }
+    }
+    std::vector<std::pair<int, int>> resolutions;
+    for (const auto& r : opt.resolutions) resolutions.push_back(ParseResolution(r));
+
+    std::vector<Knob> knobs;
+    for (const Knob& k : kKnobs) {
+        if (opt.knobs == "all" || opt.knobs.find(k.name) != std::string::npos) knobs.push_back(k);
+    }
+    if (knobs.empty()) core::ThrowError("--knobs '{}' selects none of the known knobs", opt.knobs);
+
+    std::vector<Row> rows;
+    for (SceneJob& job : jobs) {
+        auto backend = rendering::CreateGaussianSplatBackend(opt.backend);
+        backend->SetScene(job.cloud);
+        const bool reference =
+            opt.reference_max_splats > 0 && job.cloud.NumPoints() <= opt.reference_max_splats;
+        auto job_resolutions = resolutions;
+        if (job_resolutions.empty()) job_resolutions.push_back(job.native);
+        for (const auto& [w, h] : job_resolutions) {
+            const auto cams = job.cameras(w, h);
+            // CPU references, keyed by what changes the reference image (SH cap, antialias).
+            std::map<std::pair<int, bool>, std::vector<t::geometry::Image>> refs;
+            for (const Knob& knob : knobs) {
+                rendering::RenderConfig config;
+                config.reuse_geometry = false;
+                knob.apply(config);
+                Row row;
+                row.scene = job.name;
+                row.resolution = fmt::format("{}x{}", w, h);
+                row.knob = knob.name;
+                row.splats = job.cloud.NumPoints();
+                double worst_psnr = INFINITY;
+                for (size_t v = 0; v < cams.size(); ++v) {
+                    rendering::RenderOutput out = backend->Render(cams[v], config);  // warm-up
+                    double cpu_ms = 0;
+                    rendering::RenderStats sum;
+                    for (int it = 0; it < opt.repeat; ++it) {
+                        const auto start = std::chrono::steady_clock::now();
+                        out = backend->Render(cams[v], config);
+                        cpu_ms += MsSince(start);
+                        sum.gpu_project_ms += out.stats.gpu_project_ms;
+                        sum.gpu_sort_ms += out.stats.gpu_sort_ms;
+                        sum.gpu_composite_ms += out.stats.gpu_composite_ms;
+                    }
+                    const double n = opt.repeat * static_cast<double>(cams.size());
+                    row.project_ms += sum.gpu_project_ms / n;
+                    row.sort_ms += sum.gpu_sort_ms / n;
+                    row.composite_ms += sum.gpu_composite_ms / n;
+                    row.cpu_frame_ms += cpu_ms / n;
+                    row.visible += out.stats.num_visible / static_cast<int64_t>(cams.size());
+                    row.entries += out.stats.num_tile_entries / static_cast<int64_t>(cams.size());
+                    row.error_flags |= out.stats.error_flags;
+                    row.bytes_per_splat =
+                        static_cast<double>(out.stats.gpu_scene_bytes) / row.splats;
+                    if (!reference) continue;
+                    auto& ref = refs[{config.sh_degree, config.antialias}];
+                    if (ref.size() <= v) {
+                        rendering::RenderConfig ref_config;
+                        ref_config.sh_degree = config.sh_degree;
+                        ref_config.antialias = config.antialias;
+                        ref.push_back(
+                            rendering::cpu::RenderReference(job.cloud, cams[v], ref_config).color);
+                    }
+                    const auto m =
+                        t::geometry::ComputeImageErrorMetrics(out.color, ref[v], 1.0, 1.0 / 255.0);
+                    row.has_error = true;
+                    worst_psnr = std::min(worst_psnr, m.psnr_db);
+                    row.max_abs = std::max(row.max_abs, m.max_abs_error);
+                    row.over_1_255 = std::max(row.over_1_255, m.fraction_over_threshold);
+                    row.p999 = std::max(row.p999, Percentile999(out.color, ref[v]));
+                }
+                row.psnr = worst_psnr;  // the worst view
+                row.gpu_total_ms = row.project_ms + row.sort_ms + row.composite_ms;
+                rows.push_back(row);
+            }
+        }
+    }
+    PrintTable(rows);
+    if (!opt.json.empty()) {
+        nlohmann::json out = nlohmann::json::array();
+        for (const Row& r : rows) {
+            out.push_back({{"scene", r.scene},
+                           {"resolution", r.resolution},
+                           {"knob", r.knob},
+                           {"splats", r.splats},
+                           {"visible", r.visible},
+                           {"tile_entries", r.entries},
+                           {"gpu_project_ms", r.project_ms},
+                           {"gpu_sort_ms", r.sort_ms},
+                           {"gpu_composite_ms", r.composite_ms},
+                           {"gpu_total_ms", r.gpu_total_ms},
+                           {"cpu_frame_ms", r.cpu_frame_ms},
+                           {"gpu_bytes_per_splat", r.bytes_per_splat},
+                           {"error_flags", r.error_flags}});
+            if (r.has_error) {
+                out.back()["psnr_db_worst_view"] = r.psnr;
+                out.back()["max_abs_error"] = r.max_abs;
+                out.back()["fraction_over_1_255"] = r.over_1_255;
+                out.back()["p999_abs_error"] = r.p999;
+            }
+        }
+        std::ofstream(opt.json) << out.dump(2) << "\n";
+        std::printf("\nwrote %s\n", opt.json.c_str());
+    }
+    return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    Options opt;
+    CLI::App app{
+        "gs-bench: GPU time per stage against error versus the CPU reference.\n"
+        "Real scenes: one --cameras per --input, views from --views at each --resolution\n"
+        "(fx = fy = fx_json * H / H_json, principal point at the centre). --grid K builds\n"
+        "K x K copies of the first --input with the camera defined in docs/benchmark.md.\n"
+        "Knobs: default, packed-key, compact, sh<=1, antialias. The error columns compare\n"
+        "with the CPU reference rendered in the same run (worst view).",
+        "gs-bench"};
+    app.add_option("-i,--input", opt.inputs, "Scene file(s): .ply or .splat")
+        ->check(CLI::ExistingFile)
+        ->required();
+    app.add_option("--cameras", opt.cameras, "cameras.json per input")->check(CLI::ExistingFile);
+    app.add_option("--views", opt.views, "View indices, e.g. 0,5,9, or 'all'")
+        ->capture_default_str();
+    app.add_option("--resolution", opt.resolutions,
+                   "WxH, repeatable (default: the camera's own size; 1920x1080 for --grid)");
+    app.add_option("--backend", opt.backend, "Backend to time")
+        ->check(CLI::IsMember({"vulkan", "cpu"}))
+        ->capture_default_str();
+    app.add_option("--grid", opt.grid, "Tiled large scene: K x K copies of the first input")
+        ->check(CLI::Range(1, 64));
+    app.add_option("--json", opt.json, "Write machine-readable results here");
+    app.add_option("--repeat", opt.repeat, "Timed frames per view and knob")
+        ->check(CLI::Range(1, 10000))
+        ->capture_default_str();
+    app.add_option("--knobs", opt.knobs, "Comma list of knobs or 'all'")->capture_default_str();
+    app.add_option("--reference-max-splats", opt.reference_max_splats,
+                   "Skip the CPU reference for scenes larger than this (0: never compare)")
+        ->capture_default_str();
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::ParseError& e) {
+        return app.exit(e);
+    }
+    try {
+        return Run(opt);
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "gs-bench: error: %s\n", e.what());
+        return 1;
+    }
+}

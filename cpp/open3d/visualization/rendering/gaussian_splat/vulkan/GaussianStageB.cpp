@@ -1,0 +1,294 @@
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/GaussianStageB.h"
+
+#include <algorithm>
+#include <vector>
+
+#include "open3d/core/Exception.h"
+#include "open3d/visualization/rendering/gaussian_splat/RenderConfig.h"
+#include "open3d/visualization/rendering/gaussian_splat/cpu/Composite.h"
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/Commands.h"
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/ComputePipeline.h"
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/EmbeddedShaders.h"
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/VulkanContext.h"
+#include "shaders/GaussianSplatContract.h"
+
+namespace open3d {
+namespace visualization {
+namespace rendering {
+namespace vulkan {
+
+namespace {
+
+using namespace shader;  // the contract's constants and structs
+
+static_assert(kCompositeTileSize == static_cast<uint32_t>(rendering::kTileSize));
+// The GPU compares against the same float32 thresholds the reference widens to double.
+static_assert(static_cast<double>(kCompositeMaxAlpha) == cpu::kMaxAlpha);
+static_assert(static_cast<double>(kCompositeMinAlpha) == cpu::kMinAlpha);
+static_assert(static_cast<double>(kCompositeMinTransmittance) == cpu::kMinTransmittance);
+
+UniqueDescriptorSetLayout CreatePushLayout(const VulkanContext& context,
+                                           const std::vector<VkDescriptorType>& types) {
+    std::vector<VkDescriptorSetLayoutBinding> bindings(types.size());
+    for (size_t i = 0; i < types.size(); ++i) {
+        bindings[i].binding = static_cast<uint32_t>(i);
+        bindings[i].descriptorType = types[i];
+        bindings[i].descriptorCount = 1;
+        bindings[i].stageFlags = VK_SHADER_STAGE_COMPUTE_BIT;
+    }
+    VkDescriptorSetLayoutCreateInfo info = MakeInfo<VkDescriptorSetLayoutCreateInfo>(
+        VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO);
+    info.flags = VK_DESCRIPTOR_SET_LAYOUT_CREATE_PUSH_DESCRIPTOR_BIT_KHR;
+    info.bindingCount = static_cast<uint32_t>(bindings.size());
+    info.pBindings = bindings.data();
+    VkDescriptorSetLayout layout = VK_NULL_HANDLE;
+    CheckVk(vkCreateDescriptorSetLayout(context.GetDevice(), &info, nullptr, &layout),
+            "vkCreateDescriptorSetLayout");
+    return UniqueDescriptorSetLayout(context.GetDevice(), layout);
+}
+
+VkWriteDescriptorSet BufferWrite(uint32_t binding, const VkDescriptorBufferInfo* info) {
+    VkWriteDescriptorSet write =
+        MakeInfo<VkWriteDescriptorSet>(VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET);
+    write.dstBinding = binding;
+    write.descriptorCount = 1;
+    write.descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+    write.pBufferInfo = info;
+    return write;
+}
+
+VkWriteDescriptorSet ImageWrite(uint32_t binding, VkDescriptorType type,
+                                const VkDescriptorImageInfo* info) {
+    VkWriteDescriptorSet write =
+        MakeInfo<VkWriteDescriptorSet>(VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET);
+    write.dstBinding = binding;
+    write.descriptorCount = 1;
+    write.descriptorType = type;
+    write.pImageInfo = info;
+    return write;
+}
+
+VkDescriptorImageInfo StorageImage(VkImageView view) {
+    return {VK_NULL_HANDLE, view, VK_IMAGE_LAYOUT_GENERAL};
+}
+
+UniquePipeline CreateSpecialised(const VulkanContext& context, VkPipelineLayout layout,
+                                 std::span<const uint32_t> spirv, const char* name,
+                                 bool scene_depth) {
+    const uint32_t value = scene_depth ? 1u : 0u;
+    const VkSpecializationMapEntry entry{kSpecSceneDepth, 0, sizeof(uint32_t)};
+    VkSpecializationInfo specialization{1, &entry, sizeof(value), &value};
+    return CreateComputePipeline(context, layout, spirv, name, &specialization);
+}
+
+void RequireView(VkImageView view, const char* what) {
+    if (view == VK_NULL_HANDLE) core::ThrowError("GaussianStageB: {} has no image view", what);
+}
+
+}  // namespace
+
+VkFormat ToVkFormat(CompositeColorFormat format) {
+    return format == CompositeColorFormat::kRgba16f ? VK_FORMAT_R16G16B16A16_SFLOAT
+                                                    : VK_FORMAT_R32G32B32A32_SFLOAT;
+}
+
+GaussianStageB::GaussianStageB(const VulkanContext& context) : context_(context) {
+    const VkDescriptorType kBuffer = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+    const VkDescriptorType kStorage = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
+    const VkDescriptorType kSampled = VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE;
+    std::vector<VkDescriptorType> composite(kCompositeNumBindings, kStorage);
+    composite[kCompositeProjectedBinding] = kBuffer;
+    composite[kCompositeEntryKeysBinding] = kBuffer;
+    composite[kCompositeEntryValuesBinding] = kBuffer;
+    composite[kCompositeCountBinding] = kBuffer;
+    composite[kCompositeStateBinding] = kBuffer;
+    composite[kCompositeSceneDepthBinding] = kSampled;
+    composite_set_layout_ = CreatePushLayout(context, composite);
+    composite_layout_ = CreatePipelineLayout(context, composite_set_layout_.Get(),
+                                             sizeof(GaussianCompositePushConstants));
+    std::vector<VkDescriptorType> merge(kDepthMergeNumBindings, kStorage);
+    merge[kDepthMergeSceneDepthBinding] = kSampled;
+    merge_set_layout_ = CreatePushLayout(context, merge);
+    merge_layout_ = CreatePipelineLayout(context, merge_set_layout_.Get(),
+                                         sizeof(GaussianDepthMergePushConstants));
+    placeholder_depth_ = Image(context, 1, 1, VK_FORMAT_R32_SFLOAT, VK_IMAGE_USAGE_SAMPLED_BIT);
+}
+
+StageBStorageRequirements GaussianStageB::GetStorageRequirements() {
+    StageBStorageRequirements requirements;
+    requirements.state_bytes = sizeof(GaussianCompositeState);
+    return requirements;
+}
+
+VkPipeline GaussianStageB::GetCompositePipeline(CompositeColorFormat format, bool scene_depth) {
+    const bool half = format == CompositeColorFormat::kRgba16f;
+    UniquePipeline& pipeline = composite_[(half ? 2 : 0) + (scene_depth ? 1 : 0)];
+    if (!pipeline) {
+        pipeline = CreateSpecialised(
+            context_, composite_layout_.Get(),
+            half ? spirv::kGaussianCompositeRgba16f : spirv::kGaussianComposite,
+            half ? "gaussian_composite_rgba16f" : "gaussian_composite", scene_depth);
+    }
+    return pipeline.Get();
+}
+
+VkPipeline GaussianStageB::GetDepthMergePipeline(bool scene_depth) {
+    UniquePipeline& pipeline = merge_[scene_depth ? 1 : 0];
+    if (!pipeline) {
+        pipeline = CreateSpecialised(context_, merge_layout_.Get(), spirv::kGaussianDepthMerge,
+                                     "gaussian_depth_merge", scene_depth);
+    }
+    return pipeline.Get();
+}
+
+VkDescriptorImageInfo GaussianStageB::SceneDepthDescriptor(
+    VkCommandBuffer cmd, const SceneDepthTexture* scene_depth) const {
+    if (scene_depth) {
+        RequireView(scene_depth->view, "scene_depth");
+        return {VK_NULL_HANDLE, scene_depth->view, scene_depth->layout};
+    }
+    // The pipeline specialised without scene depth never reads the binding, but a statically
+    // used binding must still hold a valid descriptor. UNDEFINED -> read-only each time
+    // (its contents are never read); the barrier also orders it after earlier dispatches.
+    RecordImageBarrier(cmd, placeholder_depth_.Get(), VK_IMAGE_ASPECT_COLOR_BIT,
+                       VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+                       VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_NONE,
+                       VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);
+    return {VK_NULL_HANDLE, placeholder_depth_.GetView(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
+}
+
+void GaussianStageB::RecordComposite(VkCommandBuffer cmd, const StageBInputs& inputs,
+                                     const StageBTargets& targets, const BufferRange& state,
+                                     const CompositeParams& params) {
+    if (targets.width == 0 || targets.height == 0) {
+        core::ThrowError("GaussianStageB: the image is {}x{}", targets.width, targets.height);
+    }
+    RequireView(targets.color, "color");
+    RequireView(targets.depth, "depth");
+    RequireView(targets.alpha, "alpha");
+    RequireView(targets.median_depth, "median_depth");
+    const VkDeviceSize alignment = context_.GetDeviceInfo().min_storage_buffer_offset_alignment;
+    for (const BufferRange* range :
+         {&inputs.projected, &inputs.entry_keys, &inputs.entry_values, &state}) {
+        if (range->buffer == VK_NULL_HANDLE || range->offset % alignment != 0) {
+            core::ThrowError(
+                "GaussianStageB: every input buffer needs a buffer and an offset that is a "
+                "multiple of minStorageBufferOffsetAlignment {}",
+                alignment);
+        }
+    }
+    if (inputs.entry_count.buffer == VK_NULL_HANDLE || inputs.entry_count.offset % 4 != 0) {
+        core::ThrowError("GaussianStageB: entry_count needs a buffer and a 4-byte aligned offset");
+    }
+
+    const uint32_t tiles_x = (targets.width + kCompositeTileSize - 1) / kCompositeTileSize;
+    const uint32_t tiles_y = (targets.height + kCompositeTileSize - 1) / kCompositeTileSize;
+    const uint64_t num_tiles = uint64_t(tiles_x) * tiles_y;
+    // CPU devices (lavapipe) get one workgroup per tile: llvmpipe caps the loop iterations
+    // of an invocation (see gaussian_composite.glsl), so one workgroup must not do many
+    // tiles; GPUs get a fixed grid whose workgroups steal tiles.
+    const bool cpu_device = context_.GetDeviceInfo().type == "CPU";
+    const uint32_t max_workgroups = params.max_workgroups > 0 ? params.max_workgroups
+                                    : cpu_device              ? kMaxWorkgroupsPerDispatch
+                                                              : kDefaultMaxWorkgroups;
+    const uint32_t workgroups = static_cast<uint32_t>(
+        std::min<uint64_t>(num_tiles, std::min(max_workgroups, kMaxWorkgroupsPerDispatch)));
+
+    // Work stealing starts from tile 0 in every dispatch.
+    vkCmdFillBuffer(cmd, state.buffer, state.offset, sizeof(GaussianCompositeState), 0u);
+    RecordMemoryBarrier(cmd, VK_PIPELINE_STAGE_2_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                        VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                        VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
+
+    // The count may sit at any 4-byte offset: bind from the aligned offset below it.
+    const VkDeviceSize count_offset =
+        inputs.entry_count.offset - inputs.entry_count.offset % alignment;
+    GaussianCompositePushConstants push{};
+    push.image = {targets.width, targets.height, tiles_x, tiles_y};
+    push.entries = {static_cast<uint32_t>((inputs.entry_count.offset - count_offset) / 4),
+                    inputs.entry_capacity, params.scene_depth && params.scene_depth->flip_y, 0u};
+    push.background = {params.background[0], params.background[1], params.background[2], 0.f};
+    push.scene_depth = {params.scene_depth ? params.scene_depth->near_plane : 0.f, 0.f, 0.f, 0.f};
+
+    const VkDeviceSize entry_bytes = VkDeviceSize(std::max(inputs.entry_capacity, 1u)) * 4;
+    const std::array<VkDescriptorBufferInfo, 5> buffers{{
+        {inputs.projected.buffer, inputs.projected.offset, inputs.projected.size},
+        {inputs.entry_keys.buffer, inputs.entry_keys.offset, entry_bytes},
+        {inputs.entry_values.buffer, inputs.entry_values.offset, entry_bytes},
+        {inputs.entry_count.buffer, count_offset, VK_WHOLE_SIZE},
+        {state.buffer, state.offset, sizeof(GaussianCompositeState)},
+    }};
+    const std::array<VkDescriptorImageInfo, 5> images{{
+        StorageImage(targets.color),
+        StorageImage(targets.depth),
+        StorageImage(targets.alpha),
+        StorageImage(targets.median_depth),
+        SceneDepthDescriptor(cmd, params.scene_depth),
+    }};
+    const std::array<VkWriteDescriptorSet, kCompositeNumBindings> writes{{
+        BufferWrite(kCompositeProjectedBinding, &buffers[0]),
+        BufferWrite(kCompositeEntryKeysBinding, &buffers[1]),
+        BufferWrite(kCompositeEntryValuesBinding, &buffers[2]),
+        BufferWrite(kCompositeCountBinding, &buffers[3]),
+        BufferWrite(kCompositeStateBinding, &buffers[4]),
+        ImageWrite(kCompositeColorBinding, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, &images[0]),
+        ImageWrite(kCompositeDepthBinding, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, &images[1]),
+        ImageWrite(kCompositeAlphaBinding, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, &images[2]),
+        ImageWrite(kCompositeMedianDepthBinding, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, &images[3]),
+        ImageWrite(kCompositeSceneDepthBinding, VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE, &images[4]),
+    }};
+    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE,
+                      GetCompositePipeline(targets.color_format, params.scene_depth != nullptr));
+    context_.GetCmdPushDescriptorSet()(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, composite_layout_.Get(),
+                                       0, kCompositeNumBindings, writes.data());
+    vkCmdPushConstants(cmd, composite_layout_.Get(), VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(push),
+                       &push);
+    vkCmdDispatch(cmd, workgroups, 1, 1);
+}
+
+void GaussianStageB::RecordDepthMerge(VkCommandBuffer cmd, const DepthMergeImages& images,
+                                      const DepthMergeParams& params) {
+    if (images.width == 0 || images.height == 0) {
+        core::ThrowError("GaussianStageB: the image is {}x{}", images.width, images.height);
+    }
+    RequireView(images.splat_depth, "splat_depth");
+    RequireView(images.splat_alpha, "splat_alpha");
+    RequireView(images.normalized, "normalized");
+    RequireView(images.linear, "linear");
+    if (!(params.far > params.near)) {
+        core::ThrowError("GaussianStageB: depth merge range [{}, {}] is empty", params.near,
+                         params.far);
+    }
+    GaussianDepthMergePushConstants push{};
+    push.image = {images.width, images.height, params.scene_depth && params.scene_depth->flip_y,
+                  0u};
+    push.range = {params.near, params.far,
+                  params.scene_depth ? params.scene_depth->near_plane : 0.f, params.min_alpha};
+    const std::array<VkDescriptorImageInfo, kDepthMergeNumBindings> infos{{
+        StorageImage(images.splat_depth),
+        StorageImage(images.splat_alpha),
+        SceneDepthDescriptor(cmd, params.scene_depth),
+        StorageImage(images.normalized),
+        StorageImage(images.linear),
+    }};
+    std::array<VkWriteDescriptorSet, kDepthMergeNumBindings> writes{};
+    for (uint32_t i = 0; i < kDepthMergeNumBindings; ++i) {
+        writes[i] = ImageWrite(i,
+                               i == kDepthMergeSceneDepthBinding ? VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE
+                                                                 : VK_DESCRIPTOR_TYPE_STORAGE_IMAGE,
+                               &infos[i]);
+    }
+    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE,
+                      GetDepthMergePipeline(params.scene_depth != nullptr));
+    context_.GetCmdPushDescriptorSet()(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, merge_layout_.Get(), 0,
+                                       kDepthMergeNumBindings, writes.data());
+    vkCmdPushConstants(cmd, merge_layout_.Get(), VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(push),
+                       &push);
+    vkCmdDispatch(cmd, (images.width + kDepthMergeWorkgroupSize - 1) / kDepthMergeWorkgroupSize,
+                  (images.height + kDepthMergeWorkgroupSize - 1) / kDepthMergeWorkgroupSize, 1);
+}
+
+}  // namespace vulkan
+}  // namespace rendering
+}  // namespace visualization
+}  // namespace open3d

@@ -1,0 +1,167 @@
+// Stage B of the Vulkan pipeline as a recorder (STYLE.md point 6): the per-tile composite
+// of the tile-sorted entries that Stage A (or a test) produced, and the depth merge for
+// depth readback. The caller owns every buffer and image; Record*() only records commands
+// (no allocation, no submit). Design, images and measured errors: docs/vulkan.md "Stage B".
+#pragma once
+
+#include <vulkan/vulkan.h>
+
+#include <array>
+#include <cstdint>
+
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/Buffer.h"
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/Image.h"
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/VulkanHandle.h"
+
+namespace open3d {
+namespace visualization {
+namespace rendering {
+namespace vulkan {
+
+class VulkanContext;
+
+/// Format of the composite's colour image (one SPIR-V module each: storage image formats
+/// are declared in the shader).
+enum class CompositeColorFormat {
+    /// VK_FORMAT_R32G32B32A32_SFLOAT: headless readback at full accuracy.
+    kRgba32f,
+    /// VK_FORMAT_R16G16B16A16_SFLOAT: the Filament overlay. Its quantisation alone costs
+    /// about 77 dB PSNR against the float32 result, below the 80 dB accuracy target.
+    kRgba16f,
+};
+
+VkFormat ToVkFormat(CompositeColorFormat format);
+
+/// Formats and usages of what the caller allocates for Stage B.
+struct StageBStorageRequirements {
+    /// shader::GaussianCompositeState (work-stealing tile counter), zeroed per dispatch.
+    VkDeviceSize state_bytes = 0;
+    VkBufferUsageFlags state_usage =
+        VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
+    /// Expected depth, alpha, median depth and the merged linear depth.
+    VkFormat scalar_format = VK_FORMAT_R32_SFLOAT;
+    /// The merged depth normalised to [0, 65535].
+    VkFormat normalized_depth_format = VK_FORMAT_R16_UINT;
+    /// Every output image needs this usage (add TRANSFER_SRC to read it back, SAMPLED to
+    /// draw it); the recorder expects them in VK_IMAGE_LAYOUT_GENERAL.
+    VkImageUsageFlags image_usage = VK_IMAGE_USAGE_STORAGE_BIT;
+};
+
+/// Stage A's results that the composite reads (all written on the GPU).
+struct StageBInputs {
+    BufferRange projected;     ///< shader::GaussianProjectedSplat [N], indexed by splat
+    BufferRange entry_keys;    ///< uint32 [capacity]: tile index, ascending
+    BufferRange entry_values;  ///< uint32 [capacity]: splat index, front to back per tile
+    /// uint32 entry count (any 4-byte aligned offset), e.g. GaussianStageACounters::entry_count.
+    /// Counts above `entry_capacity` are clamped.
+    BufferRange entry_count;
+    uint32_t entry_capacity = 0;
+};
+
+/// The composite's outputs, width x height, in VK_IMAGE_LAYOUT_GENERAL.
+struct StageBTargets {
+    uint32_t width = 0;
+    uint32_t height = 0;
+    CompositeColorFormat color_format = CompositeColorFormat::kRgba32f;
+    /// rgb = C + T * background (premultiplied when the background is black), a = 1 - T.
+    VkImageView color = VK_NULL_HANDLE;
+    /// R32F sum(alpha_i T_i z_i) / (1 - T), view-space z; 0 where no splat contributes.
+    VkImageView depth = VK_NULL_HANDLE;
+    /// R32F accumulated alpha 1 - T.
+    VkImageView alpha = VK_NULL_HANDLE;
+    /// R32F view z of the splat that brings 1 - T to >= 0.5; 0 where it never gets there.
+    VkImageView median_depth = VK_NULL_HANDLE;
+};
+
+/// A sampled depth texture in Filament's convention: reversed-Z with an infinite far plane,
+/// d = near / z_view, cleared to 0 where nothing was drawn (D32_SFLOAT or R32_SFLOAT).
+struct SceneDepthTexture {
+    VkImageView view = VK_NULL_HANDLE;
+    VkImageLayout layout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
+    /// The near plane of the projection that wrote it: z_view = near_plane / d.
+    float near_plane = 0.1f;
+    /// True when row 0 is the bottom row (a texture shared with GL / Filament).
+    bool flip_y = false;
+};
+
+struct CompositeParams {
+    std::array<float, 3> background{0.f, 0.f, 0.f};
+    /// Scene depth to test each splat against (a splat farther than the scene at a pixel is
+    /// skipped), or nullptr: then the pipeline specialised without it runs and reads no depth.
+    const SceneDepthTexture* scene_depth = nullptr;
+    /// Workgroups of the grid (workgroup i does tile i, then steals tiles from a counter):
+    /// 0 = min(tiles, kDefaultMaxWorkgroups) on GPUs, one per tile on CPU devices.
+    uint32_t max_workgroups = 0;
+};
+
+struct DepthMergeParams {
+    /// Normalisation of the R16UI output: u = round(65535 * clamp((z - near) / (far - near))).
+    float near = 0.2f;
+    float far = 100.0f;
+    /// The splat depth counts where the accumulated alpha is > 0 and >= min_alpha.
+    float min_alpha = 0.5f;
+    const SceneDepthTexture* scene_depth = nullptr;
+};
+
+/// The merge's images (VK_IMAGE_LAYOUT_GENERAL): inputs are the composite's depth (or
+/// median depth) and alpha images.
+struct DepthMergeImages {
+    uint32_t width = 0;
+    uint32_t height = 0;
+    VkImageView splat_depth = VK_NULL_HANDLE;  ///< R32F view z
+    VkImageView splat_alpha = VK_NULL_HANDLE;  ///< R32F 1 - T
+    VkImageView normalized = VK_NULL_HANDLE;   ///< R16UI out; 65535 where nothing is
+    VkImageView linear = VK_NULL_HANDLE;       ///< R32F out: merged view z, 0 where nothing is
+};
+
+class GaussianStageB {
+public:
+    /// Workgroups of the default work-stealing grid (enough to fill a large GPU; a CPU
+    /// device runs them on its threads).
+    static constexpr uint32_t kDefaultMaxWorkgroups = 1024;
+    /// maxComputeWorkGroupCount[0] guaranteed by Vulkan.
+    static constexpr uint32_t kMaxWorkgroupsPerDispatch = 65535;
+
+    /// Creates the layouts and a 1x1 placeholder depth texture (bound when no scene depth
+    /// is given). Pipelines are made on first use per colour format / scene-depth variant.
+    explicit GaussianStageB(const VulkanContext& context);
+
+    static StageBStorageRequirements GetStorageRequirements();
+
+    /// Records the composite: zero `state` (vkCmdFillBuffer), then one dispatch of a fixed
+    /// grid of workgroups that take tiles until all ceil(W/16) x ceil(H/16) are done.
+    ///
+    /// Synchronisation: before, the caller makes the inputs (and scene depth) visible to
+    /// COMPUTE_SHADER reads, has the targets in GENERAL layout, and orders earlier uses of
+    /// `state`; after, the images are COMPUTE_SHADER storage writes for the caller to barrier.
+    void RecordComposite(VkCommandBuffer cmd, const StageBInputs& inputs,
+                         const StageBTargets& targets, const BufferRange& state,
+                         const CompositeParams& params);
+
+    /// Records the depth merge (16x16 pixels per workgroup). Synchronisation as above: the
+    /// composite's writes must be made visible to COMPUTE_SHADER reads before.
+    void RecordDepthMerge(VkCommandBuffer cmd, const DepthMergeImages& images,
+                          const DepthMergeParams& params);
+
+private:
+    VkPipeline GetCompositePipeline(CompositeColorFormat format, bool scene_depth);
+    VkPipeline GetDepthMergePipeline(bool scene_depth);
+    // The view and layout to bind for `scene_depth`; records the placeholder's transition
+    // when it stands in.
+    VkDescriptorImageInfo SceneDepthDescriptor(VkCommandBuffer cmd,
+                                               const SceneDepthTexture* scene_depth) const;
+
+    const VulkanContext& context_;
+    UniqueDescriptorSetLayout composite_set_layout_;
+    UniquePipelineLayout composite_layout_;
+    UniqueDescriptorSetLayout merge_set_layout_;
+    UniquePipelineLayout merge_layout_;
+    std::array<UniquePipeline, 4> composite_;  // [format * 2 + scene depth]
+    std::array<UniquePipeline, 2> merge_;      // [scene depth]
+    Image placeholder_depth_;
+};
+
+}  // namespace vulkan
+}  // namespace rendering
+}  // namespace visualization
+}  // namespace open3d

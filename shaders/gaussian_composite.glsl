@@ -1,0 +1,209 @@
+// Stage B body shared by gaussian_composite.comp (RGBA32F colour, for readback) and
+// gaussian_composite_rgba16f.comp (RGBA16F, the Filament overlay): the storage image format
+// must be declared in GLSL (no shaderStorageImageWriteWithoutFormat), so each colour format
+// is its own SPIR-V module that defines OPEN3D_COMPOSITE_COLOR_FORMAT and includes this.
+//
+// One workgroup per 16x16 tile, one invocation per pixel. A fixed grid of workgroups steals
+// tiles from a global atomic counter until none is left. A tile's entries are the range of
+// the tile-sorted entry keys found by binary search (depth order preserved inside a tile);
+// its splats are loaded cooperatively into shared memory in batches of 256 and blended front
+// to back with exactly the 3DGS rules (docs/DESIGN.md section 3, cpu/Composite.cpp).
+#ifndef OPEN3D_GAUSSIAN_COMPOSITE_GLSL
+#define OPEN3D_GAUSSIAN_COMPOSITE_GLSL
+
+#extension GL_GOOGLE_include_directive : require
+#extension GL_EXT_samplerless_texture_functions : require
+#include "GaussianSplatContract.h"
+
+layout(local_size_x = kCompositeWorkgroupSize) in;
+
+// 0: no scene depth; the texture binding is never read (the recorder binds a placeholder).
+layout(constant_id = kSpecSceneDepth) const uint kSceneDepth = 0u;
+
+layout(push_constant, std430) uniform PushConstantsBlock {
+    GaussianCompositePushConstants pc;
+};
+
+layout(std430, set = 0, binding = kCompositeProjectedBinding) readonly buffer ProjectedBlock {
+    GaussianProjectedSplat projected[];
+};
+layout(std430, set = 0, binding = kCompositeEntryKeysBinding) readonly buffer KeysBlock {
+    uint entry_keys[];  // tile index, ascending
+};
+layout(std430, set = 0, binding = kCompositeEntryValuesBinding) readonly buffer ValuesBlock {
+    uint entry_values[];  // splat index, front to back inside a tile
+};
+layout(std430, set = 0, binding = kCompositeCountBinding) readonly buffer CountBlock {
+    uint counts[];
+};
+layout(std430, set = 0, binding = kCompositeStateBinding) coherent buffer StateBlock {
+    GaussianCompositeState state;
+};
+layout(set = 0, binding = kCompositeColorBinding, OPEN3D_COMPOSITE_COLOR_FORMAT) writeonly
+uniform image2D out_color;
+layout(set = 0, binding = kCompositeDepthBinding, r32f) writeonly uniform image2D out_depth;
+layout(set = 0, binding = kCompositeAlphaBinding, r32f) writeonly uniform image2D out_alpha;
+layout(set = 0, binding = kCompositeMedianDepthBinding, r32f) writeonly
+uniform image2D out_median_depth;
+layout(set = 0, binding = kCompositeSceneDepthBinding) uniform texture2D scene_depth;
+
+// The batch in shared memory: 48 B per splat, 12 KiB (lavapipe allows 32 KiB).
+shared vec4 s_center_depth_opacity[kCompositeBatchSize];
+shared vec4 s_conic[kCompositeBatchSize];
+shared vec4 s_color[kCompositeBatchSize];
+shared uint s_tile;
+shared uint s_range[2];
+// Pixels of the current tile that need no more splats (outside the image or T-stopped).
+shared uint s_done;
+
+// First entry whose tile is >= tile, in [0, count).
+uint LowerBound(uint tile, uint count) {
+    uint lo = 0u, hi = count;
+    while (lo < hi) {
+        uint mid = (lo + hi) >> 1u;
+        if (entry_keys[mid] < tile) {
+            lo = mid + 1u;
+        } else {
+            hi = mid;
+        }
+    }
+    return lo;
+}
+
+// View-space z of the scene at a pixel. The texture holds Filament's reversed-Z depth
+// d = near / z_view (infinite far plane, cleared to 0), so z_view = near / d; d <= 0 (clear,
+// nothing drawn) means no geometry: +inf, which no splat depth exceeds.
+float SceneViewDepth(ivec2 pixel) {
+    int y = pc.entries.z != 0u ? int(pc.image.y) - 1 - pixel.y : pixel.y;
+    float d = texelFetch(scene_depth, ivec2(pixel.x, y), 0).r;
+    return d > 0.0 ? pc.scene_depth.x / d : uintBitsToFloat(0x7F800000u);
+}
+
+// What one pixel has accumulated so far.
+struct PixelState {
+    vec2 position;  // 3DGS evaluates pixel (x, y) at (x, y), not at (x + 0.5, y + 0.5)
+    float scene_z;  // view z of the scene geometry; +inf where there is none
+    float transmittance;
+    vec3 color;
+    float weighted_depth;  // sum(alpha_i T_i z_i)
+    float weight;          // sum(alpha_i T_i): 1 - T without the cancellation of 1 - T
+    float median_depth;
+    bool median_found;
+    bool done;  // T-stopped (or outside the image): no further splat changes the pixel
+};
+
+// Blends batch slot j into the pixel with exactly the reference's rules.
+void BlendSplat(uint j, inout PixelState p) {
+    vec4 cdo = s_center_depth_opacity[j];
+    // Scene-depth test: a splat behind the opaque geometry is skipped.
+    if (kSceneDepth != 0u && cdo.z > p.scene_z) return;
+    vec4 conic = s_conic[j];
+    vec2 d = cdo.xy - p.position;
+    float power = -0.5 * (conic.x * d.x * d.x + conic.z * d.y * d.y) - conic.y * d.x * d.y;
+    if (power > 0.0) return;
+    float alpha = min(kCompositeMaxAlpha, cdo.w * exp(power));
+    if (alpha < kCompositeMinAlpha) return;
+    float next_transmittance = p.transmittance * (1.0 - alpha);
+    // Stop BEFORE blending: this splat would make the pixel (almost) opaque.
+    if (next_transmittance < kCompositeMinTransmittance) {
+        p.done = true;
+        return;
+    }
+    float weight = alpha * p.transmittance;
+    p.color += s_color[j].rgb * weight;
+    p.weighted_depth += cdo.z * weight;
+    p.weight += weight;
+    p.transmittance = next_transmittance;
+    if (!p.median_found && 1.0 - p.transmittance >= 0.5) {
+        p.median_depth = cdo.z;
+        p.median_found = true;
+    }
+}
+
+// Splats blended per iteration of the batch loop. Unrolled by hand because llvmpipe
+// (lavapipe) ends every loop of an invocation once 65535 back-edges have been taken in
+// total (gallivm's loop limiter): at 8 splats per back-edge a tile may hold ~500k entries.
+const uint kUnroll = 8u;
+
+void main() {
+    uint local = gl_LocalInvocationIndex;
+    uvec2 size = pc.image.xy;
+    uint tiles_x = pc.image.z;
+    uint num_tiles = pc.image.z * pc.image.w;
+    uint count = min(counts[pc.entries.x], pc.entries.y);
+    // Workgroup i starts with tile i, then steals tiles num_workgroups, num_workgroups + 1...
+    // from the counter: with as many workgroups as tiles (CPU devices) each does one tile.
+    uint tile = gl_WorkGroupID.x;
+
+    while (tile < num_tiles) {  // uniform: tile comes from shared memory after a barrier
+        if (local < 2u) s_range[local] = LowerBound(tile + local, count);
+        if (local == 0u) s_done = 0u;
+
+        ivec2 pixel = ivec2((tile % tiles_x) * kCompositeTileSize + local % kCompositeTileSize,
+                            (tile / tiles_x) * kCompositeTileSize + local / kCompositeTileSize);
+        bool inside = pixel.x < int(size.x) && pixel.y < int(size.y);
+        PixelState p;
+        p.position = vec2(pixel);
+        p.scene_z = uintBitsToFloat(0x7F800000u);
+        if (kSceneDepth != 0u && inside) p.scene_z = SceneViewDepth(pixel);
+        p.transmittance = 1.0;
+        p.color = vec3(0.0);
+        p.weighted_depth = 0.0;
+        p.weight = 0.0;
+        p.median_depth = 0.0;
+        p.median_found = false;
+        p.done = !inside;
+        barrier();  // s_range visible; s_done reset before the increments below
+        if (p.done) atomicAdd(s_done, 1u);
+        uint begin = s_range[0];
+        uint end = s_range[1];
+
+        for (uint batch = begin; batch < end; batch += kCompositeBatchSize) {
+            barrier();  // the previous batch is consumed and its s_done increments made
+            // Early exit when every pixel of the tile is done. Uniform: s_done is read
+            // between two barriers, where no invocation changes it.
+            if (s_done == kCompositeWorkgroupSize) break;
+            uint entry = batch + local;
+            if (entry < end) {
+                GaussianProjectedSplat splat = projected[entry_values[entry]];
+                s_center_depth_opacity[local] = splat.center_depth_opacity;
+                s_conic[local] = splat.conic;
+                s_color[local] = splat.color;
+            }
+            barrier();
+            if (p.done) continue;
+            uint batch_count = min(kCompositeBatchSize, end - batch);
+            uint j = 0u;
+            for (; j + kUnroll <= batch_count && !p.done; j += kUnroll) {
+                BlendSplat(j, p);
+                if (!p.done) BlendSplat(j + 1u, p);
+                if (!p.done) BlendSplat(j + 2u, p);
+                if (!p.done) BlendSplat(j + 3u, p);
+                if (!p.done) BlendSplat(j + 4u, p);
+                if (!p.done) BlendSplat(j + 5u, p);
+                if (!p.done) BlendSplat(j + 6u, p);
+                if (!p.done) BlendSplat(j + 7u, p);
+            }
+            for (; j < batch_count && !p.done; ++j) BlendSplat(j, p);
+            if (p.done) atomicAdd(s_done, 1u);  // once: done pixels skip later batches
+        }
+
+        if (inside) {
+            float accumulated = 1.0 - p.transmittance;
+            imageStore(out_color, pixel,
+                       vec4(p.color + p.transmittance * pc.background.rgb, accumulated));
+            imageStore(out_depth, pixel,
+                       vec4(p.weight > 0.0 ? p.weighted_depth / p.weight : 0.0));
+            imageStore(out_alpha, pixel, vec4(accumulated));
+            imageStore(out_median_depth, pixel, vec4(p.median_depth));
+        }
+        // Claim the next tile. The barrier also makes sure every invocation has read
+        // s_range and s_done before they are reset for that tile.
+        barrier();
+        if (local == 0u) s_tile = gl_NumWorkGroups.x + atomicAdd(state.next_tile, 1u);
+        barrier();
+        tile = s_tile;
+    }
+}
+
+#endif  // OPEN3D_GAUSSIAN_COMPOSITE_GLSL

@@ -1,0 +1,182 @@
+// The whole Vulkan renderer ("vulkan" backend: Stage A + Stage B + readback) against the
+// CPU reference on real scenes and analytic cases, and the skips it promises (Stage A
+// reuse). Runs on the fixture's device through borrowed handles, so the fixture's
+// validation check covers it.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "TestUtility.h"
+#include "open3d/camera/CamerasJson.h"
+#include "open3d/t/geometry/ImageMetrics.h"
+#include "open3d/t/io/PointCloudIO.h"
+#include "open3d/visualization/rendering/gaussian_splat/DefaultScene.h"
+#include "open3d/visualization/rendering/gaussian_splat/cpu/CpuBackend.h"
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/GaussianSplatVulkanBackend.h"
+#include "visualization/rendering/gaussian_splat/vulkan/VulkanTestFixture.h"
+
+namespace open3d {
+namespace tests {
+namespace {
+
+using namespace visualization::rendering;
+using vulkan::GaussianSplatVulkanBackend;
+
+class VulkanBackend : public VulkanTest {
+protected:
+    std::unique_ptr<GaussianSplatVulkanBackend> MakeBackend() {
+        vulkan::BorrowedVulkanHandles handles;
+        handles.instance = Context().GetInstance();
+        handles.physical_device = Context().GetPhysicalDevice();
+        handles.device = Context().GetDevice();
+        handles.queue = Context().GetQueue();
+        handles.queue_family_index = Context().GetQueueFamilyIndex();
+        return std::make_unique<GaussianSplatVulkanBackend>(
+            vulkan::VulkanContext::CreateFromBorrowed(handles));
+    }
+};
+
+// 99.9th percentile of |a - b| over all colour elements.
+double Percentile999(const t::geometry::Image& a, const t::geometry::Image& b) {
+    std::vector<float> d(a.NumPixels() * a.GetChannels());
+    for (size_t i = 0; i < d.size(); ++i) d[i] = std::abs(a.Data<float>()[i] - b.Data<float>()[i]);
+    const size_t k = std::min(d.size() - 1, static_cast<size_t>(std::ceil(0.999 * d.size())) - 1);
+    std::nth_element(d.begin(), d.begin() + k, d.end());
+    return d[k];
+}
+
+struct SceneCase {
+    const char* scene;
+    const char* cameras;
+};
+
+TEST_F(VulkanBackend, RealScenesMatchTheReference) {
+    // Issue 9's accuracy targets at CI sizes. Measured on lavapipe (and the same binary on an
+    // H100): PSNR 103-124 dB, max abs error <= 2.3e-3, 0-0.02% of elements over 1/255 (a
+    // near-tie in depth order flips two splats at a few pixels), p99.9 <= 1e-6.
+    const SceneCase cases[] = {{"playbot/playbot_31k.ply", "playbot/cameras.json"},
+                               {"chair/chair.splat", "chair/cameras.json"},
+                               {"biker/biker_152k.ply", "biker/cameras.json"}};
+    auto backend = MakeBackend();
+    for (const SceneCase& c : cases) {
+        if (!FileExists(DataPath(c.scene))) GTEST_SKIP() << DataPath(c.scene) << " is absent";
+        t::geometry::PointCloud cloud;
+        t::io::ReadPointCloud(DataPath(c.scene), cloud);
+        const auto views = camera::ReadCamerasJson(DataPath(c.cameras));
+        backend->SetScene(cloud);
+        for (const auto& [view, w, h] : {std::tuple{0, 96, 96}, std::tuple{5, 100, 75}}) {
+            const camera::PinholeCamera cam = views.at(view).camera.Resized(w, h);
+            const RenderOutput gpu = backend->Render(cam, {});
+            const RenderOutput ref = cpu::RenderReference(cloud, cam, {});
+            const auto m =
+                t::geometry::ComputeImageErrorMetrics(gpu.color, ref.color, 1.0, 1.0 / 255.0);
+            SCOPED_TRACE(std::string(c.scene) + " view " + std::to_string(view));
+            EXPECT_GE(m.psnr_db, 80.0);
+            EXPECT_LE(m.fraction_over_threshold, 1e-4 * 4);  // 4 channels per pixel
+            EXPECT_LE(Percentile999(gpu.color, ref.color), 0.1 / 255.0);
+            EXPECT_EQ(gpu.stats.error_flags, 0u);
+            // Depth: alpha-weighted view z where the pixel is covered.
+            const auto d = t::geometry::ComputeImageErrorMetrics(gpu.depth_expected,
+                                                                 ref.depth_expected, 1.0, 1e-3);
+            EXPECT_LE(d.fraction_over_threshold, 5e-3);
+        }
+    }
+}
+
+TEST_F(VulkanBackend, UnchangedViewReusesStageAAndGivesTheSameImage) {
+    auto backend = MakeBackend();
+    const t::geometry::PointCloud cloud = CreateDefaultGaussianSplatScene();
+    backend->SetScene(cloud);
+    const camera::PinholeCamera cam = GetDefaultSceneCamera().Resized(80, 60);
+    const RenderOutput first = backend->Render(cam, {});
+    const RenderOutput second = backend->Render(cam, {});
+    EXPECT_EQ(backend->GetCounters().geometry_runs, 1);
+    EXPECT_EQ(backend->GetCounters().geometry_reuses, 1);
+    EXPECT_TRUE(second.stats.geometry_reused);
+    EXPECT_TRUE(first.color.AsTensor() == second.color.AsTensor());
+    // Another view, or reuse switched off, runs Stage A again.
+    RenderConfig no_reuse;
+    no_reuse.reuse_geometry = false;
+    backend->Render(cam, no_reuse);
+    backend->Render(cam.Resized(64, 48), {});
+    EXPECT_EQ(backend->GetCounters().geometry_runs, 3);
+}
+
+TEST_F(VulkanBackend, EmptyViewIsBackgroundOnly) {
+    auto backend = MakeBackend();
+    backend->SetScene(CreateDefaultGaussianSplatScene());
+    camera::LookAtCamera away;
+    away.eye = Eigen::Vector3d(0, 0, 50);
+    away.center = Eigen::Vector3d(0, 0, 100);  // looking away from the scene
+    RenderConfig config;
+    config.background = Eigen::Vector3d(0.25, 0.5, 0.75);
+    const RenderOutput out =
+        backend->Render(camera::PinholeCamera::FromLookAt(away, 33, 17), config);
+    EXPECT_EQ(out.stats.num_visible, 0);
+    EXPECT_EQ(out.stats.num_tile_entries, 0);
+    for (int64_t i = 0; i < out.color.NumPixels(); ++i) {
+        ASSERT_EQ(out.color.Data<float>()[i * 4 + 0], 0.25f);
+        ASSERT_EQ(out.color.Data<float>()[i * 4 + 2], 0.75f);
+        ASSERT_EQ(out.color.Data<float>()[i * 4 + 3], 0.0f);
+    }
+}
+
+TEST_F(VulkanBackend, SceneDepthOccludesLikeTheReference) {
+    auto backend = MakeBackend();
+    const t::geometry::PointCloud cloud = CreateDefaultGaussianSplatScene();
+    backend->SetScene(cloud);
+    const camera::PinholeCamera cam = GetDefaultSceneCamera().Resized(64, 48);
+    // A wall at the depth of the scene's middle over the left half of the image.
+    const RenderOutput plain = cpu::RenderReference(cloud, cam, {});
+    t::geometry::Image wall(48, 64, 1, core::Dtype::Float32);
+    double mid = 0;
+    int64_t covered = 0;
+    for (int64_t i = 0; i < plain.depth_expected.NumPixels(); ++i) {
+        if (plain.depth_expected.Data<float>()[i] > 0) {
+            mid += plain.depth_expected.Data<float>()[i];
+            ++covered;
+        }
+    }
+    ASSERT_GT(covered, 0);
+    mid /= covered;
+    for (int y = 0; y < 48; ++y) {
+        for (int x = 0; x < 64; ++x) wall.At<float>(y, x) = x < 32 ? float(mid) : 0.0f;
+    }
+    CompositeInputs inputs;
+    inputs.scene_depth = &wall;
+    backend->RenderGeometryStage(cam, {});
+    RenderOutput gpu;
+    backend->RenderCompositeStage(gpu, inputs);
+    cpu::CpuBackend reference;
+    reference.SetScene(cloud);
+    reference.RenderGeometryStage(cam, {});
+    RenderOutput ref;
+    reference.RenderCompositeStage(ref, inputs);
+    // The wall is converted to reversed-Z (near / z) and back on the GPU: a splat within
+    // float rounding of the wall may flip; measured PSNR 90+ dB.
+    EXPECT_GE(t::geometry::ComputePSNR(gpu.color, ref.color, 1.0), 60.0);
+    EXPECT_LT(t::geometry::ComputePSNR(gpu.color, plain.color, 1.0), 40.0);  // the wall matters
+}
+
+TEST_F(VulkanBackend, CompactStorageStaysWithinItsBudget) {
+    OPEN3D_REQUIRE_DATA("playbot/playbot_31k.ply");
+    t::geometry::PointCloud cloud;
+    t::io::ReadPointCloud(DataPath("playbot/playbot_31k.ply"), cloud);
+    const auto cam =
+        camera::ReadCamerasJson(DataPath("playbot/cameras.json")).at(0).camera.Resized(96, 96);
+    auto backend = MakeBackend();
+    backend->SetScene(cloud);
+    RenderConfig compact;
+    compact.compact_storage = true;
+    const RenderOutput out = backend->Render(cam, compact);
+    const RenderOutput ref = cpu::RenderReference(cloud, cam, {});
+    // Issue 9: compact >= 55 dB (measured 82-84 dB at 96x96 and 128x128).
+    EXPECT_GE(t::geometry::ComputePSNR(out.color, ref.color, 1.0), 55.0);
+    EXPECT_LE(static_cast<double>(out.stats.gpu_scene_bytes) / cloud.NumPoints(), 140.0);
+    EXPECT_EQ(backend->GetCounters().scene_uploads, 2);  // exact at SetScene, then compact
+}
+
+}  // namespace
+}  // namespace tests
+}  // namespace open3d
