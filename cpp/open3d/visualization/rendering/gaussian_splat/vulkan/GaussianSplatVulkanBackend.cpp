@@ -285,9 +285,7 @@ void GaussianSplatVulkanBackend::RenderGeometryStage(const camera::PinholeCamera
     VkCommandBuffer cmd = stage_a_cmd_.Get();
     stage_a_cmd_.Begin();
     stage_a_timestamps_.RecordReset(cmd);
-    stage_a_timestamps_.RecordBegin(cmd, TimedPass::kProject);
-    stage_a_.Record(cmd, SceneBuffers(), ViewBuffers(), params);
-    stage_a_timestamps_.RecordEnd(cmd, TimedPass::kProject);
+    stage_a_.Record(cmd, SceneBuffers(), ViewBuffers(), params, &stage_a_timestamps_);
     stage_a_cmd_.End();
     stage_a_fence_ = CreateFence(*context_);
     // Fire and forget: Stage B (or the next geometry stage) waits on the fence.
@@ -312,10 +310,8 @@ void GaussianSplatVulkanBackend::RenderCompositeStage(RenderOutput& output,
         Wait(*context_, stage_a_fence_.Get());
         geometry_.in_flight = false;
         const std::vector<double> ms = stage_a_timestamps_.ReadMilliseconds();
-        // Stage A is one recorded sequence; its projection and sorting share one timer until
-        // the recorder exposes the split.
         geometry_.gpu_project_ms = std::max(0.0, ms[static_cast<uint32_t>(TimedPass::kProject)]);
-        geometry_.gpu_sort_ms = 0.0;
+        geometry_.gpu_sort_ms = std::max(0.0, ms[static_cast<uint32_t>(TimedPass::kSort)]);
     }
     EnsureTargets(w, h);
 

@@ -145,7 +145,9 @@ void GaussianStageA::PushBindings(VkCommandBuffer cmd, const StageASceneBuffers&
 }
 
 void GaussianStageA::Record(VkCommandBuffer cmd, const StageASceneBuffers& scene,
-                            const StageAViewBuffers& buffers, const GaussianViewParams& params) {
+                            const StageAViewBuffers& buffers, const GaussianViewParams& params,
+                            const GpuTimestamps* timestamps) {
+    if (timestamps) timestamps->RecordBegin(cmd, TimedPass::kProject);
     const uint32_t n = scene.num_splats;
     const uint32_t capacity = params.flags.w;  // entries allocated
     const bool packed_key = UsesPackedSortKey(params);
@@ -186,6 +188,10 @@ void GaussianStageA::Record(VkCommandBuffer cmd, const StageASceneBuffers& scene
     vkCmdPushConstants(cmd, layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(args), &args);
     vkCmdDispatch(cmd, 1, 1, 1);
     ComputeBarrier(cmd);
+    if (timestamps) {
+        timestamps->RecordEnd(cmd, TimedPass::kProject);
+        timestamps->RecordBegin(cmd, TimedPass::kSort);
+    }
 
     // 3. Exact depth order with ties by splat index: the list was appended in subgroup
     // order, so first sort it by splat index (only the bits an index can have), then
@@ -252,6 +258,7 @@ void GaussianStageA::Record(VkCommandBuffer cmd, const StageASceneBuffers& scene
         vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, unpack_keys_.Get());
         vkCmdDispatchIndirect(cmd, counters, emit_args);
     }
+    if (timestamps) timestamps->RecordEnd(cmd, TimedPass::kSort);
 }
 
 }  // namespace vulkan

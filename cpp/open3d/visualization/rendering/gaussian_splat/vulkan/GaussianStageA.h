@@ -14,6 +14,7 @@
 
 #include "open3d/visualization/rendering/gaussian_splat/GaussianSplatDataPacking.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/Buffer.h"
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/GpuTimestamps.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/RadixSort.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/VulkanHandle.h"
 #include "shaders/GaussianSplatContract.h"
@@ -104,8 +105,11 @@ public:
     /// Synchronisation: the caller orders earlier uses of these buffers before Record (and
     /// makes scene uploads visible to compute reads); afterwards all results are
     /// COMPUTE_SHADER storage writes (the counters also) for the caller to barrier.
+    /// With  (reset by the caller in this command buffer), the projection and
+    /// its dispatch arguments are timed as TimedPass::kProject and everything after as kSort.
     void Record(VkCommandBuffer cmd, const StageASceneBuffers& scene,
-                const StageAViewBuffers& buffers, const shader::GaussianViewParams& params);
+                const StageAViewBuffers& buffers, const shader::GaussianViewParams& params,
+                const GpuTimestamps* timestamps = nullptr);
 
 private:
     VkPipeline GetProjectPipeline(uint32_t sh_degree, bool antialias, SplatPrecision precision);
