@@ -292,6 +292,19 @@ OPEN3D_SHADER_FUNC uint PackedSortKey(uint tile, float norm_depth, uint tile_bit
     uint depth_field = (floatBitsToUint(norm_depth) << 1u) >> tile_bits;
     return (tile << (kSortKeyBits - tile_bits)) | depth_field;
 }
+
+// The view depth that orders splats (both sorts) and that the composite reads: float32 with
+// a fixed operation order, every product and sum rounded (`precise`: no fused multiply-add,
+// no reordering), from row 2 of the float32 world-to-camera matrix and the float32
+// position. The CPU reference sorts by the same function, so near-tied splats come out in
+// the same order on every device (a double depth rounded once differs by an ulp and flips
+// pairs; docs/vulkan.md "Sort depth").
+OPEN3D_SHADER_FUNC float SortDepth(float r0, float r1, float r2, float t, float x, float y,
+                                   float z) {
+    OPEN3D_SHADER_PRECISE float xy = r0 * x + r1 * y;
+    OPEN3D_SHADER_PRECISE float d = (xy + r2 * z) + t;
+    return d;
+}
 #undef OPEN3D_SHADER_FUNC
 #undef OPEN3D_SHADER_PRECISE
 

@@ -188,13 +188,16 @@ bool Project(uint i, out float depth) {
 
     vec3 color = ShColor(i, p);
     GaussianProjectedSplat out_splat;
-    out_splat.center_depth_opacity = vec4(px, py, v.z, position_opacity.w * opacity_scale);
+    vec4 r2 = view.world_to_camera_row2;
+    float sort_depth = SortDepth(r2.x, r2.y, r2.z, r2.w, p.x, p.y, p.z);
+    out_splat.center_depth_opacity =
+        vec4(px, py, sort_depth, position_opacity.w * opacity_scale);
     out_splat.conic = vec4(conic, 0.0);
     out_splat.color = vec4(color, 0.0);
     out_splat.tiles = uvec4(rect_min.x | (rect_min.y << 16u), rect_max.x | (rect_max.y << 16u),
                             num_tiles, radius);
     projected[i] = out_splat;
-    depth = v.z;
+    depth = sort_depth;
     return true;
 }
 

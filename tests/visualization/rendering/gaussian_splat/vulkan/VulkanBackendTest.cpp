@@ -25,7 +25,7 @@ using vulkan::GaussianSplatVulkanBackend;
 
 class VulkanBackend : public VulkanTest {
 protected:
-    std::unique_ptr<GaussianSplatVulkanBackend> MakeBackend() {
+    std::unique_ptr<GaussianSplatVulkanBackend> MakeBackend(uint32_t entry_capacity = 1u << 22) {
         vulkan::BorrowedVulkanHandles handles;
         handles.instance = Context().GetInstance();
         handles.physical_device = Context().GetPhysicalDevice();
@@ -33,7 +33,7 @@ protected:
         handles.queue = Context().GetQueue();
         handles.queue_family_index = Context().GetQueueFamilyIndex();
         return std::make_unique<GaussianSplatVulkanBackend>(
-            vulkan::VulkanContext::CreateFromBorrowed(handles));
+            vulkan::VulkanContext::CreateFromBorrowed(handles), entry_capacity);
     }
 };
 
@@ -101,6 +101,29 @@ TEST_F(VulkanBackend, UnchangedViewReusesStageAAndGivesTheSameImage) {
     backend->Render(cam, no_reuse);
     backend->Render(cam.Resized(64, 48), {});
     EXPECT_EQ(backend->GetCounters().geometry_runs, 3);
+}
+
+TEST_F(VulkanBackend, EntryBuffersGrowInsteadOfDroppingEntries) {
+    // Start with room for 1,000 entries; the default scene at 80x60 needs ~15,000. The frame
+    // must come out complete (no flag), identical to one rendered with ample buffers.
+    const t::geometry::PointCloud cloud = CreateDefaultGaussianSplatScene();
+    const camera::PinholeCamera cam = GetDefaultSceneCamera().Resized(80, 60);
+    auto small = MakeBackend(1000);
+    small->SetScene(cloud);
+    const RenderOutput grown = small->Render(cam, {});
+    EXPECT_EQ(small->GetCounters().capacity_growths, 1);
+    EXPECT_EQ(grown.stats.error_flags, 0u);
+    EXPECT_GT(grown.stats.num_tile_entries, 1000);
+    auto ample = MakeBackend();
+    ample->SetScene(cloud);
+    const RenderOutput reference = ample->Render(cam, {});
+    EXPECT_EQ(grown.stats.num_tile_entries, reference.stats.num_tile_entries);
+    EXPECT_TRUE(grown.color.AsTensor() == reference.color.AsTensor());
+    // The config limit still binds: entries past it are dropped and flagged, not grown.
+    RenderConfig limited;
+    limited.max_tile_entries_total = 500;
+    EXPECT_NE(small->Render(cam, limited).stats.error_flags & kEntriesDropped, 0u);
+    EXPECT_EQ(small->GetCounters().capacity_growths, 1);
 }
 
 TEST_F(VulkanBackend, EmptyViewIsBackgroundOnly) {

@@ -7,6 +7,7 @@
 #include "open3d/core/Exception.h"
 #include "open3d/core/ParallelFor.h"
 #include "open3d/t/geometry/SphericalHarmonics.h"
+#include "shaders/GaussianSplatContract.h"
 
 namespace open3d {
 namespace visualization {
@@ -83,6 +84,10 @@ ProjectedSplat ProjectOne(const ViewParams& view, const RenderConfig& config, in
     const Eigen::Vector3d p(position[0], position[1], position[2]);
     const Eigen::Vector3d v = view.rotation * p + view.translation;
     out.depth = v.z();
+    const Eigen::Matrix3d& r = view.rotation;
+    out.sort_depth =
+        shader::SortDepth(float(r(2, 0)), float(r(2, 1)), float(r(2, 2)),
+                          float(view.translation.z()), position[0], position[1], position[2]);
     if (!(v.z() > config.near_plane)) {
         out.cull = CullReason::kNearPlane;
         return out;

@@ -29,6 +29,9 @@ struct ProjectedSplat {
     CullReason cull = CullReason::kNearPlane;
     double x = 0.0, y = 0.0;  ///< centre in pixels: fx * X / Z + cx, fy * Y / Z + cy
     double depth = 0.0;       ///< view-space Z
+    /// The depth that orders splats: shader::SortDepth, float32 with a fixed operation
+    /// order, exactly as the GPU computes it (ties broken by splat index).
+    float sort_depth = 0.0f;
     /// 2D covariance after the +0.3 dilation: [[cov_a, cov_b], [cov_b, cov_c]] (pixels^2).
     double cov_a = 0.0, cov_b = 0.0, cov_c = 0.0;
     /// Inverse of the dilated covariance: [[conic_a, conic_b], [conic_b, conic_c]].

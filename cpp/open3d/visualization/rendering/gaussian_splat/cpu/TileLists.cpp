@@ -8,8 +8,8 @@ namespace rendering {
 namespace cpu {
 
 std::vector<uint32_t> SortVisibleByDepth(const std::vector<ProjectedSplat>& splats) {
-    // GPU keys hold float32 depths: splats whose depths round to the same float tie
-    // there and fall back to the splat index, so the reference sorts the same way.
+    // The GPU's key: shader::SortDepth (float32, fixed operation order), ties by splat
+    // index, so near-tied splats are ordered identically on both sides.
     struct Key {
         float depth;
         uint32_t index;
@@ -18,7 +18,7 @@ std::vector<uint32_t> SortVisibleByDepth(const std::vector<ProjectedSplat>& spla
     keys.reserve(splats.size());
     for (size_t i = 0; i < splats.size(); ++i) {
         if (splats[i].IsVisible()) {
-            keys.push_back({static_cast<float>(splats[i].depth), static_cast<uint32_t>(i)});
+            keys.push_back({splats[i].sort_depth, static_cast<uint32_t>(i)});
         }
     }
     std::sort(keys.begin(), keys.end(), [](const Key& a, const Key& b) {

@@ -17,9 +17,6 @@ namespace {
 
 constexpr VkBufferUsageFlags kTransfer =
     VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
-// Tile entries allocated up front: enough for the real scenes at 4K (playbot_125k at 1080p
-// emits 1.26M); larger frames grow the buffers to the config limit.
-constexpr uint32_t kInitialEntryCapacity = 1u << 22;
 
 double MsSince(std::chrono::steady_clock::time_point start) {
     return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
@@ -68,13 +65,15 @@ void RegisterVulkanBackend() {
     });
 }
 
-GaussianSplatVulkanBackend::GaussianSplatVulkanBackend(std::unique_ptr<VulkanContext> context)
+GaussianSplatVulkanBackend::GaussianSplatVulkanBackend(std::unique_ptr<VulkanContext> context,
+                                                       uint32_t initial_entry_capacity)
     : context_(std::move(context)),
       pool_(*context_),
       stage_a_(*context_),
       stage_b_(*context_),
       stage_a_timestamps_(*context_),
-      stage_b_timestamps_(*context_) {
+      stage_b_timestamps_(*context_),
+      initial_entry_capacity_(std::max(1u, initial_entry_capacity)) {
     const StageBStorageRequirements need = GaussianStageB::GetStorageRequirements();
     composite_state_ = Buffer(*context_, need.state_bytes, need.state_usage, MemoryUsage::kDevice);
 }
@@ -269,7 +268,7 @@ void GaussianSplatVulkanBackend::RenderGeometryStage(const camera::PinholeCamera
     // The largest capacity this config allows, within what the sorts address.
     const uint64_t wanted =
         std::min<uint64_t>(config.max_tile_entries_total, shader::kScanSaturation);
-    EnsureViewBuffers(static_cast<uint32_t>(std::min<uint64_t>(wanted, kInitialEntryCapacity)));
+    EnsureViewBuffers(static_cast<uint32_t>(std::min<uint64_t>(wanted, initial_entry_capacity_)));
 
     ViewPackingInputs inputs;
     inputs.num_splats = layout_.num_splats;
@@ -410,6 +409,24 @@ void GaussianSplatVulkanBackend::RenderCompositeStage(RenderOutput& output,
 
     shader::GaussianStageACounters gpu_counters{};
     std::memcpy(&gpu_counters, counters_readback_.GetMapped(), sizeof(gpu_counters));
+    // The allocation, not the config, cut this frame short: grow the entry buffers to what
+    // it asked for (plus a quarter, so a moving camera does not regrow every frame) and
+    // render it again. Stage A reported the full request, so one retry suffices.
+    const uint64_t limit =
+        std::min<uint64_t>(geometry_.config.max_tile_entries_total, shader::kScanSaturation - 1);
+    if ((gpu_counters.error_flags & kCountsClamped) && entry_capacity_ < limit && !growing_) {
+        const uint64_t asked = gpu_counters.requested_entries;
+        EnsureViewBuffers(static_cast<uint32_t>(std::min<uint64_t>(limit, asked + asked / 4)));
+        ++counters_.capacity_growths;
+        growing_ = true;
+        const camera::PinholeCamera camera = geometry_.camera;
+        const RenderConfig config = geometry_.config;
+        geometry_.valid = false;
+        RenderGeometryStage(camera, config);
+        RenderCompositeStage(output, inputs);
+        growing_ = false;
+        return;
+    }
     const uint32_t new_flags = gpu_counters.error_flags & ~warned_flags_;
     for (uint32_t bit : {kEntriesDropped, kCountsClamped}) {
         if (new_flags & bit)

@@ -31,8 +31,11 @@ void RegisterVulkanBackend();
 
 class GaussianSplatVulkanBackend final : public GaussianSplatBackend {
 public:
-    /// Uses `context` (owned) for every GPU object.
-    explicit GaussianSplatVulkanBackend(std::unique_ptr<VulkanContext> context);
+    /// Uses `context` (owned) for every GPU object. Tile-entry buffers start at
+    /// `initial_entry_capacity` entries and grow to what a frame asks for (up to
+    /// RenderConfig::max_tile_entries_total): that frame is rendered again, once.
+    explicit GaussianSplatVulkanBackend(std::unique_ptr<VulkanContext> context,
+                                        uint32_t initial_entry_capacity = 1u << 22);
     ~GaussianSplatVulkanBackend() override;
 
     std::string GetName() const override { return "vulkan"; }
@@ -51,7 +54,7 @@ public:
         int64_t geometry_runs = 0;     ///< Stage A recorded
         int64_t geometry_reuses = 0;   ///< Stage A skipped (nothing changed)
         int64_t composites = 0;        ///< Stage B recorded
-        int64_t empty_composites = 0;  ///< frames with no tile entry: background written on the CPU
+        int64_t capacity_growths = 0;  ///< frames re-rendered with larger entry buffers
     };
     const Counters& GetCounters() const { return counters_; }
     const VulkanContext& GetContext() const { return *context_; }
@@ -103,6 +106,8 @@ private:
     CommandBuffer stage_a_cmd_;
     UniqueFence stage_a_fence_;
     uint32_t warned_flags_ = 0;
+    uint32_t initial_entry_capacity_ = 0;
+    bool growing_ = false;
 };
 
 }  // namespace vulkan
