@@ -15,9 +15,6 @@ namespace vulkan {
 
 namespace {
 
-constexpr VkBufferUsageFlags kTransfer =
-    VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
-
 double MsSince(std::chrono::steady_clock::time_point start) {
     return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
         .count();
@@ -83,20 +80,6 @@ GaussianSplatVulkanBackend::~GaussianSplatVulkanBackend() {
     if (geometry_.in_flight) Wait(*context_, stage_a_fence_.Get());
 }
 
-Buffer GaussianSplatVulkanBackend::Upload(const void* data, VkDeviceSize bytes) {
-    const VkDeviceSize size = std::max<VkDeviceSize>(bytes, 16);
-    Buffer device(*context_, size, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | kTransfer,
-                  MemoryUsage::kDevice);
-    Buffer staging(*context_, size, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, MemoryUsage::kHostUpload);
-    std::memset(staging.GetMapped(), 0, size);
-    if (bytes > 0) std::memcpy(staging.GetMapped(), data, bytes);
-    SubmitAndWait(*context_, pool_, [&](VkCommandBuffer cmd) {
-        const VkBufferCopy region{0, 0, size};
-        vkCmdCopyBuffer(cmd, staging.Get(), device.Get(), 1, &region);
-    });
-    return device;
-}
-
 void GaussianSplatVulkanBackend::SetScene(const t::geometry::PointCloud& cloud) {
     cloud.ValidateGaussianSplat();
     if (geometry_.in_flight) Wait(*context_, stage_a_fence_.Get());
@@ -109,28 +92,16 @@ void GaussianSplatVulkanBackend::SetScene(const t::geometry::PointCloud& cloud) 
 void GaussianSplatVulkanBackend::UploadScene(SplatPrecision precision) {
     PackedGaussianSplats packed = PackGaussianSplatAttrs(*cloud_, precision);
     if (!visibility_mask_.empty()) packed.visibility = visibility_mask_;
-    positions_ = Upload(packed.positions.data(), packed.positions.size() * sizeof(float));
-    shape_ = Upload(packed.shape.data(), packed.shape.size() * 4);
-    sh_ = Upload(packed.sh.data(), packed.sh.size() * 4);  // degree 0: a 16-byte placeholder
-    visibility_ = Upload(packed.visibility.data(), packed.visibility.size() * 4);
-    packed.positions.clear();
-    packed.shape.clear();
-    packed.sh.clear();
-    packed.visibility.clear();
-    layout_ = std::move(packed);
+    stage_a_resources_.UploadScene(*context_, pool_, packed);
     ++counters_.scene_uploads;
 }
 
 void GaussianSplatVulkanBackend::SetVisibility(const std::vector<uint32_t>& mask) {
     if (!cloud_) core::ThrowError("Vulkan backend: SetVisibility before SetScene");
-    const size_t words = (static_cast<size_t>(layout_.num_splats) + 31) / 32;
-    if (mask.size() != words) {
-        core::ThrowError("Vulkan backend: visibility mask has {} words, the scene needs {}",
-                         mask.size(), words);
-    }
     if (geometry_.in_flight) Wait(*context_, stage_a_fence_.Get());
+    geometry_.in_flight = false;
+    stage_a_resources_.UploadVisibility(*context_, pool_, mask);
     visibility_mask_ = mask;
-    visibility_ = Upload(mask.data(), mask.size() * 4);
     geometry_.valid = false;  // hidden splats change Stage A's output
 }
 
@@ -138,62 +109,23 @@ void GaussianSplatVulkanBackend::ReleaseResources() {
     if (geometry_.in_flight) Wait(*context_, stage_a_fence_.Get());
     geometry_ = GeometryState{};
     cloud_.reset();
-    layout_ = PackedGaussianSplats{};
-    for (Buffer* buffer : {&positions_,
-                           &shape_,
-                           &sh_,
-                           &visibility_,
-                           &view_params_,
-                           &projected_,
-                           &counters_buffer_,
-                           &depth_keys_,
-                           &splat_indices_,
-                           &scan_,
-                           &entry_keys_,
-                           &entry_values_,
-                           &keys_alt_,
-                           &values_alt_,
-                           &histogram_,
-                           &sort_params_,
-                           &counters_readback_,
-                           &color_readback_,
-                           &depth_readback_,
-                           &alpha_readback_,
-                           &median_readback_}) {
+    visibility_mask_.clear();
+    stage_a_resources_ = StageAResources();
+    for (Buffer* buffer : {&counters_readback_, &color_readback_, &depth_readback_,
+                           &alpha_readback_, &median_readback_}) {
         *buffer = Buffer();
     }
     for (Image* image : {&color_, &depth_, &alpha_, &median_}) *image = Image();
-    entry_capacity_ = 0;
     width_ = height_ = 0;
 }
 
 void GaussianSplatVulkanBackend::EnsureViewBuffers(uint32_t entry_capacity) {
-    const uint32_t n = static_cast<uint32_t>(layout_.num_splats);
-    if (projected_ && entry_capacity <= entry_capacity_ &&
-        projected_.GetSize() >= GaussianStageA::GetStorageRequirements(n, 1).projected_bytes) {
+    if (stage_a_resources_.HasView() && entry_capacity <= stage_a_resources_.EntryCapacity()) {
         return;
     }
-    const StageAStorageRequirements need =
-        GaussianStageA::GetStorageRequirements(n, entry_capacity);
-    const auto make = [&](VkDeviceSize bytes, VkBufferUsageFlags usage) {
-        return Buffer(*context_, std::max<VkDeviceSize>(bytes, 16), usage | kTransfer,
-                      MemoryUsage::kDevice);
-    };
-    view_params_ = make(need.view_params_bytes, need.view_params_usage);
-    projected_ = make(need.projected_bytes, need.usage);
-    counters_buffer_ = make(need.counters_bytes, need.counters_usage);
-    depth_keys_ = make(need.depth_keys_bytes, need.usage);
-    splat_indices_ = make(need.splat_indices_bytes, need.usage);
-    scan_ = make(need.scan_bytes, need.usage);
-    entry_keys_ = make(need.entry_keys_bytes, need.usage);
-    entry_values_ = make(need.entry_values_bytes, need.usage);
-    keys_alt_ = make(need.sort.keys_alt_bytes, need.sort.scratch_usage);
-    values_alt_ = make(need.sort.values_alt_bytes, need.sort.scratch_usage);
-    histogram_ = make(need.sort.histogram_bytes, need.sort.scratch_usage);
-    sort_params_ = make(need.sort.params_bytes, need.sort.params_usage);
-    counters_readback_ = Buffer(*context_, need.counters_bytes, VK_BUFFER_USAGE_TRANSFER_DST_BIT,
-                                MemoryUsage::kHostReadback);
-    entry_capacity_ = entry_capacity;
+    stage_a_resources_.AllocateView(*context_, entry_capacity);
+    counters_readback_ = Buffer(*context_, sizeof(shader::GaussianStageACounters),
+                                VK_BUFFER_USAGE_TRANSFER_DST_BIT, MemoryUsage::kHostReadback);
 }
 
 void GaussianSplatVulkanBackend::EnsureTargets(uint32_t width, uint32_t height) {
@@ -216,34 +148,6 @@ void GaussianSplatVulkanBackend::EnsureTargets(uint32_t width, uint32_t height) 
     height_ = height;
 }
 
-StageASceneBuffers GaussianSplatVulkanBackend::SceneBuffers() const {
-    StageASceneBuffers scene;
-    scene.positions = positions_.Range();
-    scene.shape = shape_.Range();
-    scene.sh = sh_.Range();
-    scene.visibility = visibility_.Range();
-    scene.num_splats = static_cast<uint32_t>(layout_.num_splats);
-    scene.packed_sh_degree = layout_.sh_degree;
-    scene.sh_words_per_splat = layout_.sh_words_per_splat;
-    scene.precision = layout_.precision;
-    return scene;
-}
-
-StageAViewBuffers GaussianSplatVulkanBackend::ViewBuffers() const {
-    StageAViewBuffers view;
-    view.view_params = view_params_.Range();
-    view.projected = projected_.Range();
-    view.counters = counters_buffer_.Range();
-    view.depth_keys = depth_keys_.Range();
-    view.splat_indices = splat_indices_.Range();
-    view.scan = scan_.Range();
-    view.entry_keys = entry_keys_.Range();
-    view.entry_values = entry_values_.Range();
-    view.sort_scratch = {keys_alt_.Range(), values_alt_.Range(), histogram_.Range(),
-                         sort_params_.Range()};
-    return view;
-}
-
 void GaussianSplatVulkanBackend::RenderGeometryStage(const camera::PinholeCamera& camera,
                                                      const RenderConfig& config) {
     if (!cloud_) core::ThrowError("Vulkan backend: RenderGeometryStage before SetScene");
@@ -251,7 +155,7 @@ void GaussianSplatVulkanBackend::RenderGeometryStage(const camera::PinholeCamera
     const auto start = std::chrono::steady_clock::now();
     const SplatPrecision precision =
         config.compact_storage ? SplatPrecision::kCompact : SplatPrecision::kExact;
-    if (precision != layout_.precision) {
+    if (precision != stage_a_resources_.Layout().precision) {
         if (geometry_.in_flight) Wait(*context_, stage_a_fence_.Get());
         geometry_.in_flight = false;
         UploadScene(precision);
@@ -270,21 +174,14 @@ void GaussianSplatVulkanBackend::RenderGeometryStage(const camera::PinholeCamera
         std::min<uint64_t>(config.max_tile_entries_total, shader::kScanSaturation);
     EnsureViewBuffers(static_cast<uint32_t>(std::min<uint64_t>(wanted, initial_entry_capacity_)));
 
-    ViewPackingInputs inputs;
-    inputs.num_splats = layout_.num_splats;
-    inputs.packed_sh_degree = layout_.sh_degree;
-    inputs.precision = layout_.precision;
-    inputs.sh_words_per_splat = layout_.sh_words_per_splat;
-    inputs.entry_capacity = entry_capacity_;
-    inputs.center_min = layout_.center_min;
-    inputs.center_max = layout_.center_max;
-    const shader::GaussianViewParams params = PackGaussianViewParams(camera, config, inputs);
+    const shader::GaussianViewParams params = stage_a_resources_.ViewParams(camera, config);
 
     stage_a_cmd_ = pool_.Allocate();
     VkCommandBuffer cmd = stage_a_cmd_.Get();
     stage_a_cmd_.Begin();
     stage_a_timestamps_.RecordReset(cmd);
-    stage_a_.Record(cmd, SceneBuffers(), ViewBuffers(), params, &stage_a_timestamps_);
+    stage_a_.Record(cmd, stage_a_resources_.Scene(), stage_a_resources_.View(), params,
+                    &stage_a_timestamps_);
     stage_a_cmd_.End();
     stage_a_fence_ = CreateFence(*context_);
     // Fire and forget: Stage B (or the next geometry stage) waits on the fence.
@@ -369,15 +266,16 @@ void GaussianSplatVulkanBackend::RenderCompositeStage(RenderOutput& output,
                            VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);
     }
     const VkBufferCopy counters_region{0, 0, counters_readback_.GetSize()};
-    vkCmdCopyBuffer(cmd, counters_buffer_.Get(), counters_readback_.Get(), 1, &counters_region);
+    vkCmdCopyBuffer(cmd, stage_a_resources_.counters.Get(), counters_readback_.Get(), 1,
+                    &counters_region);
 
     StageBInputs stage_b_inputs;
-    stage_b_inputs.projected = projected_.Range();
-    stage_b_inputs.entry_keys = entry_keys_.Range();
-    stage_b_inputs.entry_values = entry_values_.Range();
-    stage_b_inputs.entry_count = counters_buffer_.Range(
+    stage_b_inputs.projected = stage_a_resources_.projected.Range();
+    stage_b_inputs.entry_keys = stage_a_resources_.entry_keys.Range();
+    stage_b_inputs.entry_values = stage_a_resources_.entry_values.Range();
+    stage_b_inputs.entry_count = stage_a_resources_.counters.Range(
         offsetof(shader::GaussianStageACounters, entry_count), sizeof(uint32_t));
-    stage_b_inputs.entry_capacity = entry_capacity_;
+    stage_b_inputs.entry_capacity = stage_a_resources_.EntryCapacity();
     StageBTargets targets;
     targets.width = w;
     targets.height = h;
@@ -414,7 +312,8 @@ void GaussianSplatVulkanBackend::RenderCompositeStage(RenderOutput& output,
     // render it again. Stage A reported the full request, so one retry suffices.
     const uint64_t limit =
         std::min<uint64_t>(geometry_.config.max_tile_entries_total, shader::kScanSaturation - 1);
-    if ((gpu_counters.error_flags & kCountsClamped) && entry_capacity_ < limit && !growing_) {
+    if ((gpu_counters.error_flags & kCountsClamped) && stage_a_resources_.EntryCapacity() < limit &&
+        !growing_) {
         const uint64_t asked = gpu_counters.requested_entries;
         EnsureViewBuffers(static_cast<uint32_t>(std::min<uint64_t>(limit, asked + asked / 4)));
         ++counters_.capacity_growths;
@@ -444,7 +343,7 @@ void GaussianSplatVulkanBackend::RenderCompositeStage(RenderOutput& output,
 
     RenderStats& s = output.stats;
     s = RenderStats{};
-    s.num_splats = layout_.num_splats;
+    s.num_splats = stage_a_resources_.Layout().num_splats;
     s.num_visible = gpu_counters.visible_count;
     s.num_tile_entries = gpu_counters.entry_count;
     s.error_flags = gpu_counters.error_flags;
@@ -455,9 +354,7 @@ void GaussianSplatVulkanBackend::RenderCompositeStage(RenderOutput& output,
     s.gpu_sort_ms = geometry_.reused ? 0.0 : geometry_.gpu_sort_ms;
     const std::vector<double> ms = stage_b_timestamps_.ReadMilliseconds();
     s.gpu_composite_ms = std::max(0.0, ms[static_cast<uint32_t>(TimedPass::kComposite)]);
-    s.gpu_scene_bytes = static_cast<int64_t>(positions_.GetSize() + shape_.GetSize() +
-                                             (layout_.sh_words_per_splat ? sh_.GetSize() : 0) +
-                                             visibility_.GetSize());
+    s.gpu_scene_bytes = static_cast<int64_t>(stage_a_resources_.SceneBytes());
 }
 
 }  // namespace vulkan

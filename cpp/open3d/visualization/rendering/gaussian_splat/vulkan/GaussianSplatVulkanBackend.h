@@ -14,6 +14,7 @@
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/Buffer.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/Commands.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/GaussianStageA.h"
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/GaussianStageAResources.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/GaussianStageB.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/GpuTimestamps.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/Image.h"
@@ -63,9 +64,6 @@ private:
     void UploadScene(SplatPrecision precision);
     void EnsureViewBuffers(uint32_t entry_capacity);
     void EnsureTargets(uint32_t width, uint32_t height);
-    Buffer Upload(const void* data, VkDeviceSize bytes);
-    StageASceneBuffers SceneBuffers() const;
-    StageAViewBuffers ViewBuffers() const;
 
     std::unique_ptr<VulkanContext> context_;
     CommandPool pool_;
@@ -77,14 +75,8 @@ private:
 
     // The scene: kept on the CPU to re-pack when the storage precision changes.
     std::optional<t::geometry::PointCloud> cloud_;
-    PackedGaussianSplats layout_;  // sizes of the uploaded packing (attribute vectors emptied)
     std::vector<uint32_t> visibility_mask_;
-    Buffer positions_, shape_, sh_, visibility_;
-
-    // Per-view Stage A buffers, sized for entry_capacity_ entries.
-    uint32_t entry_capacity_ = 0;
-    Buffer view_params_, projected_, counters_buffer_, depth_keys_, splat_indices_, scan_;
-    Buffer entry_keys_, entry_values_, keys_alt_, values_alt_, histogram_, sort_params_;
+    StageAResources stage_a_resources_;
     Buffer counters_readback_;
     Buffer composite_state_;
 

@@ -14,9 +14,6 @@ namespace vulkan {
 
 namespace {
 
-constexpr VkBufferUsageFlags kTransfer =
-    VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
-
 // Copies [0, bytes) of `src` into a fresh readback buffer after a compute -> transfer
 // barrier the caller recorded, in the same command buffer.
 struct PendingCopy {
@@ -69,110 +66,31 @@ RenderStats StageAReadback::ToStats() const {
 GaussianStageARunner::GaussianStageARunner(const VulkanContext& context,
                                            const PackedGaussianSplats& packed,
                                            uint32_t entry_capacity)
-    : context_(context), pool_(context), stage_a_(context), entry_capacity_(entry_capacity) {
-    layout_.precision = packed.precision;
-    layout_.num_splats = packed.num_splats;
-    layout_.sh_degree = packed.sh_degree;
-    layout_.shape_words_per_splat = packed.shape_words_per_splat;
-    layout_.sh_words_per_splat = packed.sh_words_per_splat;
-    layout_.center_min = packed.center_min;
-    layout_.center_max = packed.center_max;
-    const uint32_t n = static_cast<uint32_t>(packed.num_splats);
-
-    positions_ = UploadBuffer(packed.positions.data(), packed.positions.size() * sizeof(float));
-    shape_ = UploadBuffer(packed.shape.data(), packed.shape.size() * 4);
-    // Degree 0: nothing is read from the SH binding, but it must name a buffer.
-    const uint32_t placeholder[4] = {0, 0, 0, 0};
-    sh_ = packed.sh.empty() ? UploadBuffer(placeholder, sizeof(placeholder))
-                            : UploadBuffer(packed.sh.data(), packed.sh.size() * 4);
-    visibility_ = UploadBuffer(packed.visibility.data(), packed.visibility.size() * 4);
-    scene_bytes_ = (packed.positions.size() + packed.shape.size() + packed.sh.size() +
-                    packed.visibility.size()) *
-                   4;
-
-    const StageAStorageRequirements need =
-        GaussianStageA::GetStorageRequirements(n, entry_capacity);
-    const auto make = [&](VkDeviceSize bytes, VkBufferUsageFlags usage) {
-        return Buffer(context, bytes, usage | kTransfer, MemoryUsage::kDevice);
-    };
-    view_params_ = make(need.view_params_bytes, need.view_params_usage);
-    projected_ = make(need.projected_bytes, need.usage);
-    counters_ = make(need.counters_bytes, need.counters_usage);
-    depth_keys_ = make(need.depth_keys_bytes, need.usage);
-    splat_indices_ = make(need.splat_indices_bytes, need.usage);
-    scan_ = make(need.scan_bytes, need.usage);
-    entry_keys_ = make(need.entry_keys_bytes, need.usage);
-    entry_values_ = make(need.entry_values_bytes, need.usage);
-    keys_alt_ = make(need.sort.keys_alt_bytes, need.sort.scratch_usage);
-    values_alt_ = make(need.sort.values_alt_bytes, need.sort.scratch_usage);
-    histogram_ = make(need.sort.histogram_bytes, need.sort.scratch_usage);
-    sort_params_ = make(need.sort.params_bytes, need.sort.params_usage);
-}
-
-Buffer GaussianStageARunner::UploadBuffer(const void* data, VkDeviceSize bytes) {
-    const VkDeviceSize size = std::max<VkDeviceSize>(bytes, 16);
-    Buffer device(context_, size, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | kTransfer,
-                  MemoryUsage::kDevice);
-    Buffer staging(context_, size, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, MemoryUsage::kHostUpload);
-    std::memset(staging.GetMapped(), 0, size);
-    if (bytes > 0) std::memcpy(staging.GetMapped(), data, bytes);
-    SubmitAndWait(context_, pool_, [&](VkCommandBuffer cmd) {
-        const VkBufferCopy region{0, 0, size};
-        vkCmdCopyBuffer(cmd, staging.Get(), device.Get(), 1, &region);
-    });
-    return device;
+    : context_(context), pool_(context), stage_a_(context) {
+    resources_.UploadScene(context, pool_, packed);
+    resources_.AllocateView(context, entry_capacity);
 }
 
 void GaussianStageARunner::SetVisibility(const std::vector<uint32_t>& mask) {
-    if (mask.size() * 4 > visibility_.GetSize()) {
-        core::ThrowError("GaussianStageARunner: visibility mask of {} words, the scene has {}",
-                         mask.size(), visibility_.GetSize() / 4);
-    }
-    visibility_ = UploadBuffer(mask.data(), mask.size() * 4);
+    resources_.UploadVisibility(context_, pool_, mask);
 }
 
 StageAReadback GaussianStageARunner::Run(const camera::PinholeCamera& camera,
                                          const RenderConfig& config, bool read_projected) {
-    ViewPackingInputs inputs;
-    inputs.num_splats = layout_.num_splats;
-    inputs.packed_sh_degree = layout_.sh_degree;
-    inputs.precision = layout_.precision;
-    inputs.sh_words_per_splat = layout_.sh_words_per_splat;
-    inputs.entry_capacity = entry_capacity_;
-    inputs.center_min = layout_.center_min;
-    inputs.center_max = layout_.center_max;
-    const shader::GaussianViewParams params = PackGaussianViewParams(camera, config, inputs);
-
-    StageASceneBuffers scene;
-    scene.positions = positions_.Range();
-    scene.shape = shape_.Range();
-    scene.sh = sh_.Range();
-    scene.visibility = visibility_.Range();
-    scene.num_splats = static_cast<uint32_t>(layout_.num_splats);
-    scene.packed_sh_degree = layout_.sh_degree;
-    scene.sh_words_per_splat = layout_.sh_words_per_splat;
-    scene.precision = layout_.precision;
-    StageAViewBuffers view;
-    view.view_params = view_params_.Range();
-    view.projected = projected_.Range();
-    view.counters = counters_.Range();
-    view.depth_keys = depth_keys_.Range();
-    view.splat_indices = splat_indices_.Range();
-    view.scan = scan_.Range();
-    view.entry_keys = entry_keys_.Range();
-    view.entry_values = entry_values_.Range();
-    view.sort_scratch = {keys_alt_.Range(), values_alt_.Range(), histogram_.Range(),
-                         sort_params_.Range()};
+    const shader::GaussianViewParams params = resources_.ViewParams(camera, config);
+    const StageASceneBuffers scene = resources_.Scene();
+    const StageAViewBuffers view = resources_.View();
 
     StageAReadback out;
-    out.num_splats = layout_.num_splats;
+    out.num_splats = resources_.Layout().num_splats;
     std::vector<PendingCopy> pending;
     {
         CommandBuffer cmd = pool_.Allocate();
         cmd.Begin();
         stage_a_.Record(cmd.Get(), scene, view, params);
         ComputeToTransferBarrier(cmd.Get());
-        RecordCopy(context_, cmd.Get(), counters_, sizeof(out.counters), &out.counters, pending);
+        RecordCopy(context_, cmd.Get(), resources_.counters, sizeof(out.counters), &out.counters,
+                   pending);
         cmd.End();
         UniqueFence fence = CreateFence(context_);
         const auto start = std::chrono::steady_clock::now();
@@ -198,16 +116,16 @@ StageAReadback GaussianStageARunner::Run(const camera::PinholeCamera& camera,
     out.visible_in_depth_order.resize(visible);
     out.entry_tiles.resize(entries);
     out.entry_splats.resize(entries);
-    if (read_projected) out.projected.resize(layout_.num_splats);
+    if (read_projected) out.projected.resize(resources_.Layout().num_splats);
     SubmitAndWait(context_, pool_, [&](VkCommandBuffer cmd) {
-        RecordCopy(context_, cmd, splat_indices_, VkDeviceSize(visible) * 4,
+        RecordCopy(context_, cmd, resources_.splat_indices, VkDeviceSize(visible) * 4,
                    out.visible_in_depth_order.data(), pending);
-        RecordCopy(context_, cmd, entry_keys_, VkDeviceSize(entries) * 4, out.entry_tiles.data(),
-                   pending);
-        RecordCopy(context_, cmd, entry_values_, VkDeviceSize(entries) * 4, out.entry_splats.data(),
-                   pending);
+        RecordCopy(context_, cmd, resources_.entry_keys, VkDeviceSize(entries) * 4,
+                   out.entry_tiles.data(), pending);
+        RecordCopy(context_, cmd, resources_.entry_values, VkDeviceSize(entries) * 4,
+                   out.entry_splats.data(), pending);
         if (read_projected) {
-            RecordCopy(context_, cmd, projected_,
+            RecordCopy(context_, cmd, resources_.projected,
                        out.projected.size() * sizeof(shader::GaussianProjectedSplat),
                        out.projected.data(), pending);
         }

@@ -13,6 +13,7 @@
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/Buffer.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/Commands.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/GaussianStageA.h"
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/GaussianStageAResources.h"
 #include "shaders/GaussianSplatContract.h"
 
 namespace open3d {
@@ -57,20 +58,13 @@ public:
                        bool read_projected = true);
 
     /// Bytes of the scene buffers on the GPU (positions + shape + SH + mask).
-    uint64_t GetSceneBytes() const { return scene_bytes_; }
+    uint64_t GetSceneBytes() const { return resources_.SceneBytes(); }
 
 private:
-    Buffer UploadBuffer(const void* data, VkDeviceSize bytes);
-
     const VulkanContext& context_;
     CommandPool pool_;
     GaussianStageA stage_a_;
-    PackedGaussianSplats layout_;  // the packed scene's sizes (attribute vectors emptied)
-    uint32_t entry_capacity_ = 0;
-    uint64_t scene_bytes_ = 0;
-    Buffer positions_, shape_, sh_, visibility_;
-    Buffer view_params_, projected_, counters_, depth_keys_, splat_indices_, scan_;
-    Buffer entry_keys_, entry_values_, keys_alt_, values_alt_, histogram_, sort_params_;
+    StageAResources resources_;
     uint32_t warned_flags_ = 0;
 };
 

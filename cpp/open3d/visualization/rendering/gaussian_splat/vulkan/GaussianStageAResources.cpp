@@ -1,0 +1,136 @@
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/GaussianStageAResources.h"
+
+#include <algorithm>
+#include <cstring>
+
+#include "open3d/core/Exception.h"
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/VulkanContext.h"
+
+namespace open3d {
+namespace visualization {
+namespace rendering {
+namespace vulkan {
+
+namespace {
+
+constexpr VkBufferUsageFlags kTransfer =
+    VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
+
+}  // namespace
+
+Buffer UploadStorageBuffer(const VulkanContext& context, const CommandPool& pool, const void* data,
+                           VkDeviceSize bytes) {
+    const VkDeviceSize size = std::max<VkDeviceSize>(bytes, 16);
+    Buffer device(context, size, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | kTransfer,
+                  MemoryUsage::kDevice);
+    Buffer staging(context, size, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, MemoryUsage::kHostUpload);
+    std::memset(staging.GetMapped(), 0, size);
+    if (bytes > 0) std::memcpy(staging.GetMapped(), data, bytes);
+    SubmitAndWait(context, pool, [&](VkCommandBuffer cmd) {
+        const VkBufferCopy region{0, 0, size};
+        vkCmdCopyBuffer(cmd, staging.Get(), device.Get(), 1, &region);
+    });
+    return device;
+}
+
+void StageAResources::UploadScene(const VulkanContext& context, const CommandPool& pool,
+                                  const PackedGaussianSplats& packed) {
+    positions = UploadStorageBuffer(context, pool, packed.positions.data(),
+                                    packed.positions.size() * sizeof(float));
+    shape = UploadStorageBuffer(context, pool, packed.shape.data(), packed.shape.size() * 4);
+    sh = UploadStorageBuffer(context, pool, packed.sh.data(), packed.sh.size() * 4);
+    visibility =
+        UploadStorageBuffer(context, pool, packed.visibility.data(), packed.visibility.size() * 4);
+    scene_bytes_ = (packed.positions.size() + packed.shape.size() + packed.sh.size() +
+                    packed.visibility.size()) *
+                   4;
+    layout_.precision = packed.precision;
+    layout_.num_splats = packed.num_splats;
+    layout_.sh_degree = packed.sh_degree;
+    layout_.shape_words_per_splat = packed.shape_words_per_splat;
+    layout_.sh_words_per_splat = packed.sh_words_per_splat;
+    layout_.center_min = packed.center_min;
+    layout_.center_max = packed.center_max;
+    // The per-view buffers are sized for a splat count: a new scene needs new ones.
+    projected = Buffer();
+    entry_capacity_ = 0;
+}
+
+void StageAResources::UploadVisibility(const VulkanContext& context, const CommandPool& pool,
+                                       const std::vector<uint32_t>& mask) {
+    const size_t words = (static_cast<size_t>(layout_.num_splats) + 31) / 32;
+    if (mask.size() != words) {
+        core::ThrowError("visibility mask has {} words, the scene of {} splats needs {}",
+                         mask.size(), layout_.num_splats, words);
+    }
+    visibility = UploadStorageBuffer(context, pool, mask.data(), mask.size() * 4);
+}
+
+void StageAResources::AllocateView(const VulkanContext& context, uint32_t entry_capacity) {
+    const uint32_t n = static_cast<uint32_t>(layout_.num_splats);
+    const StageAStorageRequirements need =
+        GaussianStageA::GetStorageRequirements(n, entry_capacity);
+    const auto make = [&](VkDeviceSize bytes, VkBufferUsageFlags usage) {
+        return Buffer(context, std::max<VkDeviceSize>(bytes, 16), usage | kTransfer,
+                      MemoryUsage::kDevice);
+    };
+    view_params = make(need.view_params_bytes, need.view_params_usage);
+    projected = make(need.projected_bytes, need.usage);
+    counters = make(need.counters_bytes, need.counters_usage);
+    depth_keys = make(need.depth_keys_bytes, need.usage);
+    splat_indices = make(need.splat_indices_bytes, need.usage);
+    scan = make(need.scan_bytes, need.usage);
+    entry_keys = make(need.entry_keys_bytes, need.usage);
+    entry_values = make(need.entry_values_bytes, need.usage);
+    keys_alt = make(need.sort.keys_alt_bytes, need.sort.scratch_usage);
+    values_alt = make(need.sort.values_alt_bytes, need.sort.scratch_usage);
+    histogram = make(need.sort.histogram_bytes, need.sort.scratch_usage);
+    sort_params = make(need.sort.params_bytes, need.sort.params_usage);
+    entry_capacity_ = entry_capacity;
+}
+
+StageASceneBuffers StageAResources::Scene() const {
+    StageASceneBuffers scene;
+    scene.positions = positions.Range();
+    scene.shape = shape.Range();
+    scene.sh = sh.Range();
+    scene.visibility = visibility.Range();
+    scene.num_splats = static_cast<uint32_t>(layout_.num_splats);
+    scene.packed_sh_degree = layout_.sh_degree;
+    scene.sh_words_per_splat = layout_.sh_words_per_splat;
+    scene.precision = layout_.precision;
+    return scene;
+}
+
+StageAViewBuffers StageAResources::View() const {
+    StageAViewBuffers view;
+    view.view_params = view_params.Range();
+    view.projected = projected.Range();
+    view.counters = counters.Range();
+    view.depth_keys = depth_keys.Range();
+    view.splat_indices = splat_indices.Range();
+    view.scan = scan.Range();
+    view.entry_keys = entry_keys.Range();
+    view.entry_values = entry_values.Range();
+    view.sort_scratch = {keys_alt.Range(), values_alt.Range(), histogram.Range(),
+                         sort_params.Range()};
+    return view;
+}
+
+shader::GaussianViewParams StageAResources::ViewParams(const camera::PinholeCamera& camera,
+                                                       const RenderConfig& config) const {
+    ViewPackingInputs inputs;
+    inputs.num_splats = layout_.num_splats;
+    inputs.packed_sh_degree = layout_.sh_degree;
+    inputs.precision = layout_.precision;
+    inputs.sh_words_per_splat = layout_.sh_words_per_splat;
+    inputs.entry_capacity = entry_capacity_;
+    inputs.center_min = layout_.center_min;
+    inputs.center_max = layout_.center_max;
+    return PackGaussianViewParams(camera, config, inputs);
+}
+
+}  // namespace vulkan
+}  // namespace rendering
+}  // namespace visualization
+}  // namespace open3d

@@ -1,0 +1,67 @@
+// The GPU buffers Stage A runs on: one packed scene (uploaded once) and one view's outputs
+// and scratch, sized from GaussianStageA::GetStorageRequirements. The backend and the test
+// runner share it, so both allocate, upload and bind Stage A the same way.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "open3d/camera/PinholeCamera.h"
+#include "open3d/visualization/rendering/gaussian_splat/GaussianSplatDataPacking.h"
+#include "open3d/visualization/rendering/gaussian_splat/RenderConfig.h"
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/Buffer.h"
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/Commands.h"
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/GaussianStageA.h"
+
+namespace open3d {
+namespace visualization {
+namespace rendering {
+namespace vulkan {
+
+/// A device-local storage buffer holding `bytes` of `data` (at least 16 bytes, zero-padded),
+/// copied through a staging buffer and waited for.
+Buffer UploadStorageBuffer(const VulkanContext& context, const CommandPool& pool, const void* data,
+                           VkDeviceSize bytes);
+
+class StageAResources {
+public:
+    /// Uploads the packed attributes (a degree-0 scene gets a 16-byte SH placeholder: the
+    /// binding must name a buffer) and keeps the packing's sizes.
+    void UploadScene(const VulkanContext& context, const CommandPool& pool,
+                     const PackedGaussianSplats& packed);
+    /// Replaces the visibility mask ([ceil(N / 32)] words).
+    void UploadVisibility(const VulkanContext& context, const CommandPool& pool,
+                          const std::vector<uint32_t>& mask);
+    /// (Re)allocates the per-view buffers for the scene's splats and `entry_capacity` entries.
+    void AllocateView(const VulkanContext& context, uint32_t entry_capacity);
+
+    /// Bindings of the uploaded scene and of the view buffers for GaussianStageA::Record.
+    StageASceneBuffers Scene() const;
+    StageAViewBuffers View() const;
+    /// The view parameters of `camera` for this scene and view allocation.
+    shader::GaussianViewParams ViewParams(const camera::PinholeCamera& camera,
+                                          const RenderConfig& config) const;
+
+    /// The packing's sizes (its attribute vectors are empty).
+    const PackedGaussianSplats& Layout() const { return layout_; }
+    uint32_t EntryCapacity() const { return entry_capacity_; }
+    bool HasView() const { return static_cast<bool>(projected); }
+    /// Bytes of the scene on the GPU: positions + shape + SH (if any) + visibility mask.
+    uint64_t SceneBytes() const { return scene_bytes_; }
+
+    // Scene.
+    Buffer positions, shape, sh, visibility;
+    // View: Stage A's outputs (projected splats, counters, sorted entries) and scratch.
+    Buffer view_params, projected, counters, depth_keys, splat_indices, scan;
+    Buffer entry_keys, entry_values, keys_alt, values_alt, histogram, sort_params;
+
+private:
+    PackedGaussianSplats layout_;
+    uint32_t entry_capacity_ = 0;
+    uint64_t scene_bytes_ = 0;
+};
+
+}  // namespace vulkan
+}  // namespace rendering
+}  // namespace visualization
+}  // namespace open3d
