@@ -3,7 +3,7 @@
 // per touched tile in that order and stably sort the entries by tile. The seed's packed
 // 32-bit (tile, truncated depth) key is an option (RenderConfig::sort_mode). The caller
 // allocates from GetStorageRequirements; Record() only records commands (no allocation,
-// no submit). Pass sequence and buffers: docs/vulkan-stage-a.md.
+// no submit). Pass sequence and buffers: docs/vulkan.md (Stage A).
 #pragma once
 
 #include <vulkan/vulkan.h>
