@@ -166,6 +166,10 @@ OPEN3D_SHADER_CONST uint kShapeWordsCompact = 5u;  // 10 halves
 OPEN3D_SHADER_CONST uint kSpecShDegree = 0u;   // 0..3; 0 reads no SH buffer
 OPEN3D_SHADER_CONST uint kSpecAntialias = 1u;  // 0 / 1
 OPEN3D_SHADER_CONST uint kSpecPrecision = 2u;  // kPrecisionExact / kPrecisionCompact
+// 1 (exact order): slot i of the visible list holds splat i (key ~0u when not visible), so
+// one stable depth sort of all N slots orders ties by splat index; 0 (packed key): visible
+// splats are appended in subgroup order.
+OPEN3D_SHADER_CONST uint kSpecIndexedList = 3u;
 // Specialisation constant of gaussian_scan.comp: level 0 gathers the tile counts.
 OPEN3D_SHADER_CONST uint kSpecScanGather = 0u;
 // Specialisation constant of gaussian_emit.comp: what the pass writes into the entry keys.
@@ -193,6 +197,7 @@ OPEN3D_SHADER_CONST uint kStageANumBindings = 12u;
 // uint indices into GaussianStageACounters, used as the radix sorter's count_index.
 OPEN3D_SHADER_CONST uint kCounterVisibleIndex = 0u;
 OPEN3D_SHADER_CONST uint kCounterEntriesIndex = 2u;
+OPEN3D_SHADER_CONST uint kCounterNumSplatsIndex = 7u;  // N, written by the recorder
 
 // Per-frame view parameters (a readonly storage buffer; only 16-byte members, so std430,
 // std140 and C++ agree).
@@ -239,7 +244,7 @@ struct GaussianStageACounters {
     uint emit_dispatch_x;    // VkDispatchIndirectCommand of the emit pass
     uint emit_dispatch_y;
     uint emit_dispatch_z;
-    uint reserved;
+    uint num_splats;  // N: the element count of the exact mode's depth sort
     GaussianScanLevel scan_levels[kScanMaxLevels];
 };
 
@@ -333,6 +338,7 @@ static_assert(offsetof(GaussianProjectedSplat, tiles) == 48);
 static_assert(sizeof(GaussianScanLevel) == 16);
 static_assert(sizeof(GaussianStageACounters) == 32 + 16 * kScanMaxLevels);
 static_assert(offsetof(GaussianStageACounters, visible_count) == 4 * kCounterVisibleIndex);
+static_assert(offsetof(GaussianStageACounters, num_splats) == 4 * kCounterNumSplatsIndex);
 static_assert(offsetof(GaussianStageACounters, requested_entries) == 4);
 static_assert(offsetof(GaussianStageACounters, entry_count) == 4 * kCounterEntriesIndex);
 static_assert(offsetof(GaussianStageACounters, error_flags) == 12);

@@ -18,6 +18,7 @@ layout(local_size_x = kProjectWorkgroupSize) in;
 layout(constant_id = kSpecShDegree) const uint kShDegree = 3u;
 layout(constant_id = kSpecAntialias) const uint kAntialias = 0u;
 layout(constant_id = kSpecPrecision) const uint kPrecision = kPrecisionExact;
+layout(constant_id = kSpecIndexedList) const uint kIndexedList = 1u;
 
 layout(std430, set = 0, binding = kStageAViewBinding) readonly buffer ViewBlock {
     GaussianViewParams view;
@@ -215,7 +216,13 @@ void main() {
         base = atomicAdd(counters.visible_count, subgroup_count);
     }
     base = subgroupBroadcastFirst(base);
-    if (visible) {
+    if (kIndexedList != 0u) {
+        // Slot i = splat i; hidden or culled splats get the largest key and sort last.
+        if (i < view.scene.x) {
+            depth_keys[i] = visible ? floatBitsToUint(depth) : 0xFFFFFFFFu;
+            splat_indices[i] = i;
+        }
+    } else if (visible) {
         // depth > near plane > 0, so the float bits order like the depths.
         depth_keys[base + rank] = floatBitsToUint(depth);
         splat_indices[base + rank] = i;

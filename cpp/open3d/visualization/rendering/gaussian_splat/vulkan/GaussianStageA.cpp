@@ -98,16 +98,20 @@ StageAStorageRequirements GaussianStageA::GetStorageRequirements(uint32_t num_sp
 }
 
 VkPipeline GaussianStageA::GetProjectPipeline(uint32_t sh_degree, bool antialias,
-                                              SplatPrecision precision) {
+                                              SplatPrecision precision, bool indexed_list) {
     const uint32_t precision_value =
         precision == SplatPrecision::kExact ? kPrecisionExact : kPrecisionCompact;
-    const uint32_t key = sh_degree | (antialias ? 4u : 0u) | (precision_value << 3);
+    const uint32_t key =
+        sh_degree | (antialias ? 4u : 0u) | (precision_value << 3) | (indexed_list ? 16u : 0u);
     auto it = project_.find(key);
     if (it != project_.end()) return it->second.Get();
-    const std::array<uint32_t, 3> values{sh_degree, antialias ? 1u : 0u, precision_value};
-    const std::array<VkSpecializationMapEntry, 3> entries{
-        {{kSpecShDegree, 0, 4}, {kSpecAntialias, 4, 4}, {kSpecPrecision, 8, 4}}};
-    const VkSpecializationInfo info{3, entries.data(), sizeof(values), values.data()};
+    const std::array<uint32_t, 4> values{sh_degree, antialias ? 1u : 0u, precision_value,
+                                         indexed_list ? 1u : 0u};
+    const std::array<VkSpecializationMapEntry, 4> entries{{{kSpecShDegree, 0, 4},
+                                                           {kSpecAntialias, 4, 4},
+                                                           {kSpecPrecision, 8, 4},
+                                                           {kSpecIndexedList, 12, 4}}};
+    const VkSpecializationInfo info{4, entries.data(), sizeof(values), values.data()};
     UniquePipeline pipeline = CreateComputePipeline(
         context_, pipeline_layout_.Get(), spirv::kGaussianProject, "gaussian_project", &info);
     return project_.emplace(key, std::move(pipeline)).first->second.Get();
@@ -168,15 +172,20 @@ void GaussianStageA::Record(VkCommandBuffer cmd, const StageASceneBuffers& scene
     // Per-frame inputs, written in the command buffer: no mapped memory, no hidden upload.
     vkCmdUpdateBuffer(cmd, buffers.view_params.buffer, buffers.view_params.offset, sizeof(params),
                       &params);
-    vkCmdFillBuffer(cmd, counters, counters_offset, sizeof(GaussianStageACounters), 0u);
+    // Counters start at zero but for N, the element count of the exact mode's depth sort
+    // (the sorter reads counts from GPU memory).
+    GaussianStageACounters initial_counters{};
+    initial_counters.num_splats = n;
+    vkCmdUpdateBuffer(cmd, counters, counters_offset, sizeof(initial_counters), &initial_counters);
     RecordMemoryBarrier(cmd, VK_PIPELINE_STAGE_2_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
                         VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
                         VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
 
     // 1. Project: visible splats -> (depth key, splat index) list, visible_count.
     PushBindings(cmd, scene, buffers);
-    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE,
-                      GetProjectPipeline(params.scene.y, params.scene.z != 0, scene.precision));
+    vkCmdBindPipeline(
+        cmd, VK_PIPELINE_BIND_POINT_COMPUTE,
+        GetProjectPipeline(params.scene.y, params.scene.z != 0, scene.precision, !packed_key));
     if (n > 0) vkCmdDispatch(cmd, DivCeil(n, kProjectWorkgroupSize), 1, 1);
     ComputeBarrier(cmd);
 
@@ -193,18 +202,14 @@ void GaussianStageA::Record(VkCommandBuffer cmd, const StageASceneBuffers& scene
         timestamps->RecordBegin(cmd, TimedPass::kSort);
     }
 
-    // 3. Exact depth order with ties by splat index: the list was appended in subgroup
-    // order, so first sort it by splat index (only the bits an index can have), then
-    // stably by the full 32-bit depth key. Keys and values swap roles between the sorts.
-    // The packed key, like the seed, keeps the append order: its one entry sort decides
-    // the depth order, and measuring its error means not helping it here.
+    // 3. Exact depth order with ties by splat index: slot i of the list holds splat i (culled
+    // and hidden splats carry the key ~0u), so one stable sort of all N slots by the 32-bit
+    // depth key puts the visible splats first, front to back, ties in index order.
+    // The packed key, like the seed, keeps the projection's append order: its one entry
+    // sort decides the depth order, and measuring its error means not helping it here.
     if (!packed_key) {
-        const uint32_t index_bits = n <= 1 ? 1u : static_cast<uint32_t>(std::bit_width(n - 1));
-        sort_.Record(cmd, buffers.splat_indices, buffers.depth_keys, buffers.sort_scratch,
-                     counter_range(kCounterVisibleIndex), std::max(n, 1u), index_bits);
-        ComputeBarrier(cmd);
         sort_.Record(cmd, buffers.depth_keys, buffers.splat_indices, buffers.sort_scratch,
-                     counter_range(kCounterVisibleIndex), std::max(n, 1u), 32);
+                     counter_range(kCounterNumSplatsIndex), std::max(n, 1u), 32);
         ComputeBarrier(cmd);
     }
 

@@ -91,11 +91,11 @@ public:
                                                             uint32_t entry_capacity);
 
     /// Records Stage A for one view: writes `params` into buffers.view_params, zeroes the
-    /// counters, then project -> dispatch args -> sort visible by splat index, then by
-    /// depth (stable) -> scan tile counts -> dispatch args -> emit entries -> stable sort by
-    /// tile (params.limits.w bits). Every size after the projection comes from GPU-side
-    /// counts. `params` must come from PackGaussianViewParams for this scene and a
-    /// capacity <= the one the buffers were sized for.
+    /// counters, then project (slot i = splat i) -> dispatch args -> one stable sort of all
+    /// N slots by depth (culled splats last, ties by index) -> scan tile counts -> dispatch args ->
+    /// emit entries -> stable sort by tile (params.limits.w bits). Every size after the projection
+    /// comes from GPU-side counts. `params` must come from PackGaussianViewParams for this scene
+    /// and a capacity <= the one the buffers were sized for.
     ///
     /// With the packed key (UsesPackedSortKey(params)): no sort of the visible list (scan
     /// and emit follow the append order), entries keyed by shader::PackedSortKey, one
@@ -112,7 +112,8 @@ public:
                 const GpuTimestamps* timestamps = nullptr);
 
 private:
-    VkPipeline GetProjectPipeline(uint32_t sh_degree, bool antialias, SplatPrecision precision);
+    VkPipeline GetProjectPipeline(uint32_t sh_degree, bool antialias, SplatPrecision precision,
+                                  bool indexed_list);
     void PushBindings(VkCommandBuffer cmd, const StageASceneBuffers& scene,
                       const StageAViewBuffers& buffers) const;
 
@@ -124,9 +125,10 @@ private:
     UniquePipeline scan_gather_;
     UniquePipeline dispatch_args_;
     UniquePipeline emit_;
-    UniquePipeline emit_packed_;                  // kEmitPackedKeys
-    UniquePipeline unpack_keys_;                  // kEmitUnpackKeys
-    std::map<uint32_t, UniquePipeline> project_;  // key: degree | antialias << 2 | precision << 3
+    UniquePipeline emit_packed_;  // kEmitPackedKeys
+    UniquePipeline unpack_keys_;  // kEmitUnpackKeys
+    std::map<uint32_t, UniquePipeline>
+        project_;  // key: degree | antialias << 2 | precision << 3 | indexed << 4
 };
 
 }  // namespace vulkan
