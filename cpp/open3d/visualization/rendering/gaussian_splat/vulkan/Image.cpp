@@ -98,6 +98,23 @@ void RecordImageBarrier(VkCommandBuffer cmd, VkImage image, VkImageAspectFlags a
     vkCmdPipelineBarrier2(cmd, &dependency);
 }
 
+void RecordDepthTextureUpload(VkCommandBuffer cmd, const Image& image, VkBuffer staging) {
+    RecordImageBarrier(cmd, image.Get(), VK_IMAGE_ASPECT_DEPTH_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
+                       VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_PIPELINE_STAGE_2_NONE,
+                       VK_ACCESS_2_NONE, VK_PIPELINE_STAGE_2_COPY_BIT,
+                       VK_ACCESS_2_TRANSFER_WRITE_BIT);
+    VkBufferImageCopy region{};
+    region.imageSubresource = {VK_IMAGE_ASPECT_DEPTH_BIT, 0, 0, 1};
+    region.imageExtent = {image.GetWidth(), image.GetHeight(), 1};
+    vkCmdCopyBufferToImage(cmd, staging, image.Get(), VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1,
+                           &region);
+    RecordImageBarrier(cmd, image.Get(), VK_IMAGE_ASPECT_DEPTH_BIT,
+                       VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+                       VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, VK_PIPELINE_STAGE_2_COPY_BIT,
+                       VK_ACCESS_2_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                       VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);
+}
+
 }  // namespace vulkan
 }  // namespace rendering
 }  // namespace visualization

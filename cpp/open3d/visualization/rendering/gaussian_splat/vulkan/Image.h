@@ -69,6 +69,11 @@ void RecordImageBarrier(VkCommandBuffer cmd, VkImage image, VkImageAspectFlags a
                         VkPipelineStageFlags2 src_stages, VkAccessFlags2 src_access,
                         VkPipelineStageFlags2 dst_stages, VkAccessFlags2 dst_access);
 
+/// Records the upload of a depth texture from `staging` (one float per texel, row 0 first)
+/// into `image` (D32_SFLOAT, created with TRANSFER_DST | SAMPLED), leaving it in
+/// SHADER_READ_ONLY_OPTIMAL for compute-shader sampling.
+void RecordDepthTextureUpload(VkCommandBuffer cmd, const Image& image, VkBuffer staging);
+
 }  // namespace vulkan
 }  // namespace rendering
 }  // namespace visualization
