@@ -59,6 +59,7 @@ struct Row {
     std::string scene, resolution, knob;
     int64_t splats = 0, visible = 0, entries = 0;
     double project_ms = 0, sort_ms = 0, composite_ms = 0, gpu_total_ms = 0, cpu_frame_ms = 0;
+    double depth_sort_ms = 0, scan_emit_ms = 0, tile_sort_ms = 0;  // parts of sort_ms
     double bytes_per_splat = 0;
     bool has_error = false;
     double psnr = 0, max_abs = 0, over_1_255 = 0, p999 = 0;
@@ -137,10 +138,13 @@ void PrintTable(const std::vector<Row>& rows) {
             std::snprintf(err, sizeof(err), "%8.1f %9.2e %9.4f", r.psnr, r.max_abs,
                           100.0 * r.over_1_255);
         }
-        std::printf("%-11s %9lld %10lld %8.3f %8.3f %8.3f %9.3f %9.2f %7.1f %s%s\n", r.knob.c_str(),
-                    static_cast<long long>(r.visible), static_cast<long long>(r.entries),
-                    r.project_ms, r.sort_ms, r.composite_ms, r.gpu_total_ms, r.cpu_frame_ms,
-                    r.bytes_per_splat, err, r.error_flags ? "  (entries dropped!)" : "");
+        std::printf(
+            "%-11s %9lld %10lld %8.3f %8.3f %8.3f %9.3f %9.2f %7.1f %s  [sort: %.3f depth, "
+            "%.3f scan+emit, %.3f tiles]%s\n",
+            r.knob.c_str(), static_cast<long long>(r.visible), static_cast<long long>(r.entries),
+            r.project_ms, r.sort_ms, r.composite_ms, r.gpu_total_ms, r.cpu_frame_ms,
+            r.bytes_per_splat, err, r.depth_sort_ms, r.scan_emit_ms, r.tile_sort_ms,
+            r.error_flags ? "  (entries dropped!)" : "");
     }
 }
 
@@ -227,11 +231,17 @@ int Run(const Options& opt) {
                         sum.gpu_project_ms += out.stats.gpu_project_ms;
                         sum.gpu_sort_ms += out.stats.gpu_sort_ms;
                         sum.gpu_composite_ms += out.stats.gpu_composite_ms;
+                        sum.gpu_depth_sort_ms += out.stats.gpu_depth_sort_ms;
+                        sum.gpu_scan_emit_ms += out.stats.gpu_scan_emit_ms;
+                        sum.gpu_tile_sort_ms += out.stats.gpu_tile_sort_ms;
                     }
                     const double n = opt.repeat * static_cast<double>(cams.size());
                     row.project_ms += sum.gpu_project_ms / n;
                     row.sort_ms += sum.gpu_sort_ms / n;
                     row.composite_ms += sum.gpu_composite_ms / n;
+                    row.depth_sort_ms += sum.gpu_depth_sort_ms / n;
+                    row.scan_emit_ms += sum.gpu_scan_emit_ms / n;
+                    row.tile_sort_ms += sum.gpu_tile_sort_ms / n;
                     row.cpu_frame_ms += cpu_ms / n;
                     row.visible += out.stats.num_visible / static_cast<int64_t>(cams.size());
                     row.entries += out.stats.num_tile_entries / static_cast<int64_t>(cams.size());
@@ -273,6 +283,9 @@ int Run(const Options& opt) {
                            {"tile_entries", r.entries},
                            {"gpu_project_ms", r.project_ms},
                            {"gpu_sort_ms", r.sort_ms},
+                           {"gpu_depth_sort_ms", r.depth_sort_ms},
+                           {"gpu_scan_emit_ms", r.scan_emit_ms},
+                           {"gpu_tile_sort_ms", r.tile_sort_ms},
                            {"gpu_composite_ms", r.composite_ms},
                            {"gpu_total_ms", r.gpu_total_ms},
                            {"cpu_frame_ms", r.cpu_frame_ms},

@@ -65,6 +65,8 @@ struct RenderStats {
     double gpu_sort_ms = 0.0;       ///< depth sort, scan, emission and tile sort
     double gpu_composite_ms = 0.0;  ///< Stage B composite
     double gpu_merge_ms = 0.0;      ///< depth merge (offscreen depth readback only)
+    /// Parts of gpu_sort_ms: depth sort, scan + entry emission, tile sort.
+    double gpu_depth_sort_ms = 0.0, gpu_scan_emit_ms = 0.0, gpu_tile_sort_ms = 0.0;
     /// Bytes the backend keeps on the GPU for the scene between frames (0 for the CPU).
     int64_t gpu_scene_bytes = 0;
     /// True when Stage A was reused because neither the scene nor the view changed.

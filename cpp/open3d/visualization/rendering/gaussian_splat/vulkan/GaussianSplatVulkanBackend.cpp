@@ -208,6 +208,10 @@ void GaussianSplatVulkanBackend::RenderCompositeStage(RenderOutput& output,
         const std::vector<double> ms = stage_a_timestamps_.ReadMilliseconds();
         geometry_.gpu_project_ms = std::max(0.0, ms[static_cast<uint32_t>(TimedPass::kProject)]);
         geometry_.gpu_sort_ms = std::max(0.0, ms[static_cast<uint32_t>(TimedPass::kSort)]);
+        geometry_.gpu_depth_sort_ms =
+            std::max(0.0, ms[static_cast<uint32_t>(TimedPass::kDepthSort)]);
+        geometry_.gpu_scan_emit_ms = std::max(0.0, ms[static_cast<uint32_t>(TimedPass::kScanEmit)]);
+        geometry_.gpu_tile_sort_ms = std::max(0.0, ms[static_cast<uint32_t>(TimedPass::kTileSort)]);
     }
     EnsureTargets(w, h);
 
@@ -337,6 +341,11 @@ void GaussianSplatVulkanBackend::RenderCompositeStage(RenderOutput& output,
     s.composite_ms = MsSince(start);
     s.gpu_project_ms = geometry_.reused ? 0.0 : geometry_.gpu_project_ms;
     s.gpu_sort_ms = geometry_.reused ? 0.0 : geometry_.gpu_sort_ms;
+    if (!geometry_.reused) {
+        s.gpu_depth_sort_ms = geometry_.gpu_depth_sort_ms;
+        s.gpu_scan_emit_ms = geometry_.gpu_scan_emit_ms;
+        s.gpu_tile_sort_ms = geometry_.gpu_tile_sort_ms;
+    }
     const std::vector<double> ms = stage_b_timestamps_.ReadMilliseconds();
     s.gpu_composite_ms = std::max(0.0, ms[static_cast<uint32_t>(TimedPass::kComposite)]);
     s.gpu_scene_bytes = static_cast<int64_t>(stage_a_resources_.SceneBytes());

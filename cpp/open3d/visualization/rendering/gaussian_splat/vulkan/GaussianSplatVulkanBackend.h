@@ -93,6 +93,7 @@ private:
         bool in_flight = false;
         bool reused = false;
         double gpu_project_ms = 0.0, gpu_sort_ms = 0.0;
+        double gpu_depth_sort_ms = 0.0, gpu_scan_emit_ms = 0.0, gpu_tile_sort_ms = 0.0;
         double cpu_ms = 0.0;
     } geometry_;
     CommandBuffer stage_a_cmd_;

@@ -207,11 +207,20 @@ void GaussianStageA::Record(VkCommandBuffer cmd, const StageASceneBuffers& scene
     // depth key puts the visible splats first, front to back, ties in index order.
     // The packed key, like the seed, keeps the projection's append order: its one entry
     // sort decides the depth order, and measuring its error means not helping it here.
+    const auto begin = [&](TimedPass pass) {
+        if (timestamps) timestamps->RecordBegin(cmd, pass);
+    };
+    const auto end = [&](TimedPass pass) {
+        if (timestamps) timestamps->RecordEnd(cmd, pass);
+    };
     if (!packed_key) {
+        begin(TimedPass::kDepthSort);
         sort_.Record(cmd, buffers.depth_keys, buffers.splat_indices, buffers.sort_scratch,
                      counter_range(kCounterNumSplatsIndex), std::max(n, 1u), 32);
         ComputeBarrier(cmd);
+        end(TimedPass::kDepthSort);
     }
+    begin(TimedPass::kScanEmit);
 
     // 4. Exclusive scan of the tile counts in depth order, up the block levels and down.
     PushBindings(cmd, scene, buffers);  // the sorts bound their own layout
@@ -252,8 +261,11 @@ void GaussianStageA::Record(VkCommandBuffer cmd, const StageASceneBuffers& scene
     vkCmdDispatchIndirect(cmd, counters, emit_args);
     ComputeBarrier(cmd);
 
+    end(TimedPass::kScanEmit);
+
     // 7. Stable sort by tile index only: each tile keeps the depth order of step 3. The
     // packed key sorts all 32 bits (4 passes, as the seed), then shifts back to tiles.
+    begin(TimedPass::kTileSort);
     sort_.Record(cmd, buffers.entry_keys, buffers.entry_values, buffers.sort_scratch,
                  counter_range(kCounterEntriesIndex), std::max(capacity, 1u),
                  packed_key ? kSortKeyBits : params.limits.w);
@@ -263,7 +275,8 @@ void GaussianStageA::Record(VkCommandBuffer cmd, const StageASceneBuffers& scene
         vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, unpack_keys_.Get());
         vkCmdDispatchIndirect(cmd, counters, emit_args);
     }
-    if (timestamps) timestamps->RecordEnd(cmd, TimedPass::kSort);
+    end(TimedPass::kTileSort);
+    end(TimedPass::kSort);
 }
 
 }  // namespace vulkan

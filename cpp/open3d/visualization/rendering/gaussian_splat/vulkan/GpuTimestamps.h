@@ -24,6 +24,10 @@ enum class TimedPass : uint32_t {
     kSort,         ///< Stage A's sorts, scan and emit
     kComposite,
     kDepthMerge,
+    // Parts of kSort, for profiling (GaussianStageA::Record times them when given timestamps).
+    kDepthSort,  ///< the depth sort of the visible list
+    kScanEmit,   ///< tile-count scan, capacity check and entry emission
+    kTileSort,   ///< the stable sort of the entries by tile
     kCount
 };
 
