@@ -5,7 +5,13 @@
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 build_dir="${BUILD_DIR:-$root/build}"
-bash "$root/scripts/build.sh" >/dev/null
+mkdir -p "$build_dir"
+# Quiet build; on failure show what went wrong.
+if ! bash "$root/scripts/build.sh" >"$build_dir/build.log" 2>&1; then
+  tail -n 40 "$build_dir/build.log" >&2
+  echo "run.sh: the build failed (full log: $build_dir/build.log)" >&2
+  exit 1
+fi
 if [ $# -eq 0 ]; then
   set -- --output "$build_dir/default_scene.png"
 fi
