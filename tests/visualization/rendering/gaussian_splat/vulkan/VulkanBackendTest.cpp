@@ -101,6 +101,7 @@ TEST_F(VulkanBackend, UnchangedViewReusesStageAAndGivesTheSameImage) {
     backend->Render(cam, no_reuse);
     backend->Render(cam.Resized(64, 48), {});
     EXPECT_EQ(backend->GetCounters().geometry_runs, 3);
+    EXPECT_EQ(backend->GetCounters().skipped_composites, 0);
 }
 
 TEST_F(VulkanBackend, EntryBuffersGrowInsteadOfDroppingEntries) {
@@ -138,6 +139,13 @@ TEST_F(VulkanBackend, EmptyViewIsBackgroundOnly) {
         backend->Render(camera::PinholeCamera::FromLookAt(away, 33, 17), config);
     EXPECT_EQ(out.stats.num_visible, 0);
     EXPECT_EQ(out.stats.num_tile_entries, 0);
+    // Nothing to blend: no composite dispatch (the sorts dispatch zero workgroups from the
+    // GPU counts); the images are cleared instead.
+    EXPECT_EQ(backend->GetCounters().skipped_composites, 1);
+    EXPECT_EQ(out.stats.gpu_composite_ms, 0.0);
+    for (int64_t i = 0; i < out.depth_expected.NumPixels(); ++i) {
+        ASSERT_EQ(out.depth_expected.Data<float>()[i], 0.0f);
+    }
     for (int64_t i = 0; i < out.color.NumPixels(); ++i) {
         ASSERT_EQ(out.color.Data<float>()[i * 4 + 0], 0.25f);
         ASSERT_EQ(out.color.Data<float>()[i * 4 + 2], 0.75f);

@@ -32,11 +32,12 @@ bool SameConfig(const RenderConfig& a, const RenderConfig& b) {
            a.compact_storage == b.compact_storage;
 }
 
-void ToTransferSrc(VkCommandBuffer cmd, const Image& image) {
+// After the composite (compute writes) or the empty-frame clear (transfer writes).
+void ToTransferSrc(VkCommandBuffer cmd, const Image& image, VkPipelineStageFlags2 stage,
+                   VkAccessFlags2 access) {
     RecordImageBarrier(cmd, image.Get(), VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_GENERAL,
-                       VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
-                       VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, VK_PIPELINE_STAGE_2_COPY_BIT,
-                       VK_ACCESS_2_TRANSFER_READ_BIT);
+                       VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, stage, access,
+                       VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_READ_BIT);
 }
 
 void CopyToBuffer(VkCommandBuffer cmd, const Image& image, const Buffer& buffer) {
@@ -131,7 +132,8 @@ void GaussianSplatVulkanBackend::EnsureViewBuffers(uint32_t entry_capacity) {
 void GaussianSplatVulkanBackend::EnsureTargets(uint32_t width, uint32_t height) {
     if (color_ && width == width_ && height == height_) return;
     const StageBStorageRequirements need = GaussianStageB::GetStorageRequirements();
-    const VkImageUsageFlags usage = need.image_usage | VK_IMAGE_USAGE_TRANSFER_SRC_BIT;
+    const VkImageUsageFlags usage =
+        need.image_usage | VK_IMAGE_USAGE_TRANSFER_SRC_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT;
     const auto readback = [&](uint32_t texel_bytes) {
         return Buffer(*context_, VkDeviceSize(width) * height * texel_bytes,
                       VK_BUFFER_USAGE_TRANSFER_DST_BIT, MemoryUsage::kHostReadback);
@@ -182,6 +184,13 @@ void GaussianSplatVulkanBackend::RenderGeometryStage(const camera::PinholeCamera
     stage_a_timestamps_.RecordReset(cmd);
     stage_a_.Record(cmd, stage_a_resources_.Scene(), stage_a_resources_.View(), params,
                     &stage_a_timestamps_);
+    // The counters reach the host with Stage A's fence: Stage B can skip an empty frame.
+    RecordMemoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                        VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, VK_PIPELINE_STAGE_2_COPY_BIT,
+                        VK_ACCESS_2_TRANSFER_READ_BIT);
+    const VkBufferCopy counters_region{0, 0, counters_readback_.GetSize()};
+    vkCmdCopyBuffer(cmd, stage_a_resources_.counters.Get(), counters_readback_.Get(), 1,
+                    &counters_region);
     stage_a_cmd_.End();
     stage_a_fence_ = CreateFence(*context_);
     // Fire and forget: Stage B (or the next geometry stage) waits on the fence.
@@ -214,6 +223,11 @@ void GaussianSplatVulkanBackend::RenderCompositeStage(RenderOutput& output,
         geometry_.gpu_tile_sort_ms = std::max(0.0, ms[static_cast<uint32_t>(TimedPass::kTileSort)]);
     }
     EnsureTargets(w, h);
+    shader::GaussianStageACounters gpu_counters{};
+    std::memcpy(&gpu_counters, counters_readback_.GetMapped(), sizeof(gpu_counters));
+    // Nothing to blend (everything culled or hidden): no composite dispatch, the images are
+    // cleared to the background instead.
+    const bool empty = gpu_counters.entry_count == 0;
 
     // Scene depth (view z) becomes Filament's reversed-Z texture d = near / z.
     Image scene_image;
@@ -247,17 +261,16 @@ void GaussianSplatVulkanBackend::RenderCompositeStage(RenderOutput& output,
     RecordMemoryBarrier(cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_MEMORY_WRITE_BIT,
                         VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_COPY_BIT,
                         VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_TRANSFER_READ_BIT);
+    const VkPipelineStageFlags2 write_stage =
+        empty ? VK_PIPELINE_STAGE_2_CLEAR_BIT : VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT;
+    const VkAccessFlags2 write_access =
+        empty ? VK_ACCESS_2_TRANSFER_WRITE_BIT : VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT;
     for (const Image* image : {&color_, &depth_, &alpha_, &median_}) {
         RecordImageBarrier(cmd, image->Get(), VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
                            VK_IMAGE_LAYOUT_GENERAL, VK_PIPELINE_STAGE_2_COPY_BIT,
-                           VK_ACCESS_2_TRANSFER_READ_BIT, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
-                           VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
+                           VK_ACCESS_2_TRANSFER_READ_BIT, write_stage, write_access);
     }
     if (has_scene) RecordDepthTextureUpload(cmd, scene_image, scene_upload.Get());
-    const VkBufferCopy counters_region{0, 0, counters_readback_.GetSize()};
-    vkCmdCopyBuffer(cmd, stage_a_resources_.counters.Get(), counters_readback_.Get(), 1,
-                    &counters_region);
-
     StageBInputs stage_b_inputs;
     stage_b_inputs.projected = stage_a_resources_.projected.Range();
     stage_b_inputs.entry_keys = stage_a_resources_.entry_keys.Range();
@@ -277,13 +290,25 @@ void GaussianSplatVulkanBackend::RenderCompositeStage(RenderOutput& output,
     for (int c = 0; c < 3; ++c)
         params.background[c] = static_cast<float>(geometry_.config.background[c]);
     params.scene_depth = has_scene ? &scene : nullptr;
-    stage_b_timestamps_.RecordBegin(cmd, TimedPass::kComposite);
-    stage_b_.RecordComposite(cmd, stage_b_inputs, targets, composite_state_.Range(), params);
-    stage_b_timestamps_.RecordEnd(cmd, TimedPass::kComposite);
-    ToTransferSrc(cmd, color_);
-    ToTransferSrc(cmd, depth_);
-    ToTransferSrc(cmd, alpha_);
-    ToTransferSrc(cmd, median_);
+    if (empty) {
+        const VkImageSubresourceRange all{VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
+        VkClearColorValue background{};
+        for (int c = 0; c < 3; ++c) background.float32[c] = params.background[c];
+        const VkClearColorValue zero{};
+        vkCmdClearColorImage(cmd, color_.Get(), VK_IMAGE_LAYOUT_GENERAL, &background, 1, &all);
+        for (const Image* image : {&depth_, &alpha_, &median_}) {
+            vkCmdClearColorImage(cmd, image->Get(), VK_IMAGE_LAYOUT_GENERAL, &zero, 1, &all);
+        }
+        ++counters_.skipped_composites;
+    } else {
+        stage_b_timestamps_.RecordBegin(cmd, TimedPass::kComposite);
+        stage_b_.RecordComposite(cmd, stage_b_inputs, targets, composite_state_.Range(), params);
+        stage_b_timestamps_.RecordEnd(cmd, TimedPass::kComposite);
+    }
+    ToTransferSrc(cmd, color_, write_stage, write_access);
+    ToTransferSrc(cmd, depth_, write_stage, write_access);
+    ToTransferSrc(cmd, alpha_, write_stage, write_access);
+    ToTransferSrc(cmd, median_, write_stage, write_access);
     CopyToBuffer(cmd, color_, color_readback_);
     CopyToBuffer(cmd, depth_, depth_readback_);
     CopyToBuffer(cmd, alpha_, alpha_readback_);
@@ -294,8 +319,6 @@ void GaussianSplatVulkanBackend::RenderCompositeStage(RenderOutput& output,
     Wait(*context_, fence.Get());
     ++counters_.composites;
 
-    shader::GaussianStageACounters gpu_counters{};
-    std::memcpy(&gpu_counters, counters_readback_.GetMapped(), sizeof(gpu_counters));
     // The allocation, not the config, cut this frame short: grow the entry buffers to what
     // it asked for (plus a quarter, so a moving camera does not regrow every frame) and
     // render it again. Stage A reported the full request, so one retry suffices.
@@ -347,7 +370,8 @@ void GaussianSplatVulkanBackend::RenderCompositeStage(RenderOutput& output,
         s.gpu_tile_sort_ms = geometry_.gpu_tile_sort_ms;
     }
     const std::vector<double> ms = stage_b_timestamps_.ReadMilliseconds();
-    s.gpu_composite_ms = std::max(0.0, ms[static_cast<uint32_t>(TimedPass::kComposite)]);
+    s.gpu_composite_ms =
+        empty ? 0.0 : std::max(0.0, ms[static_cast<uint32_t>(TimedPass::kComposite)]);
     s.gpu_scene_bytes = static_cast<int64_t>(stage_a_resources_.SceneBytes());
 }
 

@@ -51,11 +51,12 @@ public:
 
     /// Counters that make the skips visible to tests and benchmarks.
     struct Counters {
-        int64_t scene_uploads = 0;     ///< packs + uploads of the scene
-        int64_t geometry_runs = 0;     ///< Stage A recorded
-        int64_t geometry_reuses = 0;   ///< Stage A skipped (nothing changed)
-        int64_t composites = 0;        ///< Stage B recorded
-        int64_t capacity_growths = 0;  ///< frames re-rendered with larger entry buffers
+        int64_t scene_uploads = 0;       ///< packs + uploads of the scene
+        int64_t geometry_runs = 0;       ///< Stage A recorded
+        int64_t geometry_reuses = 0;     ///< Stage A skipped (nothing changed)
+        int64_t composites = 0;          ///< Stage B recorded
+        int64_t capacity_growths = 0;    ///< frames re-rendered with larger entry buffers
+        int64_t skipped_composites = 0;  ///< frames with no tile entry: images cleared instead
     };
     const Counters& GetCounters() const { return counters_; }
     const VulkanContext& GetContext() const { return *context_; }
