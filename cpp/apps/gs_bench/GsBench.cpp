@@ -17,6 +17,7 @@
 #include "open3d/camera/CamerasJson.h"
 #include "open3d/core/Exception.h"
 #include "open3d/core/ParallelFor.h"
+#include "open3d/core/Timer.h"
 #include "open3d/t/geometry/ImageMetrics.h"
 #include "open3d/t/io/PointCloudIO.h"
 #include "open3d/visualization/rendering/gaussian_splat/GaussianSplatRenderer.h"
@@ -65,10 +66,6 @@ struct Row {
     double psnr = 0, max_abs = 0, over_1_255 = 0, p999 = 0;
     uint32_t error_flags = 0;
 };
-
-double MsSince(std::chrono::steady_clock::time_point t) {
-    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t).count();
-}
 
 std::pair<int, int> ParseResolution(const std::string& text) {
     int w = 0, h = 0;
@@ -227,7 +224,7 @@ int Run(const Options& opt) {
                     for (int it = 0; it < opt.repeat; ++it) {
                         const auto start = std::chrono::steady_clock::now();
                         out = backend->Render(cams[v], config);
-                        cpu_ms += MsSince(start);
+                        cpu_ms += core::MillisecondsSince(start);
                         sum.gpu_project_ms += out.stats.gpu_project_ms;
                         sum.gpu_sort_ms += out.stats.gpu_sort_ms;
                         sum.gpu_composite_ms += out.stats.gpu_composite_ms;

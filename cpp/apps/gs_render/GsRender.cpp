@@ -12,6 +12,7 @@
 #include "open3d/camera/PinholeCamera.h"
 #include "open3d/core/Exception.h"
 #include "open3d/core/ParallelFor.h"
+#include "open3d/core/Timer.h"
 #include "open3d/t/io/ImageIO.h"
 #include "open3d/t/io/PointCloudIO.h"
 #include "open3d/visualization/rendering/gaussian_splat/DefaultScene.h"
@@ -44,11 +45,6 @@ struct Options {
     std::optional<double> fov;
     double orbit_angle = 0.0;
 };
-
-double MsSince(std::chrono::steady_clock::time_point start) {
-    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
-        .count();
-}
 
 Eigen::Vector3d ToVec(const std::vector<double>& v) { return Eigen::Vector3d(v[0], v[1], v[2]); }
 
@@ -144,7 +140,7 @@ int Run(const Options& opt) {
     } else {
         t::io::ReadPointCloud(opt.input, cloud);
     }
-    const double load_ms = MsSince(start);
+    const double load_ms = core::MillisecondsSince(start);
     std::printf("scene: %s, %lld splats, SH degree %d, loaded in %.1f ms\n",
                 default_scene ? "built-in default" : opt.input.c_str(),
                 static_cast<long long>(cloud.NumPoints()), cloud.GaussianSplatGetSHOrder(),
@@ -176,7 +172,7 @@ int Run(const Options& opt) {
     backend->RenderGeometryStage(cam, config);
     rendering::RenderOutput out;
     backend->RenderCompositeStage(out);
-    const double render_ms = MsSince(render_start);
+    const double render_ms = core::MillisecondsSince(render_start);
     const auto& s = out.stats;
     std::printf(
         "render: %dx%d, backend %s, %d threads: geometry %.1f ms, composite %.1f ms, "
@@ -201,7 +197,7 @@ int Run(const Options& opt) {
         t::io::WriteNpy(opt.float_output, out.color);
         std::printf("wrote %s (float RGBA)\n", opt.float_output.c_str());
     }
-    std::printf("total time %.1f ms\n", MsSince(start));
+    std::printf("total time %.1f ms\n", core::MillisecondsSince(start));
     return 0;
 }
 

@@ -1,4 +1,5 @@
 #include "open3d/visualization/rendering/gaussian_splat/cpu/CpuBackend.h"
+#include "open3d/core/Timer.h"
 
 #include <chrono>
 
@@ -9,13 +10,6 @@ namespace open3d {
 namespace visualization {
 namespace rendering {
 namespace cpu {
-
-namespace {
-double MillisecondsSince(std::chrono::steady_clock::time_point start) {
-    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
-        .count();
-}
-}  // namespace
 
 void CpuBackend::SetScene(const t::geometry::PointCloud& cloud) {
     cloud.ValidateGaussianSplat();
@@ -41,7 +35,7 @@ void CpuBackend::RenderGeometryStage(const camera::PinholeCamera& camera,
         BuildTileLists(projected_, TileGrid::ForImage(camera.width, camera.height), config);
     camera_ = camera;
     config_ = config;
-    geometry_ms_ = MillisecondsSince(start);
+    geometry_ms_ = core::MillisecondsSince(start);
 }
 
 void CpuBackend::RenderCompositeStage(RenderOutput& output, const CompositeInputs& inputs) {
@@ -56,7 +50,7 @@ void CpuBackend::RenderCompositeStage(RenderOutput& output, const CompositeInput
     output.stats.num_tile_entries = tile_lists_.NumEntries();
     output.stats.error_flags = tile_lists_.error_flags;
     output.stats.geometry_ms = geometry_ms_;
-    output.stats.composite_ms = MillisecondsSince(start);
+    output.stats.composite_ms = core::MillisecondsSince(start);
 }
 
 RenderOutput RenderReference(const t::geometry::PointCloud& cloud,

@@ -1,4 +1,5 @@
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/GaussianSplatVulkanBackend.h"
+#include "open3d/core/Timer.h"
 
 #include <chrono>
 #include <cmath>
@@ -14,11 +15,6 @@ namespace rendering {
 namespace vulkan {
 
 namespace {
-
-double MsSince(std::chrono::steady_clock::time_point start) {
-    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
-        .count();
-}
 
 bool SameCamera(const camera::PinholeCamera& a, const camera::PinholeCamera& b) {
     return a.width == b.width && a.height == b.height && a.fx == b.fx && a.fy == b.fy &&
@@ -201,7 +197,7 @@ void GaussianSplatVulkanBackend::RenderGeometryStage(const camera::PinholeCamera
     geometry_.valid = true;
     geometry_.in_flight = true;
     geometry_.reused = false;
-    geometry_.cpu_ms = MsSince(start);
+    geometry_.cpu_ms = core::MillisecondsSince(start);
 }
 
 void GaussianSplatVulkanBackend::RenderCompositeStage(RenderOutput& output,
@@ -361,7 +357,7 @@ void GaussianSplatVulkanBackend::RenderCompositeStage(RenderOutput& output,
     s.error_flags = gpu_counters.error_flags;
     s.geometry_reused = geometry_.reused;
     s.geometry_ms = geometry_.reused ? 0.0 : geometry_.cpu_ms;
-    s.composite_ms = MsSince(start);
+    s.composite_ms = core::MillisecondsSince(start);
     s.gpu_project_ms = geometry_.reused ? 0.0 : geometry_.gpu_project_ms;
     s.gpu_sort_ms = geometry_.reused ? 0.0 : geometry_.gpu_sort_ms;
     if (!geometry_.reused) {

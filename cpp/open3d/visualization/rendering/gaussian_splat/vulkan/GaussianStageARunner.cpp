@@ -1,4 +1,5 @@
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/GaussianStageARunner.h"
+#include "open3d/core/Timer.h"
 
 #include <chrono>
 #include <cstring>
@@ -96,9 +97,7 @@ StageAReadback GaussianStageARunner::Run(const camera::PinholeCamera& camera,
         const auto start = std::chrono::steady_clock::now();
         Submit(context_, cmd.Get(), fence.Get());
         Wait(context_, fence.Get());
-        out.stage_a_ms =
-            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
-                .count();
+        out.stage_a_ms = core::MillisecondsSince(start);
         FinishCopies(pending);
     }
 

@@ -1,4 +1,5 @@
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/GaussianStageBRunner.h"
+#include "open3d/core/Timer.h"
 
 #include <chrono>
 #include <cmath>
@@ -202,10 +203,9 @@ StageBReadback GaussianStageBRunner::Run(const StageBRunInputs& in) {
     const auto start = std::chrono::steady_clock::now();
     Submit(context_, c, fence.Get());
     Wait(context_, fence.Get());
-    const auto stop = std::chrono::steady_clock::now();
 
     StageBReadback out;
-    out.wall_ms = std::chrono::duration<double, std::milli>(stop - start).count();
+    out.wall_ms = core::MillisecondsSince(start);
     const std::vector<double> ms = timestamps_.ReadMilliseconds();
     out.composite_ms = ms[static_cast<uint32_t>(TimedPass::kComposite)];
     out.merge_ms = ms[static_cast<uint32_t>(TimedPass::kDepthMerge)];
