@@ -99,18 +99,6 @@ std::vector<int> ParseViews(const std::string& text, int available) {
     return views;
 }
 
-// 99.9th percentile of the per-element absolute colour difference.
-double Percentile999(const t::geometry::Image& a, const t::geometry::Image& b) {
-    const int64_t n = a.NumPixels() * a.GetChannels();
-    std::vector<float> diff(n);
-    const float* pa = a.Data<float>();
-    const float* pb = b.Data<float>();
-    for (int64_t i = 0; i < n; ++i) diff[i] = std::abs(pa[i] - pb[i]);
-    const int64_t k = std::min<int64_t>(n - 1, static_cast<int64_t>(std::ceil(0.999 * n)) - 1);
-    std::nth_element(diff.begin(), diff.begin() + std::max<int64_t>(k, 0), diff.end());
-    return diff[std::max<int64_t>(k, 0)];
-}
-
 struct SceneJob {
     std::string name;
     t::geometry::PointCloud cloud;
@@ -260,7 +248,8 @@ int Run(const Options& opt) {
                     worst_psnr = std::min(worst_psnr, m.psnr_db);
                     row.max_abs = std::max(row.max_abs, m.max_abs_error);
                     row.over_1_255 = std::max(row.over_1_255, m.fraction_over_threshold);
-                    row.p999 = std::max(row.p999, Percentile999(out.color, ref[v]));
+                    row.p999 = std::max(
+                        row.p999, t::geometry::ComputeAbsErrorPercentile(out.color, ref[v], 0.999));
                 }
                 row.psnr = worst_psnr;  // the worst view
                 row.gpu_total_ms = row.project_ms + row.sort_ms + row.composite_ms;

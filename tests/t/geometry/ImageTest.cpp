@@ -52,3 +52,25 @@ TEST(ImageMetrics, KnownValues) {
 
 }  // namespace tests
 }  // namespace open3d
+
+namespace open3d {
+namespace t {
+namespace geometry {
+
+TEST(ImageMetrics, AbsErrorPercentileIsNearestRank) {
+    // |a - b| = 1, 2, ..., 1000 (shuffled order): the 99.9th percentile by nearest rank is
+    // element ceil(0.999 * 1000) - 1 = 998 of the sorted values, i.e. 999.
+    Image a(10, 100, 1, core::Dtype::Float32), b(10, 100, 1, core::Dtype::Float32);
+    for (int i = 0; i < 1000; ++i) {
+        a.Data<float>()[i] = static_cast<float>((i * 7919) % 1000 + 1);
+        b.Data<float>()[i] = 0.0f;
+    }
+    EXPECT_EQ(ComputeAbsErrorPercentile(a, b, 0.999), 999.0);
+    EXPECT_EQ(ComputeAbsErrorPercentile(a, b, 1.0), 1000.0);
+    EXPECT_EQ(ComputeAbsErrorPercentile(a, b, 0.5), 500.0);
+    EXPECT_THROW(ComputeAbsErrorPercentile(a, b, 0.0), core::Open3DError);
+}
+
+}  // namespace geometry
+}  // namespace t
+}  // namespace open3d

@@ -1,7 +1,9 @@
 #include "open3d/t/geometry/ImageMetrics.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
+#include <vector>
 
 #include "open3d/core/Exception.h"
 
@@ -80,6 +82,18 @@ Image ComputeAbsDifference(const Image& a, const Image& b) {
         out.Data<float>()[i] = std::abs(fa.Data<float>()[i] - fb.Data<float>()[i]);
     }
     return out;
+}
+
+double ComputeAbsErrorPercentile(const Image& a, const Image& b, double q) {
+    if (!(q > 0.0 && q <= 1.0))
+        core::ThrowError("ComputeAbsErrorPercentile: q = {} not in (0, 1]", q);
+    const Image diff = ComputeAbsDifference(a, b);
+    const int64_t n = diff.AsTensor().NumElements();
+    if (n == 0) return 0.0;
+    std::vector<float> values(diff.Data<float>(), diff.Data<float>() + n);
+    const int64_t k = std::clamp<int64_t>(static_cast<int64_t>(std::ceil(q * n)) - 1, 0, n - 1);
+    std::nth_element(values.begin(), values.begin() + k, values.end());
+    return values[k];
 }
 
 }  // namespace geometry

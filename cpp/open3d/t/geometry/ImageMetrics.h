@@ -35,6 +35,10 @@ double ComputeFractionOverThreshold(const Image& a, const Image& b, double thres
 /// |a - b| per element, as Float32 (values as stored), for diff images.
 Image ComputeAbsDifference(const Image& a, const Image& b);
 
+/// The q-quantile (0 < q <= 1, nearest rank: element ceil(q n) - 1 in ascending order) of
+/// |a - b| over all elements, e.g. q = 0.999 for the 99.9th percentile.
+double ComputeAbsErrorPercentile(const Image& a, const Image& b, double q);
+
 }  // namespace geometry
 }  // namespace t
 }  // namespace open3d

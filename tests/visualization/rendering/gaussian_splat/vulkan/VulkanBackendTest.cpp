@@ -37,15 +37,6 @@ protected:
     }
 };
 
-// 99.9th percentile of |a - b| over all colour elements.
-double Percentile999(const t::geometry::Image& a, const t::geometry::Image& b) {
-    std::vector<float> d(a.NumPixels() * a.GetChannels());
-    for (size_t i = 0; i < d.size(); ++i) d[i] = std::abs(a.Data<float>()[i] - b.Data<float>()[i]);
-    const size_t k = std::min(d.size() - 1, static_cast<size_t>(std::ceil(0.999 * d.size())) - 1);
-    std::nth_element(d.begin(), d.begin() + k, d.end());
-    return d[k];
-}
-
 struct SceneCase {
     const char* scene;
     const char* cameras;
@@ -74,7 +65,8 @@ TEST_F(VulkanBackend, RealScenesMatchTheReference) {
             SCOPED_TRACE(std::string(c.scene) + " view " + std::to_string(view));
             EXPECT_GE(m.psnr_db, 80.0);
             EXPECT_LE(m.fraction_over_threshold, 1e-4 * 4);  // 4 channels per pixel
-            EXPECT_LE(Percentile999(gpu.color, ref.color), 0.1 / 255.0);
+            EXPECT_LE(t::geometry::ComputeAbsErrorPercentile(gpu.color, ref.color, 0.999),
+                      0.1 / 255.0);
             EXPECT_EQ(gpu.stats.error_flags, 0u);
             // Depth: alpha-weighted view z where the pixel is covered.
             const auto d = t::geometry::ComputeImageErrorMetrics(gpu.depth_expected,
