@@ -109,6 +109,20 @@ int PointCloud::GaussianSplatGetSHOrder() const {
     }
 }
 
+GaussianSplatArrays PointCloud::GetGaussianSplatArrays() const {
+    GaussianSplatArrays a;
+    a.sh_degree = GaussianSplatGetSHOrder();  // validates
+    a.num_rest = NumSHRestCoeffs(a.sh_degree);
+    a.num_points = NumPoints();
+    a.positions = GetPointPositions().Data<float>();
+    a.scale = GetPointAttr(gs_attr::kScale).Data<float>();
+    a.rot = GetPointAttr(gs_attr::kRot).Data<float>();
+    a.opacity = GetPointAttr(gs_attr::kOpacity).Data<float>();
+    a.f_dc = GetPointAttr(gs_attr::kFDc).Data<float>();
+    if (a.sh_degree > 0) a.f_rest = GetPointAttr(gs_attr::kFRest).Data<float>();
+    return a;
+}
+
 }  // namespace geometry
 }  // namespace t
 }  // namespace open3d

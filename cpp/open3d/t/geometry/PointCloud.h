@@ -30,6 +30,20 @@ inline constexpr const char* kFRest = "f_rest";
 /// Number of f_rest coefficients per channel for an SH degree: (degree+1)^2 - 1.
 inline int NumSHRestCoeffs(int degree) { return (degree + 1) * (degree + 1) - 1; }
 
+/// Read-only pointers to the attributes of a valid Gaussian splat cloud, looked up once:
+/// loops over splats index these instead of looking attributes up by name.
+struct GaussianSplatArrays {
+    int64_t num_points = 0;
+    int sh_degree = 0;                 ///< 0..3
+    int num_rest = 0;                  ///< Nc = (degree + 1)^2 - 1 coefficients per channel
+    const float* positions = nullptr;  // [N, 3]
+    const float* scale = nullptr;      // [N, 3] linear
+    const float* rot = nullptr;        // [N, 4] (w, x, y, z)
+    const float* opacity = nullptr;    // [N, 1] logit
+    const float* f_dc = nullptr;       // [N, 3]
+    const float* f_rest = nullptr;     // [N, Nc, 3]; null at degree 0
+};
+
 class PointCloud {
 public:
     PointCloud() = default;
@@ -59,6 +73,9 @@ public:
     int GaussianSplatGetSHOrder() const;
     /// Throws Open3DError naming the first attribute whose dtype or shape is wrong.
     void ValidateGaussianSplat() const;
+    /// Validates (as ValidateGaussianSplat) and returns the attribute arrays. The pointers
+    /// stay valid until an attribute is set or removed.
+    GaussianSplatArrays GetGaussianSplatArrays() const;
 
     // Geometric transforms (PointCloudTransform.cpp). For splat clouds every Gaussian
     // attribute follows: see docs/transforms.md.

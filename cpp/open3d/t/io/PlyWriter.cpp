@@ -43,26 +43,23 @@ std::vector<std::string> PropertyNames(bool gaussian, int num_rest) {
     return names;
 }
 
-// Fills row i with the file's values in PropertyNames order.
-void FillRow(const geometry::PointCloud& cloud, bool gaussian, int nc, int64_t i, float* row) {
-    using namespace geometry::gs_attr;
-    const float* p = cloud.GetPointPositions().Data<float>() + i * 3;
-    for (int c = 0; c < 3; ++c) *row++ = p[c];
-    if (!gaussian) return;
+// Fills row i with the file's values in PropertyNames order (`a` is null for a plain cloud).
+void FillRow(const float* positions, const geometry::GaussianSplatArrays* a, int64_t i,
+             float* row) {
+    for (int c = 0; c < 3; ++c) *row++ = positions[i * 3 + c];
+    if (a == nullptr) return;
     for (int c = 0; c < 3; ++c) *row++ = 0.0f;  // normals: unused by 3DGS, kept for the layout
-    const float* dc = cloud.GetPointAttr(kFDc).Data<float>() + i * 3;
-    for (int c = 0; c < 3; ++c) *row++ = dc[c];
+    for (int c = 0; c < 3; ++c) *row++ = a->f_dc[i * 3 + c];
+    const int nc = a->num_rest;
     if (nc > 0) {
-        const float* rest = cloud.GetPointAttr(kFRest).Data<float>() + i * nc * 3;
+        const float* rest = a->f_rest + i * nc * 3;
         for (int c = 0; c < 3; ++c) {
             for (int k = 0; k < nc; ++k) *row++ = rest[k * 3 + c];  // channel-major in the file
         }
     }
-    *row++ = cloud.GetPointAttr(kOpacity).Data<float>()[i];
-    const float* s = cloud.GetPointAttr(kScale).Data<float>() + i * 3;
-    for (int c = 0; c < 3; ++c) *row++ = EncodeLogScale(s[c]);
-    const float* q = cloud.GetPointAttr(kRot).Data<float>() + i * 4;
-    for (int c = 0; c < 4; ++c) *row++ = q[c];
+    *row++ = a->opacity[i];
+    for (int c = 0; c < 3; ++c) *row++ = EncodeLogScale(a->scale[i * 3 + c]);
+    for (int c = 0; c < 4; ++c) *row++ = a->rot[i * 4 + c];
 }
 
 }  // namespace
@@ -72,9 +69,11 @@ void WritePly(const std::string& filename, const geometry::PointCloud& cloud, Pl
         core::ThrowError("Cannot write '{}': the point cloud has no positions", filename);
     }
     const bool gaussian = cloud.IsGaussianSplat();
-    const int nc = gaussian ? geometry::NumSHRestCoeffs(cloud.GaussianSplatGetSHOrder()) : 0;
+    geometry::GaussianSplatArrays arrays;
+    if (gaussian) arrays = cloud.GetGaussianSplatArrays();
+    const int nc = arrays.num_rest;
     if (gaussian) {
-        const float* s = cloud.GetPointAttr(geometry::gs_attr::kScale).Data<float>();
+        const float* s = arrays.scale;
         for (int64_t k = 0; k < cloud.NumPoints() * 3; ++k) {
             if (s[k] < 0.0f) {
                 core::ThrowError("Cannot write '{}': splat {} has a negative scale {}", filename,
@@ -106,9 +105,12 @@ void WritePly(const std::string& filename, const geometry::PointCloud& cloud, Pl
     for (const auto& name : names) header += "property float " + name + "\n";
     header += "end_header\n";
 
+    const float* positions = cloud.GetPointPositions().Data<float>();  // [N, 3]
     std::vector<float> values(n * width);
     core::ParallelFor(
-        n, [&](int64_t i) { FillRow(cloud, gaussian, nc, i, &values[i * width]); }, 4096);
+        n,
+        [&](int64_t i) { FillRow(positions, gaussian ? &arrays : nullptr, i, &values[i * width]); },
+        4096);
 
     std::vector<uint8_t> bytes(header.begin(), header.end());
     if (format == PlyFormat::Ascii) {

@@ -72,23 +72,20 @@ geometry::PointCloud ReadSplat(const std::string& filename, const ReadPointCloud
 }
 
 void WriteSplat(const std::string& filename, const geometry::PointCloud& cloud) {
-    using namespace geometry::gs_attr;
     if (!cloud.IsGaussianSplat()) {
         core::ThrowError(
             "Cannot write '{}': .splat needs a Gaussian splat cloud (scale, rot, "
             "opacity, f_dc)",
             filename);
     }
-    if (cloud.GaussianSplatGetSHOrder() > 0) {
+    const geometry::GaussianSplatArrays a = cloud.GetGaussianSplatArrays();
+    if (a.sh_degree > 0) {
         core::LogWarning("'{}': .splat holds SH degree 0 only; f_rest (degree {}) is not written",
-                         filename, cloud.GaussianSplatGetSHOrder());
+                         filename, a.sh_degree);
     }
-    const int64_t n = cloud.NumPoints();
-    const float* positions = cloud.GetPointPositions().Data<float>();
-    const float* scale = cloud.GetPointAttr(kScale).Data<float>();
-    const float* rot = cloud.GetPointAttr(kRot).Data<float>();
-    const float* opacity = cloud.GetPointAttr(kOpacity).Data<float>();
-    const float* f_dc = cloud.GetPointAttr(kFDc).Data<float>();
+    const int64_t n = a.num_points;
+    const float *positions = a.positions, *scale = a.scale, *rot = a.rot;
+    const float *opacity = a.opacity, *f_dc = a.f_dc;
     std::vector<uint8_t> bytes(n * kSplatBytes);
     std::vector<uint8_t> clamped(n, 0);
     core::ParallelFor(

@@ -13,8 +13,6 @@ namespace open3d {
 namespace visualization {
 namespace rendering {
 
-namespace gs = t::geometry::gs_attr;
-
 static_assert(shader::kGaussianTileSize == static_cast<uint32_t>(kTileSize));
 static_assert(shader::kErrorEntriesDropped == kEntriesDropped);
 static_assert(shader::kErrorCountsClamped == kCountsClamped);
@@ -91,58 +89,49 @@ uint32_t WordsFor(int values, SplatPrecision precision) {
 
 PackedGaussianSplats PackGaussianSplatAttrs(const t::geometry::PointCloud& cloud,
                                             SplatPrecision precision, int max_sh_degree) {
-    cloud.ValidateGaussianSplat();
-    const int64_t n = cloud.NumPoints();
+    const t::geometry::GaussianSplatArrays a = cloud.GetGaussianSplatArrays();  // validates
+    const int64_t n = a.num_points;
     if (n > static_cast<int64_t>(std::numeric_limits<uint32_t>::max())) {
         core::ThrowError("PackGaussianSplatAttrs: {} splats, at most 2^32 - 1 fit a splat index",
                          n);
     }
-    const int scene_degree = cloud.GaussianSplatGetSHOrder();
-    const int64_t scene_rest = t::geometry::NumSHRestCoeffs(scene_degree);  // per channel
 
     PackedGaussianSplats packed;
     packed.precision = precision;
     packed.num_splats = n;
-    packed.sh_degree = std::clamp(max_sh_degree, 0, scene_degree);
+    packed.sh_degree = std::clamp(max_sh_degree, 0, a.sh_degree);
     const int rest_values = 3 * t::geometry::NumSHRestCoeffs(packed.sh_degree);
     packed.shape_words_per_splat = WordsFor(10, precision);
     packed.sh_words_per_splat = WordsFor(rest_values, precision);
     static_assert(shader::kShapeWordsExact == 10 && shader::kShapeWordsCompact == 5);
-
-    const float* positions = cloud.GetPointAttr(gs::kPositions).Data<float>();  // [N, 3]
-    const float* scales = cloud.GetPointAttr(gs::kScale).Data<float>();         // [N, 3]
-    const float* rots = cloud.GetPointAttr(gs::kRot).Data<float>();             // [N, 4]
-    const float* opacities = cloud.GetPointAttr(gs::kOpacity).Data<float>();    // [N, 1]
-    const float* f_dc = cloud.GetPointAttr(gs::kFDc).Data<float>();             // [N, 3]
-    const float* f_rest =
-        scene_degree > 0 ? cloud.GetPointAttr(gs::kFRest).Data<float>() : nullptr;  // [N,Nc,3]
 
     packed.positions.reserve(4 * n);
     packed.shape.reserve(packed.shape_words_per_splat * n);
     packed.sh.reserve(packed.sh_words_per_splat * n);
     std::vector<double> values(std::max(10, rest_values));
     for (int64_t i = 0; i < n; ++i) {
-        for (int c = 0; c < 3; ++c) packed.positions.push_back(positions[3 * i + c]);
-        const Eigen::Vector3d center(positions[3 * i], positions[3 * i + 1], positions[3 * i + 2]);
+        for (int c = 0; c < 3; ++c) packed.positions.push_back(a.positions[3 * i + c]);
+        const Eigen::Vector3d center(a.positions[3 * i], a.positions[3 * i + 1],
+                                     a.positions[3 * i + 2]);
         packed.center_min = packed.center_min.cwiseMin(center);
         packed.center_max = packed.center_max.cwiseMax(center);
         // The sigmoid in double, rounded once: within half an ulp of the reference's value.
-        const double logit = opacities[i];
+        const double logit = a.opacity[i];
         packed.positions.push_back(static_cast<float>(1.0 / (1.0 + std::exp(-logit))));
 
-        for (int c = 0; c < 3; ++c) values[c] = scales[3 * i + c];
-        const float* q = rots + 4 * i;
+        for (int c = 0; c < 3; ++c) values[c] = a.scale[3 * i + c];
+        const float* q = a.rot + 4 * i;
         const double norm = std::sqrt(double(q[0]) * q[0] + double(q[1]) * q[1] +
                                       double(q[2]) * q[2] + double(q[3]) * q[3]);
         // A zero quaternion stays zero: the shader's rotation formula then gives the
         // identity, as Eigen's does for the CPU reference.
         for (int c = 0; c < 4; ++c) values[3 + c] = norm > 0.0 ? q[c] / norm : 0.0;
-        for (int c = 0; c < 3; ++c) values[7 + c] = f_dc[3 * i + c];
+        for (int c = 0; c < 3; ++c) values[7 + c] = a.f_dc[3 * i + c];
         AppendWords(values.data(), 10, precision, packed.shape);
 
         if (rest_values > 0) {
             // The scene's [Nc, 3] block starts with the packed degree's coefficients.
-            const float* rest = f_rest + i * scene_rest * 3;
+            const float* rest = a.f_rest + i * a.num_rest * 3;
             for (int k = 0; k < rest_values; ++k) values[k] = rest[k];
             AppendWords(values.data(), rest_values, precision, packed.sh);
         }

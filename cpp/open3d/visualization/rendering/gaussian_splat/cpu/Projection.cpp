@@ -14,8 +14,6 @@ namespace visualization {
 namespace rendering {
 namespace cpu {
 
-namespace gs = t::geometry::gs_attr;
-
 ScreenEllipse ComputeScreenEllipse(double cov_a, double cov_b, double cov_c, bool antialias) {
     // The low-pass filter: every splat covers at least about one pixel.
     constexpr double kDilation = 0.3;
@@ -137,7 +135,7 @@ ProjectedSplat ProjectOne(const ViewParams& view, const RenderConfig& config, in
 std::vector<ProjectedSplat> ProjectSplats(const t::geometry::PointCloud& cloud,
                                           const camera::PinholeCamera& camera,
                                           const RenderConfig& config) {
-    cloud.ValidateGaussianSplat();
+    const t::geometry::GaussianSplatArrays a = cloud.GetGaussianSplatArrays();  // validates
     camera.Validate();
     ViewParams view;
     view.rotation = camera.GetRotation();
@@ -151,25 +149,16 @@ std::vector<ProjectedSplat> ProjectSplats(const t::geometry::PointCloud& cloud,
     view.lim_y = 1.3 * camera.GetTanHalfFovY();
     view.grid = TileGrid::ForImage(camera.width, camera.height);
 
-    const int64_t n = cloud.NumPoints();
-    const int scene_degree = cloud.GaussianSplatGetSHOrder();
-    const int sh_degree = std::clamp(config.sh_degree, 0, scene_degree);
-    const int64_t num_rest = t::geometry::NumSHRestCoeffs(scene_degree);        // per channel
-    const float* positions = cloud.GetPointAttr(gs::kPositions).Data<float>();  // [N, 3]
-    const float* scales = cloud.GetPointAttr(gs::kScale).Data<float>();         // [N, 3]
-    const float* rots = cloud.GetPointAttr(gs::kRot).Data<float>();             // [N, 4]
-    const float* opacities = cloud.GetPointAttr(gs::kOpacity).Data<float>();    // [N, 1]
-    const float* f_dc = cloud.GetPointAttr(gs::kFDc).Data<float>();             // [N, 3]
-    const float* f_rest =
-        scene_degree > 0 ? cloud.GetPointAttr(gs::kFRest).Data<float>() : nullptr;  // [N, Nc, 3]
-
+    const int64_t n = a.num_points;
+    const int sh_degree = std::clamp(config.sh_degree, 0, a.sh_degree);
+    const int64_t num_rest = a.num_rest;  // per channel
     std::vector<ProjectedSplat> out(n);
     core::ParallelFor(
         n,
         [&](int64_t i) {
-            out[i] = ProjectOne(view, config, sh_degree, num_rest, positions + 3 * i,
-                                scales + 3 * i, rots + 4 * i, opacities[i], f_dc + 3 * i,
-                                f_rest ? f_rest + i * num_rest * 3 : nullptr);
+            out[i] = ProjectOne(view, config, sh_degree, num_rest, a.positions + 3 * i,
+                                a.scale + 3 * i, a.rot + 4 * i, a.opacity[i], a.f_dc + 3 * i,
+                                a.f_rest ? a.f_rest + i * num_rest * 3 : nullptr);
         },
         4096);
     return out;
