@@ -197,7 +197,8 @@ void GaussianSplatVulkanBackend::RenderGeometryStage(const camera::PinholeCamera
     geometry_.valid = true;
     geometry_.in_flight = true;
     geometry_.reused = false;
-    geometry_.cpu_ms = core::MillisecondsSince(start);
+    geometry_.times = RenderStats{};
+    geometry_.times.geometry_ms = core::MillisecondsSince(start);
 }
 
 void GaussianSplatVulkanBackend::RenderCompositeStage(RenderOutput& output,
@@ -211,12 +212,15 @@ void GaussianSplatVulkanBackend::RenderCompositeStage(RenderOutput& output,
         Wait(*context_, stage_a_fence_.Get());
         geometry_.in_flight = false;
         const std::vector<double> ms = stage_a_timestamps_.ReadMilliseconds();
-        geometry_.gpu_project_ms = std::max(0.0, ms[static_cast<uint32_t>(TimedPass::kProject)]);
-        geometry_.gpu_sort_ms = std::max(0.0, ms[static_cast<uint32_t>(TimedPass::kSort)]);
-        geometry_.gpu_depth_sort_ms =
-            std::max(0.0, ms[static_cast<uint32_t>(TimedPass::kDepthSort)]);
-        geometry_.gpu_scan_emit_ms = std::max(0.0, ms[static_cast<uint32_t>(TimedPass::kScanEmit)]);
-        geometry_.gpu_tile_sort_ms = std::max(0.0, ms[static_cast<uint32_t>(TimedPass::kTileSort)]);
+        const auto at = [&](TimedPass pass) {
+            return std::max(0.0, ms[static_cast<uint32_t>(pass)]);  // -1: not recorded
+        };
+        RenderStats& t = geometry_.times;
+        t.gpu_project_ms = at(TimedPass::kProject);
+        t.gpu_sort_ms = at(TimedPass::kSort);
+        t.gpu_depth_sort_ms = at(TimedPass::kDepthSort);
+        t.gpu_scan_emit_ms = at(TimedPass::kScanEmit);
+        t.gpu_tile_sort_ms = at(TimedPass::kTileSort);
     }
     EnsureTargets(w, h);
     shader::GaussianStageACounters gpu_counters{};
@@ -350,21 +354,14 @@ void GaussianSplatVulkanBackend::RenderCompositeStage(RenderOutput& output,
     std::memcpy(output.depth_median.Data<float>(), median_readback_.GetMapped(), size_t(w) * h * 4);
 
     RenderStats& s = output.stats;
-    s = RenderStats{};
+    // A reused Stage A did no work this frame: its times stay 0.
+    s = geometry_.reused ? RenderStats{} : geometry_.times;
     s.num_splats = stage_a_resources_.Layout().num_splats;
     s.num_visible = gpu_counters.visible_count;
     s.num_tile_entries = gpu_counters.entry_count;
     s.error_flags = gpu_counters.error_flags;
     s.geometry_reused = geometry_.reused;
-    s.geometry_ms = geometry_.reused ? 0.0 : geometry_.cpu_ms;
     s.composite_ms = core::MillisecondsSince(start);
-    s.gpu_project_ms = geometry_.reused ? 0.0 : geometry_.gpu_project_ms;
-    s.gpu_sort_ms = geometry_.reused ? 0.0 : geometry_.gpu_sort_ms;
-    if (!geometry_.reused) {
-        s.gpu_depth_sort_ms = geometry_.gpu_depth_sort_ms;
-        s.gpu_scan_emit_ms = geometry_.gpu_scan_emit_ms;
-        s.gpu_tile_sort_ms = geometry_.gpu_tile_sort_ms;
-    }
     const std::vector<double> ms = stage_b_timestamps_.ReadMilliseconds();
     s.gpu_composite_ms =
         empty ? 0.0 : std::max(0.0, ms[static_cast<uint32_t>(TimedPass::kComposite)]);

@@ -93,9 +93,9 @@ private:
         bool valid = false;
         bool in_flight = false;
         bool reused = false;
-        double gpu_project_ms = 0.0, gpu_sort_ms = 0.0;
-        double gpu_depth_sort_ms = 0.0, gpu_scan_emit_ms = 0.0, gpu_tile_sort_ms = 0.0;
-        double cpu_ms = 0.0;
+        /// Stage A's times as a frame reports them: geometry_ms, gpu_project_ms,
+        /// gpu_sort_ms and its parts (the rest stays 0).
+        RenderStats times;
     } geometry_;
     CommandBuffer stage_a_cmd_;
     UniqueFence stage_a_fence_;
