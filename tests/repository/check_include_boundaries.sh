@@ -5,23 +5,21 @@ set -euo pipefail
 root="${1:?usage: $0 ROOT}"
 cd "$root"
 status=0
+
+# check FILE FOLDER LIBRARY PATTERN: FILE outside */FOLDER/* must not include PATTERN.
+check() {
+  local file=$1 folder=$2 library=$3 pattern=$4
+  case "$file" in */"$folder"/*) return 0 ;; esac
+  if grep -nE "^\s*#\s*include\s*[<\"]($pattern)" "$file"; then
+    echo "error: $file includes $library headers outside a $folder/ folder" >&2
+    status=1
+  fi
+}
+
 while IFS= read -r -d '' file; do
-  case "$file" in
-    */vulkan/*) ;;
-    *)
-      if grep -nE '^\s*#\s*include\s*[<"](vulkan/|vk_)' "$file"; then
-        echo "error: $file includes Vulkan headers outside a vulkan/ folder" >&2
-        status=1
-      fi ;;
-  esac
-  case "$file" in
-    */filament/*) ;;
-    *)
-      if grep -nE '^\s*#\s*include\s*[<"](filament/|filamat/|backend/|gltfio/|filameshio/|utils/EntityManager|math/mat)' "$file"; then
-        echo "error: $file includes Filament headers outside a filament/ folder" >&2
-        status=1
-      fi ;;
-  esac
+  check "$file" vulkan Vulkan 'vulkan/|vk_'
+  check "$file" filament Filament \
+    'filament/|filamat/|backend/|gltfio/|filameshio/|utils/EntityManager|math/mat'
 done < <(find cpp tests examples benchmarks -type f \( -name '*.h' -o -name '*.cpp' -o -name '*.hpp' \) \
            -not -path 'tests/repository/fixtures/*' -print0 2>/dev/null)
 exit $status
