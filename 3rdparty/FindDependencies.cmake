@@ -22,3 +22,10 @@ endif()
 find_package(Vulkan REQUIRED)
 find_program(GLSLANG_VALIDATOR glslangValidator REQUIRED)
 find_program(SPIRV_CROSS spirv-cross REQUIRED)
+
+# Filament integration (libfilament-dev + libfilament-tools 1.9.25, libglfw3-dev 3.3.8,
+# libgl-dev for the GL headers; GL entry points are loaded through GLFW at run time).
+find_package(filament 1.9 REQUIRED CONFIG)
+find_package(glfw3 3.3 REQUIRED)
+find_path(OPENGL_GLEXT_INCLUDE_DIR GL/glext.h REQUIRED)
+find_program(FILAMENT_MATC matc REQUIRED)

@@ -11,6 +11,7 @@ packages=(
   libvulkan-dev mesa-vulkan-drivers vulkan-tools vulkan-validationlayers
   glslang-tools glslang-dev spirv-cross libspirv-cross-c-shared-dev
   libfilament-dev libfilament-tools libglfw3-dev libimgui-dev
+  libxrandr-dev  # glfw3native.h (the GLX context handed to Filament) includes Xrandr.h
   xvfb xauth libgl1-mesa-dri libgl-dev xdotool
 )
 

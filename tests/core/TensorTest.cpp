@@ -14,6 +14,11 @@ TEST(Tensor, ShapeAndZeroInit) {
     for (int i = 0; i < 12; ++i) EXPECT_EQ(t.Data<float>()[i], 0.0f);
     Tensor u({2, 5}, Dtype::UInt8);
     EXPECT_EQ(u.NumBytes(), 10);
+    Tensor w({2, 5}, Dtype::UInt16);  // normalised depth
+    EXPECT_EQ(w.NumBytes(), 20);
+    EXPECT_EQ(DtypeName(Dtype::UInt16), "UInt16");
+    EXPECT_EQ(w.Data<uint16_t>()[9], 0);
+    EXPECT_THROW(w.Data<uint8_t>(), Open3DError);
 }
 
 TEST(Tensor, DtypeMismatchThrows) {

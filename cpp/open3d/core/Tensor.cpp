@@ -12,9 +12,29 @@
 namespace open3d {
 namespace core {
 
-int64_t DtypeSize(Dtype dtype) { return dtype == Dtype::Float32 ? 4 : 1; }
+int64_t DtypeSize(Dtype dtype) {
+    switch (dtype) {
+        case Dtype::Float32:
+            return 4;
+        case Dtype::UInt8:
+            return 1;
+        case Dtype::UInt16:
+            return 2;
+    }
+    ThrowError("Tensor: unknown dtype {}", static_cast<int>(dtype));
+}
 
-std::string DtypeName(Dtype dtype) { return dtype == Dtype::Float32 ? "Float32" : "UInt8"; }
+std::string DtypeName(Dtype dtype) {
+    switch (dtype) {
+        case Dtype::Float32:
+            return "Float32";
+        case Dtype::UInt8:
+            return "UInt8";
+        case Dtype::UInt16:
+            return "UInt16";
+    }
+    ThrowError("Tensor: unknown dtype {}", static_cast<int>(dtype));
+}
 
 std::string ShapeToString(const SizeVector& shape) {
     return fmt::format("[{}]", fmt::join(shape, ", "));

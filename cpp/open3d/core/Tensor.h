@@ -1,5 +1,6 @@
 // A small typed, contiguous, owning array for per-point attributes.
-// Only what the splat data model needs: float32 and uint8, any rank, row-major.
+// Only what the splat data model needs: float32, uint8 and uint16 (normalised depth), any
+// rank, row-major.
 #pragma once
 
 #include <algorithm>
@@ -11,7 +12,7 @@
 namespace open3d {
 namespace core {
 
-enum class Dtype { Float32, UInt8 };
+enum class Dtype { Float32, UInt8, UInt16 };
 
 /// Size of one element in bytes.
 int64_t DtypeSize(Dtype dtype);
@@ -26,6 +27,10 @@ constexpr Dtype DtypeOf<float>() {
 template <>
 constexpr Dtype DtypeOf<uint8_t>() {
     return Dtype::UInt8;
+}
+template <>
+constexpr Dtype DtypeOf<uint16_t>() {
+    return Dtype::UInt16;
 }
 
 using SizeVector = std::vector<int64_t>;

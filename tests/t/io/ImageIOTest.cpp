@@ -57,6 +57,10 @@ TEST(ImageIO, NpyRoundTripIsExact) {
     const Image u = Pattern(3, core::Dtype::UInt8);
     t::io::WriteImage(dir + "/u.npy", u);
     EXPECT_EQ(t::io::ReadNpy(dir + "/u.npy"), u);
+    Image w(5, 7, 1, core::Dtype::UInt16);  // normalised depth ('<u2')
+    for (int64_t i = 0; i < w.NumPixels(); ++i) w.Data<uint16_t>()[i] = uint16_t(i * 1871);
+    t::io::WriteNpy(dir + "/w.npy", w);
+    EXPECT_EQ(t::io::ReadNpy(dir + "/w.npy"), w);
     // The header is a multiple of 64 bytes, as numpy requires.
     std::ifstream in(dir + "/f.npy", std::ios::binary | std::ios::ate);
     EXPECT_EQ((static_cast<int64_t>(in.tellg()) - f.AsTensor().NumBytes()) % 64, 0);

@@ -17,9 +17,17 @@ void CheckShape(const core::SizeVector& shape) {
     }
 }
 
-// Reads element i of a Float32 or UInt8 tensor as double.
+// Reads element i of a tensor as double.
 double ReadAsDouble(const core::Tensor& t, int64_t i) {
-    return t.GetDtype() == core::Dtype::Float32 ? t.Data<float>()[i] : t.Data<uint8_t>()[i];
+    switch (t.GetDtype()) {
+        case core::Dtype::Float32:
+            return t.Data<float>()[i];
+        case core::Dtype::UInt8:
+            return t.Data<uint8_t>()[i];
+        case core::Dtype::UInt16:
+            return t.Data<uint16_t>()[i];
+    }
+    core::ThrowError("Image: unknown dtype {}", static_cast<int>(t.GetDtype()));
 }
 }  // namespace
 

@@ -1,4 +1,4 @@
-// A 2D image on a core::Tensor of shape [rows, cols, channels], Float32 or UInt8,
+// A 2D image on a core::Tensor of shape [rows, cols, channels], Float32, UInt8 or UInt16,
 // row-major with interleaved channels (pixel (x, y) channel c at (y * cols + x) * C + c).
 #pragma once
 

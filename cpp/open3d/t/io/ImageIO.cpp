@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <cstring>
 #include <fstream>
+#include <optional>
 #include <vector>
 
 #include "open3d/core/Exception.h"
@@ -79,6 +80,19 @@ std::string LowerExtension(const std::string& filename) {
     std::transform(ext.begin(), ext.end(), ext.begin(),
                    [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
     return ext;
+}
+
+// NumPy's dtype string of an image element (little-endian).
+const char* NpyDescr(core::Dtype dtype) {
+    switch (dtype) {
+        case core::Dtype::Float32:
+            return "<f4";
+        case core::Dtype::UInt8:
+            return "|u1";
+        case core::Dtype::UInt16:
+            return "<u2";
+    }
+    core::ThrowError("npy: unknown dtype {}", static_cast<int>(dtype));
 }
 
 }  // namespace
@@ -198,10 +212,9 @@ geometry::Image ReadPNG(const std::string& filename) {
 }
 
 void WriteNpy(const std::string& filename, const geometry::Image& image) {
-    const bool is_float = image.GetDtype() == core::Dtype::Float32;
     std::string header = fmt::format(
         "{{'descr': '{}', 'fortran_order': False, 'shape': ({}, {}, {}), }}",
-        is_float ? "<f4" : "|u1", image.GetRows(), image.GetCols(), image.GetChannels());
+        NpyDescr(image.GetDtype()), image.GetRows(), image.GetCols(), image.GetChannels());
     // Magic (6) + version (2) + length (2) + header + '\n' is padded to a multiple of 64.
     const size_t total = 10 + header.size() + 1;
     header.append((64 - total % 64) % 64, ' ');
@@ -229,20 +242,21 @@ geometry::Image ReadNpy(const std::string& filename) {
     const size_t len = static_cast<uint8_t>(magic[8]) | (static_cast<uint8_t>(magic[9]) << 8);
     std::string header(len, '\0');
     in.read(header.data(), static_cast<std::streamsize>(len));
-    const bool is_float = header.find("'<f4'") != std::string::npos;
-    const bool is_u8 = header.find("'|u1'") != std::string::npos;
+    std::optional<core::Dtype> dtype;
+    for (const core::Dtype d : {core::Dtype::Float32, core::Dtype::UInt8, core::Dtype::UInt16}) {
+        if (header.find(fmt::format("'{}'", NpyDescr(d))) != std::string::npos) dtype = d;
+    }
     long long rows = 0, cols = 0, channels = 0;
     const auto shape_pos = header.find("'shape': (");
-    if (!in || (!is_float && !is_u8) ||
-        header.find("'fortran_order': False") == std::string::npos ||
+    if (!in || !dtype || header.find("'fortran_order': False") == std::string::npos ||
         shape_pos == std::string::npos ||
         std::sscanf(header.c_str() + shape_pos, "'shape': (%lld, %lld, %lld)", &rows, &cols,
                     &channels) != 3) {
-        core::ThrowError("'{}': unsupported .npy header (need '<f4' or '|u1', C order, rank 3)",
-                         filename);
+        core::ThrowError(
+            "'{}': unsupported .npy header (need '<f4', '|u1' or '<u2', C order, rank 3)",
+            filename);
     }
-    geometry::Image image(rows, cols, channels,
-                          is_float ? core::Dtype::Float32 : core::Dtype::UInt8);
+    geometry::Image image(rows, cols, channels, *dtype);
     core::Tensor tensor = image.AsTensor();
     in.read(static_cast<char*>(tensor.RawData()), tensor.NumBytes());
     if (!in) core::ThrowError("'{}': .npy data is truncated", filename);

@@ -23,10 +23,10 @@ void WritePNG16(const std::string& filename, const geometry::Image& image, doubl
 /// values 0..65535.
 geometry::Image ReadPNG(const std::string& filename);
 
-/// Writes a Float32 or UInt8 image as a NumPy .npy array of shape [rows, cols, channels]
-/// (format version 1.0, '<f4' or '|u1'); numpy.load reads it.
+/// Writes a Float32, UInt8 or UInt16 image as a NumPy .npy array of shape
+/// [rows, cols, channels] (format version 1.0, '<f4', '|u1' or '<u2'); numpy.load reads it.
 void WriteNpy(const std::string& filename, const geometry::Image& image);
-/// Reads what WriteNpy writes ('<f4' or '|u1', C order, rank 3 with 1..4 channels).
+/// Reads what WriteNpy writes ('<f4', '|u1' or '<u2', C order, rank 3 with 1..4 channels).
 geometry::Image ReadNpy(const std::string& filename);
 
 /// Writes by extension: .png (UInt8 images; Float32 images are converted with

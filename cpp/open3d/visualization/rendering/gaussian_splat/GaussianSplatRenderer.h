@@ -60,6 +60,14 @@ public:
     /// (images are (re)allocated to the view size). Throws when no geometry stage ran.
     virtual void RenderCompositeStage(RenderOutput& output, const CompositeInputs& inputs = {}) = 0;
 
+    /// Hides splats without a new upload: bit i of word i / 32 shows splat i
+    /// ([ceil(N / 32)] words; empty shows all). Backends without a mask return false and
+    /// the caller rebuilds the scene from the visible splats instead.
+    virtual bool SetVisibilityMask(const std::vector<uint32_t>& mask) {
+        (void)mask;
+        return false;
+    }
+
     /// Both stages.
     RenderOutput Render(const camera::PinholeCamera& camera, const RenderConfig& config);
 };

@@ -5,6 +5,8 @@
 #include <cmath>
 #include <cstddef>
 #include <cstring>
+#include <utility>
+#include <vector>
 
 #include "open3d/core/Exception.h"
 #include "open3d/core/Logging.h"
@@ -36,12 +38,9 @@ void ToTransferSrc(VkCommandBuffer cmd, const Image& image, VkPipelineStageFlags
                        VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_READ_BIT);
 }
 
-void CopyToBuffer(VkCommandBuffer cmd, const Image& image, const Buffer& buffer) {
-    VkBufferImageCopy region{};
-    region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
-    region.imageExtent = {image.GetWidth(), image.GetHeight(), 1};
-    vkCmdCopyImageToBuffer(cmd, image.Get(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, buffer.Get(), 1,
-                           &region);
+// A pass's milliseconds from GpuTimestamps::ReadMilliseconds; 0 when it was not recorded.
+double PassMs(const std::vector<double>& ms, TimedPass pass) {
+    return std::max(0.0, ms[static_cast<uint32_t>(pass)]);
 }
 
 const char* FlagMessage(uint32_t bit) {
@@ -52,12 +51,6 @@ const char* FlagMessage(uint32_t bit) {
 }
 
 }  // namespace
-
-void RegisterVulkanBackend() {
-    RegisterGaussianSplatBackend("vulkan", [] {
-        return std::make_unique<GaussianSplatVulkanBackend>(VulkanContext::CreateHeadless());
-    });
-}
 
 GaussianSplatVulkanBackend::GaussianSplatVulkanBackend(std::unique_ptr<VulkanContext> context,
                                                        uint32_t initial_entry_capacity)
@@ -112,7 +105,7 @@ void GaussianSplatVulkanBackend::ReleaseResources() {
                            &alpha_readback_, &median_readback_}) {
         *buffer = Buffer();
     }
-    for (Image* image : {&color_, &depth_, &alpha_, &median_}) *image = Image();
+    for (Image* image : {&depth_, &alpha_, &median_, &color_}) *image = Image();
     width_ = height_ = 0;
 }
 
@@ -126,24 +119,31 @@ void GaussianSplatVulkanBackend::EnsureViewBuffers(uint32_t entry_capacity) {
 }
 
 void GaussianSplatVulkanBackend::EnsureTargets(uint32_t width, uint32_t height) {
-    if (color_ && width == width_ && height == height_) return;
+    if (depth_ && width == width_ && height == height_) return;
     const StageBStorageRequirements need = GaussianStageB::GetStorageRequirements();
     const VkImageUsageFlags usage =
         need.image_usage | VK_IMAGE_USAGE_TRANSFER_SRC_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT;
+    depth_ = Image(*context_, width, height, need.scalar_format, usage);
+    alpha_ = Image(*context_, width, height, need.scalar_format, usage);
+    median_ = Image(*context_, width, height, need.scalar_format, usage);
+    width_ = width;
+    height_ = height;
+}
+
+void GaussianSplatVulkanBackend::EnsureReadback(uint32_t width, uint32_t height) {
+    if (color_ && color_.GetWidth() == width && color_.GetHeight() == height) return;
+    const VkImageUsageFlags usage = GaussianStageB::GetStorageRequirements().image_usage |
+                                    VK_IMAGE_USAGE_TRANSFER_SRC_BIT |
+                                    VK_IMAGE_USAGE_TRANSFER_DST_BIT;
     const auto readback = [&](uint32_t texel_bytes) {
         return Buffer(*context_, VkDeviceSize(width) * height * texel_bytes,
                       VK_BUFFER_USAGE_TRANSFER_DST_BIT, MemoryUsage::kHostReadback);
     };
     color_ = Image(*context_, width, height, ToVkFormat(CompositeColorFormat::kRgba32f), usage);
-    depth_ = Image(*context_, width, height, need.scalar_format, usage);
-    alpha_ = Image(*context_, width, height, need.scalar_format, usage);
-    median_ = Image(*context_, width, height, need.scalar_format, usage);
     color_readback_ = readback(16);
     depth_readback_ = readback(4);
     alpha_readback_ = readback(4);
     median_readback_ = readback(4);
-    width_ = width;
-    height_ = height;
 }
 
 void GaussianSplatVulkanBackend::RenderGeometryStage(const camera::PinholeCamera& camera,
@@ -201,27 +201,119 @@ void GaussianSplatVulkanBackend::RenderGeometryStage(const camera::PinholeCamera
     geometry_.times.geometry_ms = core::MillisecondsSince(start);
 }
 
+// RenderCompositeStage's sink: the backend's RGBA32F colour image, the scene depth uploaded
+// from CompositeInputs, every image copied to its host buffer.
+class GaussianSplatVulkanBackend::ReadbackSink final : public CompositeSink {
+public:
+    ReadbackSink(GaussianSplatVulkanBackend& backend, const CompositeInputs& inputs,
+                 RenderOutput& output)
+        : backend_(backend), output_(output) {
+        const uint32_t w = backend.color_.GetWidth(), h = backend.color_.GetHeight();
+        if (inputs.scene_depth == nullptr || inputs.scene_depth->IsEmpty()) return;
+        // Scene depth (view z) becomes Filament's reversed-Z texture d = near / z.
+        const t::geometry::Image& z = *inputs.scene_depth;
+        if (z.GetRows() != h || z.GetCols() != w || z.GetChannels() != 1 ||
+            z.GetDtype() != core::Dtype::Float32) {
+            core::ThrowError("Vulkan backend: scene depth must be Float32 [{}, {}, 1]", h, w);
+        }
+        const VulkanContext& context = *backend.context_;
+        scene_.near_plane = static_cast<float>(backend.geometry_.config.near_plane);
+        scene_upload_ = Buffer(context, VkDeviceSize(w) * h * 4, VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
+                               MemoryUsage::kHostUpload);
+        float* d = static_cast<float*>(scene_upload_.GetMapped());
+        const float* src = z.Data<float>();
+        for (size_t i = 0; i < size_t(w) * h; ++i) {
+            d[i] = src[i] > 0.0f && std::isfinite(src[i]) ? scene_.near_plane / src[i] : 0.0f;
+        }
+        scene_image_ = Image(context, w, h, VK_FORMAT_D32_SFLOAT,
+                             VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT);
+        scene_.view = scene_image_.GetView();
+    }
+
+    const Image& ColorTarget() const override { return backend_.color_; }
+
+    void AdjustParams(CompositeParams& params) const override {
+        params.scene_depth = scene_image_ ? &scene_ : nullptr;
+    }
+
+    void RecordBefore(const Frame& frame) override {
+        RecordImageBarrier(frame.cmd, backend_.color_.Get(), VK_IMAGE_ASPECT_COLOR_BIT,
+                           VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_GENERAL,
+                           VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_READ_BIT,
+                           frame.write_stage, frame.write_access);
+        if (scene_image_) RecordDepthTextureUpload(frame.cmd, scene_image_, scene_upload_.Get());
+    }
+
+    void RecordAfter(const Frame& frame) override {
+        const std::pair<const Image*, const Buffer*> copies[] = {
+            {&backend_.color_, &backend_.color_readback_},
+            {frame.depth, &backend_.depth_readback_},
+            {frame.alpha, &backend_.alpha_readback_},
+            {frame.median, &backend_.median_readback_}};
+        for (const auto& [image, buffer] : copies) {
+            ToTransferSrc(frame.cmd, *image, frame.write_stage, frame.write_access);
+            RecordCopyToBuffer(frame.cmd, *image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+                               buffer->Get());
+        }
+    }
+
+    void ReadBack() override {
+        const size_t pixels = size_t(backend_.width_) * backend_.height_;
+        const int64_t h = backend_.height_, w = backend_.width_;
+        output_.color = t::geometry::Image(h, w, 4, core::Dtype::Float32);
+        output_.depth_expected = t::geometry::Image(h, w, 1, core::Dtype::Float32);
+        output_.depth_median = t::geometry::Image(h, w, 1, core::Dtype::Float32);
+        std::memcpy(output_.color.Data<float>(), backend_.color_readback_.GetMapped(), pixels * 16);
+        std::memcpy(output_.depth_expected.Data<float>(), backend_.depth_readback_.GetMapped(),
+                    pixels * 4);
+        std::memcpy(output_.depth_median.Data<float>(), backend_.median_readback_.GetMapped(),
+                    pixels * 4);
+    }
+
+private:
+    GaussianSplatVulkanBackend& backend_;
+    RenderOutput& output_;
+    Image scene_image_;
+    Buffer scene_upload_;
+    SceneDepthTexture scene_;
+};
+
 void GaussianSplatVulkanBackend::RenderCompositeStage(RenderOutput& output,
                                                       const CompositeInputs& inputs) {
     if (!geometry_.valid)
         core::ThrowError("Vulkan backend: RenderCompositeStage before RenderGeometryStage");
+    EnsureReadback(static_cast<uint32_t>(geometry_.camera.width),
+                   static_cast<uint32_t>(geometry_.camera.height));
+    ReadbackSink sink(*this, inputs, output);
+    output.stats = RenderComposite(sink);
+}
+
+void GaussianSplatVulkanBackend::WaitForGeometry() {
+    if (!geometry_.in_flight) return;
+    Wait(*context_, stage_a_fence_.Get());
+    geometry_.in_flight = false;
+    const std::vector<double> ms = stage_a_timestamps_.ReadMilliseconds();
+    const auto at = [&](TimedPass pass) { return PassMs(ms, pass); };
+    RenderStats& t = geometry_.times;
+    t.gpu_project_ms = at(TimedPass::kProject);
+    t.gpu_sort_ms = at(TimedPass::kSort);
+    t.gpu_depth_sort_ms = at(TimedPass::kDepthSort);
+    t.gpu_scan_emit_ms = at(TimedPass::kScanEmit);
+    t.gpu_tile_sort_ms = at(TimedPass::kTileSort);
+}
+
+RenderStats GaussianSplatVulkanBackend::RenderComposite(CompositeSink& sink) {
+    if (!geometry_.valid)
+        core::ThrowError("Vulkan backend: a composite before RenderGeometryStage");
     const auto start = std::chrono::steady_clock::now();
     const uint32_t w = static_cast<uint32_t>(geometry_.camera.width);
     const uint32_t h = static_cast<uint32_t>(geometry_.camera.height);
-    if (geometry_.in_flight) {
-        Wait(*context_, stage_a_fence_.Get());
-        geometry_.in_flight = false;
-        const std::vector<double> ms = stage_a_timestamps_.ReadMilliseconds();
-        const auto at = [&](TimedPass pass) {
-            return std::max(0.0, ms[static_cast<uint32_t>(pass)]);  // -1: not recorded
-        };
-        RenderStats& t = geometry_.times;
-        t.gpu_project_ms = at(TimedPass::kProject);
-        t.gpu_sort_ms = at(TimedPass::kSort);
-        t.gpu_depth_sort_ms = at(TimedPass::kDepthSort);
-        t.gpu_scan_emit_ms = at(TimedPass::kScanEmit);
-        t.gpu_tile_sort_ms = at(TimedPass::kTileSort);
+    const Image& color = sink.ColorTarget();
+    if (color.GetWidth() != w || color.GetHeight() != h) {
+        core::ThrowError("Vulkan backend: the composite targets are {}x{}, the camera is {}x{}",
+                         color.GetWidth(), color.GetHeight(), w, h);
     }
+    WaitForGeometry();
     EnsureTargets(w, h);
     shader::GaussianStageACounters gpu_counters{};
     std::memcpy(&gpu_counters, counters_readback_.GetMapped(), sizeof(gpu_counters));
@@ -229,29 +321,10 @@ void GaussianSplatVulkanBackend::RenderCompositeStage(RenderOutput& output,
     // cleared to the background instead.
     const bool empty = gpu_counters.entry_count == 0;
 
-    // Scene depth (view z) becomes Filament's reversed-Z texture d = near / z.
-    Image scene_image;
-    Buffer scene_upload;
-    SceneDepthTexture scene;
-    const bool has_scene = inputs.scene_depth != nullptr && !inputs.scene_depth->IsEmpty();
-    if (has_scene) {
-        const t::geometry::Image& z = *inputs.scene_depth;
-        if (z.GetRows() != h || z.GetCols() != w || z.GetChannels() != 1 ||
-            z.GetDtype() != core::Dtype::Float32) {
-            core::ThrowError("Vulkan backend: scene depth must be Float32 [{}, {}, 1]", h, w);
-        }
-        scene.near_plane = static_cast<float>(geometry_.config.near_plane);
-        scene_upload = Buffer(*context_, VkDeviceSize(w) * h * 4, VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
-                              MemoryUsage::kHostUpload);
-        float* d = static_cast<float*>(scene_upload.GetMapped());
-        const float* src = z.Data<float>();
-        for (size_t i = 0; i < size_t(w) * h; ++i) {
-            d[i] = src[i] > 0.0f && std::isfinite(src[i]) ? scene.near_plane / src[i] : 0.0f;
-        }
-        scene_image = Image(*context_, w, h, VK_FORMAT_D32_SFLOAT,
-                            VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT);
-        scene.view = scene_image.GetView();
-    }
+    CompositeParams params;
+    for (int c = 0; c < 3; ++c)
+        params.background[c] = static_cast<float>(geometry_.config.background[c]);
+    sink.AdjustParams(params);
 
     CommandBuffer cmd_buffer = pool_.Allocate();
     VkCommandBuffer cmd = cmd_buffer.Get();
@@ -261,58 +334,60 @@ void GaussianSplatVulkanBackend::RenderCompositeStage(RenderOutput& output,
     RecordMemoryBarrier(cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_MEMORY_WRITE_BIT,
                         VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_COPY_BIT,
                         VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_TRANSFER_READ_BIT);
-    const VkPipelineStageFlags2 write_stage =
+    CompositeSink::Frame frame;
+    frame.cmd = cmd;
+    frame.empty = empty;
+    frame.write_stage =
         empty ? VK_PIPELINE_STAGE_2_CLEAR_BIT : VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT;
-    const VkAccessFlags2 write_access =
+    frame.write_access =
         empty ? VK_ACCESS_2_TRANSFER_WRITE_BIT : VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT;
-    for (const Image* image : {&color_, &depth_, &alpha_, &median_}) {
+    frame.depth = &depth_;
+    frame.alpha = &alpha_;
+    frame.median = &median_;
+    frame.stage_b = &stage_b_;
+    frame.timestamps = &stage_b_timestamps_;
+    // The last frame copied these (readback) or read them in a depth merge.
+    for (const Image* image : {&depth_, &alpha_, &median_}) {
         RecordImageBarrier(cmd, image->Get(), VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
-                           VK_IMAGE_LAYOUT_GENERAL, VK_PIPELINE_STAGE_2_COPY_BIT,
-                           VK_ACCESS_2_TRANSFER_READ_BIT, write_stage, write_access);
+                           VK_IMAGE_LAYOUT_GENERAL,
+                           VK_PIPELINE_STAGE_2_COPY_BIT | VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                           VK_ACCESS_2_TRANSFER_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_READ_BIT,
+                           frame.write_stage, frame.write_access);
     }
-    if (has_scene) RecordDepthTextureUpload(cmd, scene_image, scene_upload.Get());
-    StageBInputs stage_b_inputs;
-    stage_b_inputs.projected = stage_a_resources_.projected.Range();
-    stage_b_inputs.entry_keys = stage_a_resources_.entry_keys.Range();
-    stage_b_inputs.entry_values = stage_a_resources_.entry_values.Range();
-    stage_b_inputs.entry_count = stage_a_resources_.counters.Range(
-        offsetof(shader::GaussianStageACounters, entry_count), sizeof(uint32_t));
-    stage_b_inputs.entry_capacity = stage_a_resources_.EntryCapacity();
-    StageBTargets targets;
-    targets.width = w;
-    targets.height = h;
-    targets.color_format = CompositeColorFormat::kRgba32f;
-    targets.color = color_.GetView();
-    targets.depth = depth_.GetView();
-    targets.alpha = alpha_.GetView();
-    targets.median_depth = median_.GetView();
-    CompositeParams params;
-    for (int c = 0; c < 3; ++c)
-        params.background[c] = static_cast<float>(geometry_.config.background[c]);
-    params.scene_depth = has_scene ? &scene : nullptr;
+    sink.RecordBefore(frame);
     if (empty) {
         const VkImageSubresourceRange all{VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
         VkClearColorValue background{};
         for (int c = 0; c < 3; ++c) background.float32[c] = params.background[c];
         const VkClearColorValue zero{};
-        vkCmdClearColorImage(cmd, color_.Get(), VK_IMAGE_LAYOUT_GENERAL, &background, 1, &all);
+        vkCmdClearColorImage(cmd, color.Get(), VK_IMAGE_LAYOUT_GENERAL, &background, 1, &all);
         for (const Image* image : {&depth_, &alpha_, &median_}) {
             vkCmdClearColorImage(cmd, image->Get(), VK_IMAGE_LAYOUT_GENERAL, &zero, 1, &all);
         }
         ++counters_.skipped_composites;
     } else {
+        StageBInputs inputs;
+        inputs.projected = stage_a_resources_.projected.Range();
+        inputs.entry_keys = stage_a_resources_.entry_keys.Range();
+        inputs.entry_values = stage_a_resources_.entry_values.Range();
+        inputs.entry_count = stage_a_resources_.counters.Range(
+            offsetof(shader::GaussianStageACounters, entry_count), sizeof(uint32_t));
+        inputs.entry_capacity = stage_a_resources_.EntryCapacity();
+        StageBTargets targets;
+        targets.width = w;
+        targets.height = h;
+        targets.color_format = color.GetFormat() == ToVkFormat(CompositeColorFormat::kRgba16f)
+                                   ? CompositeColorFormat::kRgba16f
+                                   : CompositeColorFormat::kRgba32f;
+        targets.color = color.GetView();
+        targets.depth = depth_.GetView();
+        targets.alpha = alpha_.GetView();
+        targets.median_depth = median_.GetView();
         stage_b_timestamps_.RecordBegin(cmd, TimedPass::kComposite);
-        stage_b_.RecordComposite(cmd, stage_b_inputs, targets, composite_state_.Range(), params);
+        stage_b_.RecordComposite(cmd, inputs, targets, composite_state_.Range(), params);
         stage_b_timestamps_.RecordEnd(cmd, TimedPass::kComposite);
     }
-    ToTransferSrc(cmd, color_, write_stage, write_access);
-    ToTransferSrc(cmd, depth_, write_stage, write_access);
-    ToTransferSrc(cmd, alpha_, write_stage, write_access);
-    ToTransferSrc(cmd, median_, write_stage, write_access);
-    CopyToBuffer(cmd, color_, color_readback_);
-    CopyToBuffer(cmd, depth_, depth_readback_);
-    CopyToBuffer(cmd, alpha_, alpha_readback_);
-    CopyToBuffer(cmd, median_, median_readback_);
+    sink.RecordAfter(frame);
     cmd_buffer.End();
     UniqueFence fence = CreateFence(*context_);
     Submit(*context_, cmd, fence.Get());
@@ -334,9 +409,9 @@ void GaussianSplatVulkanBackend::RenderCompositeStage(RenderOutput& output,
         const RenderConfig config = geometry_.config;
         geometry_.valid = false;
         RenderGeometryStage(camera, config);
-        RenderCompositeStage(output, inputs);
+        const RenderStats stats = RenderComposite(sink);
         growing_ = false;
-        return;
+        return stats;
     }
     const uint32_t new_flags = gpu_counters.error_flags & ~warned_flags_;
     for (uint32_t bit : {kEntriesDropped, kCountsClamped}) {
@@ -344,18 +419,10 @@ void GaussianSplatVulkanBackend::RenderCompositeStage(RenderOutput& output,
             core::LogWarning("Gaussian splat Vulkan backend: {}", FlagMessage(bit));
     }
     warned_flags_ |= gpu_counters.error_flags;
+    sink.ReadBack();
 
-    output.color = t::geometry::Image(h, w, 4, core::Dtype::Float32);
-    output.depth_expected = t::geometry::Image(h, w, 1, core::Dtype::Float32);
-    output.depth_median = t::geometry::Image(h, w, 1, core::Dtype::Float32);
-    std::memcpy(output.color.Data<float>(), color_readback_.GetMapped(), size_t(w) * h * 16);
-    std::memcpy(output.depth_expected.Data<float>(), depth_readback_.GetMapped(),
-                size_t(w) * h * 4);
-    std::memcpy(output.depth_median.Data<float>(), median_readback_.GetMapped(), size_t(w) * h * 4);
-
-    RenderStats& s = output.stats;
     // A reused Stage A did no work this frame: its times stay 0.
-    s = geometry_.reused ? RenderStats{} : geometry_.times;
+    RenderStats s = geometry_.reused ? RenderStats{} : geometry_.times;
     s.num_splats = stage_a_resources_.Layout().num_splats;
     s.num_visible = gpu_counters.visible_count;
     s.num_tile_entries = gpu_counters.entry_count;
@@ -363,9 +430,10 @@ void GaussianSplatVulkanBackend::RenderCompositeStage(RenderOutput& output,
     s.geometry_reused = geometry_.reused;
     s.composite_ms = core::MillisecondsSince(start);
     const std::vector<double> ms = stage_b_timestamps_.ReadMilliseconds();
-    s.gpu_composite_ms =
-        empty ? 0.0 : std::max(0.0, ms[static_cast<uint32_t>(TimedPass::kComposite)]);
+    s.gpu_composite_ms = empty ? 0.0 : PassMs(ms, TimedPass::kComposite);
+    s.gpu_merge_ms = PassMs(ms, TimedPass::kDepthMerge);
     s.gpu_scene_bytes = static_cast<int64_t>(stage_a_resources_.SceneBytes());
+    return s;
 }
 
 }  // namespace vulkan

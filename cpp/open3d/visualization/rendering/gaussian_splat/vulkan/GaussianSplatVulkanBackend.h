@@ -1,8 +1,9 @@
 // The Vulkan compute backend ("vulkan"): uploads a splat scene once, then renders views
 // headless with Stage A (GaussianStageA) and Stage B (GaussianStageB), reads the images
 // back and reports GPU time per pass. Stage A is skipped when the scene, the camera and the
-// config are unchanged (RenderConfig::reuse_geometry). The Filament integration drives the
-// same recorders with shared images instead of readbacks.
+// config are unchanged (RenderConfig::reuse_geometry). The Filament integration composites
+// into images shared with GL instead (GaussianSplatInterop.h) through the same frame logic
+// (CompositeSink).
 #pragma once
 
 #include <memory>
@@ -18,6 +19,7 @@
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/GaussianStageB.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/GpuTimestamps.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/Image.h"
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/VulkanBackendRegistry.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/VulkanContext.h"
 
 namespace open3d {
@@ -25,10 +27,46 @@ namespace visualization {
 namespace rendering {
 namespace vulkan {
 
-/// Registers the factory "vulkan" (a headless context per backend; validation follows
-/// OPEN3D_VULKAN_VALIDATION). Creating the backend throws core::Open3DError when no usable
-/// Vulkan device exists. Call once before CreateGaussianSplatBackend("vulkan").
-void RegisterVulkanBackend();
+/// Where a composite goes and what is recorded around it: the readback images of
+/// RenderCompositeStage, or the images shared with GL of RenderCompositeToInterop. The
+/// backend runs what both share (Stage A wait, counters, empty-frame skip, entry-buffer
+/// growth and retry, flag warnings, stats) and calls these hooks; a retried frame calls the
+/// Record* hooks again and ReadBack once.
+class CompositeSink {
+public:
+    /// What the hooks of one frame get.
+    struct Frame {
+        VkCommandBuffer cmd = VK_NULL_HANDLE;
+        /// No tile entry: the targets are cleared (colour to the background, the rest to 0)
+        /// with transfer writes instead of being composited.
+        bool empty = false;
+        /// What writes the targets: the composite's storage writes or the clear.
+        VkPipelineStageFlags2 write_stage = VK_PIPELINE_STAGE_2_NONE;
+        VkAccessFlags2 write_access = VK_ACCESS_2_NONE;
+        /// The backend's R32F expected depth, alpha and median depth (GENERAL during the
+        /// frame; the backend transitions them before RecordBefore).
+        const Image* depth = nullptr;
+        const Image* alpha = nullptr;
+        const Image* median = nullptr;
+        GaussianStageB* stage_b = nullptr;
+        /// Stage B's query pool, reset for this frame (time the depth merge with it).
+        const GpuTimestamps* timestamps = nullptr;
+    };
+
+    virtual ~CompositeSink() = default;
+    /// The colour target, the camera's size, RGBA32F or RGBA16F, with STORAGE and
+    /// TRANSFER_DST (an empty frame clears it) usage.
+    virtual const Image& ColorTarget() const = 0;
+    /// Adjusts the composite's parameters (background from the config, no scene depth).
+    virtual void AdjustParams(CompositeParams& params) const = 0;
+    /// Before the writes: brings the colour target into GENERAL, ready for the frame's
+    /// write stage and access, and records uploads or ownership acquires.
+    virtual void RecordBefore(const Frame& frame) = 0;
+    /// After the writes: depth merges, copies, ownership releases.
+    virtual void RecordAfter(const Frame& frame) = 0;
+    /// After the frame's fence: reads the results.
+    virtual void ReadBack() = 0;
+};
 
 class GaussianSplatVulkanBackend final : public GaussianSplatBackend {
 public:
@@ -48,6 +86,10 @@ public:
 
     /// Replaces the visibility mask: bit i of word i / 32 shows splat i ([ceil(N / 32)]).
     void SetVisibility(const std::vector<uint32_t>& mask);
+    bool SetVisibilityMask(const std::vector<uint32_t>& mask) override {
+        SetVisibility(mask);
+        return true;
+    }
 
     /// Counters that make the skips visible to tests and benchmarks.
     struct Counters {
@@ -61,10 +103,19 @@ public:
     const Counters& GetCounters() const { return counters_; }
     const VulkanContext& GetContext() const { return *context_; }
 
+    /// Stage B of the last geometry stage into `sink` (RenderCompositeStage and
+    /// RenderCompositeToInterop); returns the frame's stats. Throws core::Open3DError when no
+    /// geometry stage ran or the sink's colour target is not the camera's size.
+    RenderStats RenderComposite(CompositeSink& sink);
+
 private:
+    class ReadbackSink;
+
     void UploadScene(SplatPrecision precision);
     void EnsureViewBuffers(uint32_t entry_capacity);
     void EnsureTargets(uint32_t width, uint32_t height);
+    void EnsureReadback(uint32_t width, uint32_t height);
+    void WaitForGeometry();
 
     std::unique_ptr<VulkanContext> context_;
     CommandPool pool_;
@@ -81,9 +132,11 @@ private:
     Buffer counters_readback_;
     Buffer composite_state_;
 
-    // Stage B images and their readback buffers.
+    // Stage B's R32F images (every composite), RenderCompositeStage's RGBA32F colour and the
+    // readback buffers of all four.
     uint32_t width_ = 0, height_ = 0;
-    Image color_, depth_, alpha_, median_;
+    Image depth_, alpha_, median_;
+    Image color_;
     Buffer color_readback_, depth_readback_, alpha_readback_, median_readback_;
 
     // The last Stage A: what it rendered, and its command buffer while in flight.

@@ -17,26 +17,6 @@ namespace vulkan {
 
 namespace {
 
-// IEEE half to float (exact), for reading back an RGBA16F colour image.
-float HalfBitsToFloat(uint16_t h) {
-    const uint32_t sign = uint32_t(h >> 15) << 31;
-    const uint32_t exponent = (h >> 10) & 0x1Fu;
-    const uint32_t mantissa = h & 0x3FFu;
-    float magnitude;
-    if (exponent == 0) {
-        magnitude = std::ldexp(static_cast<float>(mantissa), -24);
-    } else if (exponent == 31) {
-        magnitude = mantissa ? NAN : INFINITY;
-    } else {
-        magnitude = std::ldexp(static_cast<float>(mantissa | 0x400u), int(exponent) - 25);
-    }
-    uint32_t bits;
-    std::memcpy(&bits, &magnitude, 4);
-    bits |= sign;
-    std::memcpy(&magnitude, &bits, 4);
-    return magnitude;
-}
-
 Buffer UploadBuffer(const VulkanContext& context, const void* data, VkDeviceSize bytes,
                     VkBufferUsageFlags usage) {
     Buffer buffer(context, std::max<VkDeviceSize>(bytes, 16), usage, MemoryUsage::kHostUpload);
@@ -212,7 +192,7 @@ StageBReadback GaussianStageBRunner::Run(const StageBRunInputs& in) {
     if (in.color_format == CompositeColorFormat::kRgba16f) {
         const std::vector<uint16_t> halves = Read<uint16_t>(color);
         out.color.resize(halves.size());
-        for (size_t i = 0; i < halves.size(); ++i) out.color[i] = HalfBitsToFloat(halves[i]);
+        for (size_t i = 0; i < halves.size(); ++i) out.color[i] = HalfToFloat(halves[i]);
     } else {
         out.color = Read<float>(color);
     }

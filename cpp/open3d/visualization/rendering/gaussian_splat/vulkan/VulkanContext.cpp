@@ -1,7 +1,9 @@
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/VulkanContext.h"
 
+#include <algorithm>
 #include <cstdlib>
 #include <cstring>
+#include <iterator>
 #include <optional>
 #include <string_view>
 #include <vector>
@@ -105,6 +107,8 @@ struct DeviceQuery {
             VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SUBGROUP_SIZE_CONTROL_PROPERTIES);
     VkPhysicalDeviceDriverProperties driver = MakeInfo<VkPhysicalDeviceDriverProperties>(
         VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_DRIVER_PROPERTIES);
+    VkPhysicalDeviceIDProperties ids =
+        MakeInfo<VkPhysicalDeviceIDProperties>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ID_PROPERTIES);
     VkPhysicalDeviceFeatures2 features =
         MakeInfo<VkPhysicalDeviceFeatures2>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2);
     VkPhysicalDeviceVulkan13Features features13 = MakeInfo<VkPhysicalDeviceVulkan13Features>(
@@ -116,6 +120,7 @@ struct DeviceQuery {
         properties.pNext = &subgroup;
         subgroup.pNext = &size_control;
         size_control.pNext = &driver;
+        driver.pNext = &ids;
         vkGetPhysicalDeviceProperties2(device, &properties);
         features.pNext = &features13;
         vkGetPhysicalDeviceFeatures2(device, &features);
@@ -281,7 +286,9 @@ std::unique_ptr<VulkanContext> VulkanContext::CreateHeadless(const VulkanContext
     if (best == VK_NULL_HANDLE) {
         core::ThrowError("Vulkan: no usable device.{}\n{}", rejected, kInstallHint);
     }
-    context->InitDevice(best, *DeviceQuery(best).FindQueueFamily());
+    const DeviceQuery chosen(best);
+    context->InitDevice(best, *chosen.FindQueueFamily(),
+                        chosen.HasExtension(VK_KHR_EXTERNAL_MEMORY_FD_EXTENSION_NAME));
     return context;
 }
 
@@ -310,14 +317,20 @@ std::unique_ptr<VulkanContext> VulkanContext::CreateFromBorrowed(
     context->physical_device_ = handles.physical_device;
     context->device_ = handles.device;
     context->queue_ = handles.queue;
-    context->InitDevice(handles.physical_device, handles.queue_family_index);
+    context->InitDevice(handles.physical_device, handles.queue_family_index,
+                        handles.external_memory_fd_enabled);
     return context;
 }
 
-void VulkanContext::InitDevice(VkPhysicalDevice physical_device, uint32_t queue_family_index) {
+void VulkanContext::InitDevice(VkPhysicalDevice physical_device, uint32_t queue_family_index,
+                               bool external_memory_fd) {
     physical_device_ = physical_device;
     DeviceQuery query(physical_device);
     if (owns_handles_) {
+        // Memory export (zero-copy sharing with GL) is optional: enabled when present.
+        std::vector<const char*> extensions(std::begin(kRequiredDeviceExtensions),
+                                            std::end(kRequiredDeviceExtensions));
+        if (external_memory_fd) extensions.push_back(VK_KHR_EXTERNAL_MEMORY_FD_EXTENSION_NAME);
         const float priority = 1.0f;
         VkDeviceQueueCreateInfo queue_info =
             MakeInfo<VkDeviceQueueCreateInfo>(VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO);
@@ -338,9 +351,8 @@ void VulkanContext::InitDevice(VkPhysicalDevice physical_device, uint32_t queue_
         device_info.pNext = &features;
         device_info.queueCreateInfoCount = 1;
         device_info.pQueueCreateInfos = &queue_info;
-        device_info.enabledExtensionCount =
-            static_cast<uint32_t>(std::size(kRequiredDeviceExtensions));
-        device_info.ppEnabledExtensionNames = kRequiredDeviceExtensions;
+        device_info.enabledExtensionCount = static_cast<uint32_t>(extensions.size());
+        device_info.ppEnabledExtensionNames = extensions.data();
         CheckVk(vkCreateDevice(physical_device, &device_info, nullptr, &device_), "vkCreateDevice");
         vkGetDeviceQueue(device_, queue_family_index, 0, &queue_);
     }
@@ -362,12 +374,16 @@ void VulkanContext::InitDevice(VkPhysicalDevice physical_device, uint32_t queue_
     info_.timestamp_period_ns =
         family.timestampValidBits > 0 ? properties.limits.timestampPeriod : 0.0f;
     info_.queue_family_index = queue_family_index;
+    std::copy(std::begin(query.ids.deviceUUID), std::end(query.ids.deviceUUID),
+              info_.device_uuid.begin());
+    std::copy(std::begin(query.ids.driverUUID), std::end(query.ids.driverUUID),
+              info_.driver_uuid.begin());
 
-    LoadDeviceFunctions();
+    LoadDeviceFunctions(external_memory_fd);
     ReportDevice();
 }
 
-void VulkanContext::LoadDeviceFunctions() {
+void VulkanContext::LoadDeviceFunctions(bool external_memory_fd) {
     push_descriptor_set_ = reinterpret_cast<PFN_vkCmdPushDescriptorSetKHR>(
         vkGetDeviceProcAddr(device_, "vkCmdPushDescriptorSetKHR"));
     if (push_descriptor_set_ == nullptr) {
@@ -376,16 +392,25 @@ void VulkanContext::LoadDeviceFunctions() {
             "created with {}",
             VK_KHR_PUSH_DESCRIPTOR_EXTENSION_NAME);
     }
+    if (external_memory_fd) {
+        get_memory_fd_ = reinterpret_cast<PFN_vkGetMemoryFdKHR>(
+            vkGetDeviceProcAddr(device_, "vkGetMemoryFdKHR"));
+        if (get_memory_fd_ == nullptr) {
+            core::ThrowError(
+                "Vulkan: vkGetMemoryFdKHR is unavailable although {} was reported enabled",
+                VK_KHR_EXTERNAL_MEMORY_FD_EXTENSION_NAME);
+        }
+    }
 }
 
 void VulkanContext::ReportDevice() const {
     core::LogInfo(
         "Vulkan device: {} ({}), driver {} [{}], Vulkan {}, subgroup size {} (range {}..{}), "
-        "{} KiB shared memory, queue family {}, validation {}{}",
+        "{} KiB shared memory, queue family {}, memory export {}, validation {}{}",
         info_.name, info_.type, info_.driver_name, info_.driver_info,
         VersionString(info_.api_version), info_.subgroup_size, info_.min_subgroup_size,
         info_.max_subgroup_size, info_.max_compute_shared_memory / 1024, info_.queue_family_index,
-        IsValidationEnabled() ? "on" : "off",
+        SupportsExternalMemoryFd() ? "on" : "off", IsValidationEnabled() ? "on" : "off",
         owns_handles_ ? "" : ", handles borrowed from the host application");
 }
 

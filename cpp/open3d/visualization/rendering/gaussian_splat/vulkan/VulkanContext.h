@@ -6,6 +6,7 @@
 
 #include <vulkan/vulkan.h>
 
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -38,6 +39,9 @@ struct BorrowedVulkanHandles {
     VkDevice device = VK_NULL_HANDLE;
     uint32_t queue_family_index = 0;  ///< a family with graphics and compute
     VkQueue queue = VK_NULL_HANDLE;   ///< a queue of that family
+    /// The host created the device with VK_KHR_external_memory_fd (a context cannot ask a
+    /// device which extensions it was created with): enables exporting image memory.
+    bool external_memory_fd_enabled = false;
 };
 
 /// What the device is, as reported in the log at creation.
@@ -55,6 +59,10 @@ struct VulkanDeviceInfo {
     uint64_t min_storage_buffer_offset_alignment = 0;  ///< bytes
     float timestamp_period_ns = 0.0f;                  ///< 0 when timestamps are unsupported
     uint32_t queue_family_index = 0;
+    /// VkPhysicalDeviceIDProperties: another API (GL) sharing memory with this device must
+    /// report the same UUIDs.
+    std::array<uint8_t, VK_UUID_SIZE> device_uuid{};
+    std::array<uint8_t, VK_UUID_SIZE> driver_uuid{};
 };
 
 /// Validation messages seen since the context was created.
@@ -103,13 +111,20 @@ public:
     /// vkCmdPushDescriptorSetKHR of this device (an extension entry point).
     PFN_vkCmdPushDescriptorSetKHR GetCmdPushDescriptorSet() const { return push_descriptor_set_; }
 
+    /// True when VK_KHR_external_memory_fd is enabled: headless contexts enable it whenever
+    /// the device has it; borrowed ones when BorrowedVulkanHandles says the host did.
+    bool SupportsExternalMemoryFd() const { return get_memory_fd_ != nullptr; }
+    /// vkGetMemoryFdKHR of this device; nullptr unless SupportsExternalMemoryFd().
+    PFN_vkGetMemoryFdKHR GetMemoryFd() const { return get_memory_fd_; }
+
     /// vkDeviceWaitIdle; for teardown and tests, not for frames.
     void WaitIdle() const;
 
 private:
     VulkanContext();
-    void InitDevice(VkPhysicalDevice physical_device, uint32_t queue_family_index);
-    void LoadDeviceFunctions();
+    void InitDevice(VkPhysicalDevice physical_device, uint32_t queue_family_index,
+                    bool external_memory_fd);
+    void LoadDeviceFunctions(bool external_memory_fd);
     void ReportDevice() const;
 
     bool owns_handles_ = false;
@@ -122,6 +137,7 @@ private:
     VkQueue queue_ = VK_NULL_HANDLE;
     VkPhysicalDeviceMemoryProperties memory_properties_{};
     PFN_vkCmdPushDescriptorSetKHR push_descriptor_set_ = nullptr;
+    PFN_vkGetMemoryFdKHR get_memory_fd_ = nullptr;
     VulkanDeviceInfo info_;
 };
 

@@ -1,0 +1,119 @@
+#include "open3d/visualization/rendering/filament/FilamentEngine.h"
+
+#include <GLFW/glfw3.h>
+#define GLFW_EXPOSE_NATIVE_X11
+#define GLFW_EXPOSE_NATIVE_GLX
+#include <GLFW/glfw3native.h>
+#include <filament/Engine.h>
+
+#include <cstdlib>
+#include <mutex>
+#include <string>
+
+#include "open3d/core/Exception.h"
+#include "open3d/core/Logging.h"
+
+namespace open3d {
+namespace visualization {
+namespace rendering {
+
+namespace {
+
+constexpr const char* kRunUnderXvfb =
+    "Filament 1.9's OpenGL backend needs an X server (GLX); on a machine without a display "
+    "run the program under Xvfb, e.g. `xvfb-run -a -s \"-screen 0 1280x1024x24\" <command>`";
+
+// GLFW is initialised once per process and terminated with the last engine.
+std::mutex glfw_mutex;
+int glfw_users = 0;
+std::string glfw_error;
+
+void OnGlfwError(int code, const char* description) {
+    glfw_error = fmt::format("GLFW error 0x{:x}: {}", code, description);
+}
+
+bool AcquireGlfw(std::string* why) {
+    std::lock_guard<std::mutex> lock(glfw_mutex);
+    if (glfw_users > 0) {
+        ++glfw_users;
+        return true;
+    }
+    const char* display = std::getenv("DISPLAY");
+    if (display == nullptr || display[0] == '\0') {
+        *why = fmt::format("DISPLAY is not set. {}", kRunUnderXvfb);
+        return false;
+    }
+    glfwSetErrorCallback(OnGlfwError);
+    glfw_error.clear();
+    if (!glfwInit()) {
+        *why =
+            fmt::format("cannot open X display '{}' ({}). {}", display, glfw_error, kRunUnderXvfb);
+        return false;
+    }
+    ++glfw_users;
+    return true;
+}
+
+void ReleaseGlfw() {
+    std::lock_guard<std::mutex> lock(glfw_mutex);
+    if (--glfw_users == 0) glfwTerminate();
+}
+
+}  // namespace
+
+std::string FilamentUnavailableReason() {
+    std::string why;
+    if (!AcquireGlfw(&why)) return why;
+    ReleaseGlfw();
+    return {};
+}
+
+FilamentEngine::FilamentEngine() {
+    std::string why;
+    if (!AcquireGlfw(&why)) core::ThrowError("Filament: {}", why);
+    glfwDefaultWindowHints();
+    glfwWindowHint(GLFW_VISIBLE, GLFW_FALSE);
+    glfwWindowHint(GLFW_CLIENT_API, GLFW_OPENGL_API);
+    // llvmpipe offers 4.5 core, not 4.6 (ENVIRONMENT.md).
+    glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 4);
+    glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 5);
+    glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
+    glfwWindowHint(GLFW_ALPHA_BITS, 0);
+    glfw_error.clear();
+    window_ = glfwCreateWindow(16, 16, "open3d-filament-context", nullptr, nullptr);
+    if (window_ == nullptr) {
+        ReleaseGlfw();
+        core::ThrowError("Filament: GLFW could not create a hidden OpenGL 4.5 core context ({})",
+                         glfw_error);
+    }
+    glfwMakeContextCurrent(window_);
+    try {
+        gl_ = GlFunctions::Load();
+    } catch (...) {
+        glfwDestroyWindow(window_);
+        ReleaseGlfw();
+        throw;
+    }
+    void* shared_context = glfwGetGLXContext(window_);
+    engine_ = filament::Engine::create(filament::Engine::Backend::OPENGL, nullptr, shared_context);
+    if (engine_ == nullptr) {
+        glfwDestroyWindow(window_);
+        ReleaseGlfw();
+        core::ThrowError("Filament: Engine::create(OPENGL) failed");
+    }
+    // Engine creation may leave another context current on this thread.
+    glfwMakeContextCurrent(window_);
+}
+
+FilamentEngine::~FilamentEngine() {
+    filament::Engine::destroy(&engine_);
+    glfwMakeContextCurrent(nullptr);
+    glfwDestroyWindow(window_);
+    ReleaseGlfw();
+}
+
+void FilamentEngine::MakeContextCurrent() const { glfwMakeContextCurrent(window_); }
+
+}  // namespace rendering
+}  // namespace visualization
+}  // namespace open3d

@@ -1,0 +1,87 @@
+// The frame schedule of docs/DESIGN.md section 5 (docs/filament.md "Frame"):
+//   flushAndWait -> Stage A submit (no CPU wait) -> Filament draws the meshes (colour +
+//   the shared depth) -> flushAndWait -> Stage B (waits for Stage A's fence, tests splats
+//   against the depth, writes the shared RGBA16F) -> the compose view blits the mesh colour
+//   and blends the splat colour over it on a swap chain, and/or the offscreen readback
+//   blends the two on the host.
+#pragma once
+
+#include <memory>
+
+#include "open3d/t/geometry/Image.h"
+#include "open3d/visualization/rendering/gaussian_splat/RenderConfig.h"
+
+namespace filament {
+class Renderer;
+class SwapChain;
+}  // namespace filament
+
+namespace open3d {
+namespace visualization {
+namespace rendering {
+
+class FilamentEngine;
+class FilamentMaterials;
+class FilamentScene;
+class FilamentView;
+
+struct FrameRequest {
+    /// Splat settings; `background` is ignored (the view's background shows through).
+    RenderConfig splat_config;
+    /// Read the composed colour back (FrameResult::color).
+    bool read_color = false;
+    /// Merge and read the depth back (FrameResult::linear_depth / normalized_depth).
+    bool read_depth = false;
+    float depth_near = 0.2f;  ///< normalisation of normalized_depth
+    float depth_far = 100.0f;
+};
+
+/// Wall-clock parts of a frame in milliseconds (CPU side, including waits).
+struct FrameTimes {
+    double stage_a_ms = 0.0;   ///< Stage A record + submit (and scene/mask uploads)
+    double filament_ms = 0.0;  ///< mesh view render + flushAndWait
+    double stage_b_ms = 0.0;   ///< Stage A fence wait + Stage B (+ GPU depth merge, readback)
+    double compose_ms = 0.0;   ///< swap chain frame (blit + overlay), when drawn
+    double readback_ms = 0.0;  ///< mesh colour readPixels + host blend (offscreen)
+    double total_ms = 0.0;
+};
+
+struct FrameResult {
+    /// UInt8 [H, W, 4], top row first: splat colour blended "over" the mesh view's colour.
+    t::geometry::Image color;
+    /// Float32 [H, W, 1] nearer of splat and mesh view z, 0 where nothing is.
+    t::geometry::Image linear_depth;
+    /// UInt16 [H, W, 1] normalised, 65535 where nothing is.
+    t::geometry::Image normalized_depth;
+    RenderStats splat_stats;
+    bool splats_drawn = false;      ///< some splat cloud was visible (Stage A and B ran)
+    bool scene_depth_used = false;  ///< a mesh was visible, so splats were depth-tested
+    FrameTimes times;
+};
+
+class FilamentRenderer {
+public:
+    explicit FilamentRenderer(FilamentEngine& engine);
+    ~FilamentRenderer();
+    FilamentRenderer(const FilamentRenderer&) = delete;
+    FilamentRenderer& operator=(const FilamentRenderer&) = delete;
+
+    FilamentEngine& GetEngine() const { return engine_; }
+    const FilamentMaterials& GetMaterials() const { return *materials_; }
+    filament::Renderer* GetFilamentRenderer() const { return renderer_; }
+
+    /// One frame of `scene` through `view`. Draws to `swap_chain` when given (the caller
+    /// presents it); reads back what `request` asks for. The splat pipeline always runs
+    /// for visible splats (Stage A is reused by the backend when nothing changed).
+    FrameResult Draw(FilamentScene& scene, FilamentView& view, const FrameRequest& request,
+                     filament::SwapChain* swap_chain = nullptr);
+
+private:
+    FilamentEngine& engine_;
+    std::unique_ptr<FilamentMaterials> materials_;
+    filament::Renderer* renderer_ = nullptr;
+};
+
+}  // namespace rendering
+}  // namespace visualization
+}  // namespace open3d

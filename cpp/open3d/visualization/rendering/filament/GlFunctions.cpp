@@ -1,0 +1,92 @@
+#include "open3d/visualization/rendering/filament/GlFunctions.h"
+
+#include <GLFW/glfw3.h>
+
+#include <cstring>
+
+#include "open3d/core/Exception.h"
+
+namespace open3d {
+namespace visualization {
+namespace rendering {
+
+namespace {
+
+template <typename T>
+void LoadProc(T& pointer, const char* name) {
+    pointer = reinterpret_cast<T>(glfwGetProcAddress(name));
+}
+
+}  // namespace
+
+GlFunctions GlFunctions::Load() {
+    if (glfwGetCurrentContext() == nullptr) {
+        core::ThrowError("OpenGL: no current context to load entry points from");
+    }
+    GlFunctions gl;
+    LoadProc(gl.GetStringi, "glGetStringi");
+    LoadProc(gl.GetIntegerv, "glGetIntegerv");
+    LoadProc(gl.GetError, "glGetError");
+    LoadProc(gl.Finish, "glFinish");
+    LoadProc(gl.CreateTextures, "glCreateTextures");
+    LoadProc(gl.DeleteTextures, "glDeleteTextures");
+    LoadProc(gl.TextureStorage2D, "glTextureStorage2D");
+    LoadProc(gl.TextureSubImage2D, "glTextureSubImage2D");
+    LoadProc(gl.GetTextureImage, "glGetTextureImage");
+    LoadProc(gl.PixelStorei, "glPixelStorei");
+    for (const void* p :
+         {(const void*)gl.GetStringi, (const void*)gl.GetIntegerv, (const void*)gl.GetError,
+          (const void*)gl.Finish, (const void*)gl.CreateTextures, (const void*)gl.DeleteTextures,
+          (const void*)gl.TextureStorage2D, (const void*)gl.TextureSubImage2D,
+          (const void*)gl.GetTextureImage, (const void*)gl.PixelStorei}) {
+        if (p == nullptr) {
+            core::ThrowError("OpenGL: the context lacks a 4.5 core entry point (need OpenGL 4.5)");
+        }
+    }
+    LoadProc(gl.CreateMemoryObjectsEXT, "glCreateMemoryObjectsEXT");
+    LoadProc(gl.DeleteMemoryObjectsEXT, "glDeleteMemoryObjectsEXT");
+    LoadProc(gl.MemoryObjectParameterivEXT, "glMemoryObjectParameterivEXT");
+    LoadProc(gl.ImportMemoryFdEXT, "glImportMemoryFdEXT");
+    LoadProc(gl.TextureStorageMem2DEXT, "glTextureStorageMem2DEXT");
+    LoadProc(gl.GetUnsignedBytevEXT, "glGetUnsignedBytevEXT");
+    LoadProc(gl.GetUnsignedBytei_vEXT, "glGetUnsignedBytei_vEXT");
+    return gl;
+}
+
+bool GlFunctions::HasExtension(const std::string& name) const {
+    GLint count = 0;
+    GetIntegerv(GL_NUM_EXTENSIONS, &count);
+    for (GLint i = 0; i < count; ++i) {
+        const auto* extension = reinterpret_cast<const char*>(GetStringi(GL_EXTENSIONS, i));
+        if (extension != nullptr && name == extension) return true;
+    }
+    return false;
+}
+
+bool GlFunctions::HasMemoryObjectFd() const {
+    return HasExtension("GL_EXT_memory_object") && HasExtension("GL_EXT_memory_object_fd") &&
+           CreateMemoryObjectsEXT && DeleteMemoryObjectsEXT && MemoryObjectParameterivEXT &&
+           ImportMemoryFdEXT && TextureStorageMem2DEXT && GetUnsignedBytevEXT &&
+           GetUnsignedBytei_vEXT;
+}
+
+std::array<uint8_t, 16> GlFunctions::DeviceUuid() const {
+    std::array<uint8_t, 16> uuid{};
+    if (GetUnsignedBytei_vEXT) GetUnsignedBytei_vEXT(GL_DEVICE_UUID_EXT, 0, uuid.data());
+    return uuid;
+}
+
+std::array<uint8_t, 16> GlFunctions::DriverUuid() const {
+    std::array<uint8_t, 16> uuid{};
+    if (GetUnsignedBytevEXT) GetUnsignedBytevEXT(GL_DRIVER_UUID_EXT, uuid.data());
+    return uuid;
+}
+
+void GlFunctions::CheckError(const char* what) const {
+    const GLenum error = GetError();
+    if (error != GL_NO_ERROR) core::ThrowError("OpenGL: {} failed (error 0x{:04x})", what, error);
+}
+
+}  // namespace rendering
+}  // namespace visualization
+}  // namespace open3d

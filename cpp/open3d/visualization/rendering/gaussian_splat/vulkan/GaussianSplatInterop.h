@@ -1,0 +1,128 @@
+// Sharing the Vulkan backend's frame images with an OpenGL renderer (Filament) without
+// copies (docs/filament.md "Zero-copy images"): the splat colour (RGBA16F, written by the
+// composite) and the scene depth (D32_SFLOAT, written by Filament, sampled by the
+// composite) live in Vulkan memory exported as POSIX file descriptors, which GL imports
+// with GL_EXT_memory_object_fd. This header has no Vulkan types so the Filament layer can
+// use it (STYLE.md point 2); synchronisation is on the CPU (fence waits), because lavapipe
+// has no external semaphores (docs/environment-notes.md).
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <memory>
+
+#include "open3d/t/geometry/Image.h"
+#include "open3d/visualization/rendering/gaussian_splat/GaussianSplatRenderer.h"
+
+namespace open3d {
+namespace visualization {
+namespace rendering {
+namespace vulkan {
+
+/// What the device of a backend can share.
+struct InteropSupport {
+    /// The backend is the Vulkan backend and its device has VK_KHR_external_memory_fd.
+    bool external_memory_fd = false;
+    /// VkPhysicalDeviceIDProperties: GL must report the same UUIDs
+    /// (GL_DEVICE_UUID_EXT / GL_DRIVER_UUID_EXT) before it may import the memory.
+    std::array<uint8_t, 16> device_uuid{};
+    std::array<uint8_t, 16> driver_uuid{};
+};
+
+/// Support of `backend`: all false / zero when it is not the Vulkan backend.
+InteropSupport QueryInteropSupport(const GaussianSplatBackend& backend);
+
+/// One exported image allocation, for glImportMemoryFdEXT + glTextureStorageMem2DEXT.
+struct ExportedImageMemory {
+    /// A new descriptor per export. The caller owns it: a successful GL import takes
+    /// ownership; otherwise the caller closes it.
+    int fd = -1;
+    /// Size of the allocation (glImportMemoryFdEXT's size argument).
+    uint64_t size = 0;
+    /// Always a dedicated allocation: set GL_DEDICATED_MEMORY_OBJECT_EXT before importing.
+    bool dedicated = true;
+};
+
+struct InteropCompositeRequest;
+struct InteropFrame;
+
+/// The images of one view size, made on the backend's device with exportable memory
+/// (OPAQUE_FD, dedicated allocations, optimal tiling):
+/// - colour: RGBA16F, premultiplied splat colour (rgb = C, a = 1 - T, no background),
+///   row 0 = the top image row (GL, whose row 0 is the bottom, must flip y);
+/// - depth: D32_SFLOAT, Filament's depth attachment: reversed-Z d = near / z_view, 0 where
+///   nothing was drawn, row 0 = GL's bottom row.
+/// Both stay in VK_IMAGE_LAYOUT_GENERAL and are owned by the external queue family between
+/// composites. Destroy them only after GL/Filament stopped using the imported textures, and
+/// before the backend (whose device they live on).
+class InteropTargets {
+public:
+    /// Throws core::Open3DError when `backend` is not the Vulkan backend, its device cannot
+    /// export memory, or a size is 0.
+    InteropTargets(GaussianSplatBackend& backend, uint32_t width, uint32_t height);
+    ~InteropTargets();
+    InteropTargets(const InteropTargets&) = delete;
+    InteropTargets& operator=(const InteropTargets&) = delete;
+
+    uint32_t GetWidth() const;
+    uint32_t GetHeight() const;
+
+    ExportedImageMemory ExportColor();
+    ExportedImageMemory ExportDepth();
+
+    /// Writes the depth image from the host: `reversed_z` holds width * height floats in GL
+    /// row order (bottom row first), stored as given. For tests and for drivers where GL
+    /// cannot import. Acquires and releases the image itself and waits for the copy.
+    void UploadDepth(const float* reversed_z);
+
+    struct Impl;
+
+private:
+    friend void RenderCompositeToInterop(GaussianSplatBackend& backend, InteropTargets& targets,
+                                         const InteropCompositeRequest& request,
+                                         InteropFrame& frame);
+    std::unique_ptr<Impl> impl_;
+};
+
+struct InteropCompositeRequest {
+    /// Test each splat against the shared depth (some mesh is visible). When false the
+    /// pipeline variant without scene depth runs and reads no depth.
+    bool use_scene_depth = false;
+    /// Near plane of the projection that wrote the depth: z_view = scene_near / d.
+    float scene_near = 0.1f;
+    /// Copy the splat colour to InteropFrame::color (offscreen rendering).
+    bool read_color = false;
+    /// Merge the splat depth (expected depth where 1 - T >= 0.5) with the scene depth on
+    /// the GPU and read both merged images back (RenderToDepthImage).
+    bool read_depth = false;
+    /// Normalisation of InteropFrame::normalized_depth: 65535 * (z - near) / (far - near).
+    float depth_near = 0.2f;
+    float depth_far = 100.0f;
+};
+
+/// What a composite read back; the images not requested come back empty.
+struct InteropFrame {
+    /// Float32 [H, W, 4], premultiplied rgb and a = 1 - T, top row first (read_color).
+    t::geometry::Image color;
+    /// Float32 [H, W, 1] merged view z, 0 where neither splat nor mesh is (read_depth).
+    t::geometry::Image linear_depth;
+    /// UInt16 [H, W, 1] merged depth normalised, 65535 where nothing is (read_depth).
+    t::geometry::Image normalized_depth;
+    /// As RenderCompositeStage reports it (counts, flags, GPU times, geometry_reused).
+    RenderStats stats;
+};
+
+/// Stage B of `backend`'s last RenderGeometryStage into `targets`, whose size must equal
+/// that camera's. Acquires both images from the external queue family and releases them
+/// back in the same command buffer, waits for the fence, then fills `frame`. Entry-buffer
+/// growth and empty-frame skips behave as in RenderCompositeStage. Throws core::Open3DError
+/// on a size mismatch, a non-Vulkan backend, targets of another backend, when no geometry
+/// stage ran, or for a request with scene_near <= 0 (use_scene_depth) or depth_far <=
+/// depth_near (read_depth).
+void RenderCompositeToInterop(GaussianSplatBackend& backend, InteropTargets& targets,
+                              const InteropCompositeRequest& request, InteropFrame& frame);
+
+}  // namespace vulkan
+}  // namespace rendering
+}  // namespace visualization
+}  // namespace open3d

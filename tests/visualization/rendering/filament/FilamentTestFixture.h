@@ -1,0 +1,64 @@
+// One Filament engine and renderer per test binary (each ctest entry is its own process),
+// skipping with the reason where no X server (run under xvfb-run) or no Vulkan device
+// exists, and small scenes built in code: a wall of splats behind, a red sphere, splats in
+// front. The camera looks along +z from the origin.
+#pragma once
+
+#include <gtest/gtest.h>
+
+#include <memory>
+#include <string>
+
+#include "open3d/camera/PinholeCamera.h"
+#include "open3d/t/geometry/PointCloud.h"
+#include "open3d/visualization/rendering/filament/FilamentEngine.h"
+#include "open3d/visualization/rendering/filament/FilamentRenderer.h"
+#include "open3d/visualization/rendering/filament/FilamentScene.h"
+#include "open3d/visualization/rendering/filament/FilamentView.h"
+
+namespace open3d {
+namespace tests {
+
+namespace rendering = visualization::rendering;
+
+class FilamentTest : public ::testing::Test {
+protected:
+    static void SetUpTestSuite();
+    static void TearDownTestSuite();
+    void SetUp() override;
+    void TearDown() override;
+
+    /// A scene drawn by `backend` ("vulkan", "cpu" or "placeholder"), owned by the fixture
+    /// until TearDown (which checks the validation counts, then destroys views and scenes).
+    rendering::FilamentScene& MakeScene(const std::string& backend = "vulkan");
+    rendering::FilamentView& MakeView(
+        const camera::PinholeCamera& camera,
+        rendering::SplatSharing sharing = rendering::SplatSharing::kAuto);
+    /// Validation problems of every Vulkan backend this test made (must stay 0).
+    uint64_t ValidationProblems() const;
+
+    static rendering::FilamentEngine* engine_;
+    static rendering::FilamentRenderer* renderer_;
+    static std::string skip_reason_;
+    std::vector<std::unique_ptr<rendering::FilamentScene>> scenes_;
+    std::vector<std::unique_ptr<rendering::FilamentView>> views_;
+};
+
+/// Camera at the origin looking along +z, fx = fy = 0.9 * width, principal point at the
+/// image centre.
+camera::PinholeCamera MakeFilamentTestCamera(int width, int height);
+
+/// A wall of n x n overlapping splats of `rgb` in the plane z = `depth`, covering
+/// [-half, half]^2, opacity 0.95, degree 0.
+t::geometry::PointCloud MakeSplatWall(double depth, double half, int n, const Eigen::Vector3d& rgb);
+
+/// The red sphere of the occlusion tests (radius 0.5 at (0, 0, 2), flat colour).
+constexpr double kSphereRadius = 0.5;
+constexpr double kSphereZ = 2.0;
+void AddRedSphere(rendering::FilamentScene& scene, const std::string& name = "sphere");
+
+/// Depth of the sphere's surface along the ray of pixel (u, v), or 0 when the ray misses.
+double SphereDepthAt(const camera::PinholeCamera& camera, double u, double v);
+
+}  // namespace tests
+}  // namespace open3d
