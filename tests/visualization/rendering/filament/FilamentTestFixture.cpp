@@ -1,5 +1,6 @@
 #include "visualization/rendering/filament/FilamentTestFixture.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "open3d/core/Exception.h"
@@ -43,6 +44,7 @@ void FilamentTest::TearDown() {
     EXPECT_EQ(ValidationProblems(), 0u);
     views_.clear();  // their targets belong to the scenes' backends
     scenes_.clear();
+    open3d_scenes_.clear();
 }
 
 rendering::FilamentScene& FilamentTest::MakeScene(const std::string& backend) {
@@ -60,8 +62,26 @@ rendering::FilamentView& FilamentTest::MakeView(const camera::PinholeCamera& cam
     return *views_.back();
 }
 
+rendering::Open3DScene& FilamentTest::MakeOpen3DScene(
+    const rendering::Open3DSceneOptions& options) {
+    open3d_scenes_.push_back(std::make_unique<rendering::Open3DScene>(*renderer_, options));
+    return *open3d_scenes_.back();
+}
+
+rendering::RenderOutput FilamentTest::RenderHeadless(const t::geometry::PointCloud& cloud,
+                                                     const camera::PinholeCamera& camera) {
+    auto backend = rendering::CreateGaussianSplatBackend("vulkan");
+    backend->SetScene(cloud);
+    rendering::RenderOutput out = backend->Render(camera, rendering::RenderConfig{});
+    headless_problems_ += rendering::vulkan::GetValidationProblemCount(*backend);
+    return out;
+}
+
 uint64_t FilamentTest::ValidationProblems() const {
-    uint64_t problems = 0;
+    uint64_t problems = headless_problems_;
+    for (const auto& scene : open3d_scenes_) {
+        problems += rendering::vulkan::GetValidationProblemCount(scene->GetScene().GetBackend());
+    }
     for (const auto& scene : scenes_) {
         problems += rendering::vulkan::GetValidationProblemCount(scene->GetBackend());
     }
@@ -95,6 +115,31 @@ t::geometry::PointCloud MakeSplatWall(double depth, double half, int n,
     return MakeCloud(splats);
 }
 
+t::geometry::PointCloud MakeSplatBlob(double x, double y, double depth, double radius,
+                                      const Eigen::Vector3d& rgb) {
+    std::vector<TestSplat> splats;
+    for (int j = -1; j <= 1; ++j) {
+        for (int i = -1; i <= 1; ++i) {
+            TestSplat s;
+            s.position = Eigen::Vector3d(x + i * radius / 2, y + j * radius / 2, depth);
+            s.scale = Eigen::Vector3d(radius / 2, radius / 2, 0.01);
+            s.opacity = 0.9;
+            s.color = rgb;
+            splats.push_back(s);
+        }
+    }
+    return MakeCloud(splats);
+}
+
+std::array<int, 4> ExpectedOver(const float* s, const Eigen::Vector4f& background) {
+    std::array<int, 4> out{};
+    for (int c = 0; c < 4; ++c) {
+        const double v = s[c] + (1.0 - s[3]) * background[c];
+        out[c] = static_cast<int>(std::lround(std::clamp(v, 0.0, 1.0) * 255.0));
+    }
+    return out;
+}
+
 void AddRedSphere(rendering::FilamentScene& scene, const std::string& name) {
     t::geometry::TriangleMesh sphere = t::geometry::TriangleMesh::CreateSphere(kSphereRadius, 40);
     sphere.Translate(Eigen::Vector3d(0, 0, kSphereZ));
@@ -103,7 +148,12 @@ void AddRedSphere(rendering::FilamentScene& scene, const std::string& name) {
     scene.AddGeometry(name, sphere, material);
 }
 
-double SphereDepthAt(const camera::PinholeCamera& camera, double u, double v) {
+double SphereDepthTolerance(double cos_incidence) {
+    return cos_incidence < 0.3 ? -1.0 : 2e-3 / cos_incidence;
+}
+
+double SphereDepthAt(const camera::PinholeCamera& camera, double u, double v,
+                     double* cos_incidence) {
     // Ray (x, y, 1) * t against |p - c| = r with c = (0, 0, kSphereZ); depth = t.
     const Eigen::Vector3d d((u - camera.cx) / camera.fx, (v - camera.cy) / camera.fy, 1.0);
     const Eigen::Vector3d c(0, 0, kSphereZ);
@@ -111,7 +161,9 @@ double SphereDepthAt(const camera::PinholeCamera& camera, double u, double v) {
     const double k = c.squaredNorm() - kSphereRadius * kSphereRadius;
     const double disc = b * b - 4 * a * k;
     if (disc < 0) return 0.0;
-    return (-b - std::sqrt(disc)) / (2 * a);
+    const double t = (-b - std::sqrt(disc)) / (2 * a);
+    if (cos_incidence) *cos_incidence = std::abs((t * d - c).normalized().dot(d.normalized()));
+    return t;
 }
 
 }  // namespace tests

@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <memory>
 #include <string>
 
@@ -15,6 +16,7 @@
 #include "open3d/visualization/rendering/filament/FilamentRenderer.h"
 #include "open3d/visualization/rendering/filament/FilamentScene.h"
 #include "open3d/visualization/rendering/filament/FilamentView.h"
+#include "open3d/visualization/rendering/filament/Open3DScene.h"
 
 namespace open3d {
 namespace tests {
@@ -34,6 +36,11 @@ protected:
     rendering::FilamentView& MakeView(
         const camera::PinholeCamera& camera,
         rendering::SplatSharing sharing = rendering::SplatSharing::kAuto);
+    /// An Open3DScene on the shared renderer, owned by the fixture like MakeScene's.
+    rendering::Open3DScene& MakeOpen3DScene(const rendering::Open3DSceneOptions& options = {});
+    /// The headless Vulkan renderer's image of `cloud` (no Filament), black background.
+    rendering::RenderOutput RenderHeadless(const t::geometry::PointCloud& cloud,
+                                           const camera::PinholeCamera& camera);
     /// Validation problems of every Vulkan backend this test made (must stay 0).
     uint64_t ValidationProblems() const;
 
@@ -42,6 +49,8 @@ protected:
     static std::string skip_reason_;
     std::vector<std::unique_ptr<rendering::FilamentScene>> scenes_;
     std::vector<std::unique_ptr<rendering::FilamentView>> views_;
+    std::vector<std::unique_ptr<rendering::Open3DScene>> open3d_scenes_;
+    uint64_t headless_problems_ = 0;
 };
 
 /// Camera at the origin looking along +z, fx = fy = 0.9 * width, principal point at the
@@ -52,13 +61,29 @@ camera::PinholeCamera MakeFilamentTestCamera(int width, int height);
 /// [-half, half]^2, opacity 0.95, degree 0.
 t::geometry::PointCloud MakeSplatWall(double depth, double half, int n, const Eigen::Vector3d& rgb);
 
+/// A few splats of `rgb` around (x, y) in the plane z = depth (a small blob), opacity 0.9.
+t::geometry::PointCloud MakeSplatBlob(double x, double y, double depth, double radius,
+                                      const Eigen::Vector3d& rgb);
+
+/// round(255 * (s + (1 - s_a) * background)) per channel: the expected RGBA8 of splats
+/// (premultiplied float RGBA) over an opaque background.
+std::array<int, 4> ExpectedOver(const float* splat_rgba, const Eigen::Vector4f& background);
+
 /// The red sphere of the occlusion tests (radius 0.5 at (0, 0, 2), flat colour).
 constexpr double kSphereRadius = 0.5;
 constexpr double kSphereZ = 2.0;
 void AddRedSphere(rendering::FilamentScene& scene, const std::string& name = "sphere");
 
-/// Depth of the sphere's surface along the ray of pixel (u, v), or 0 when the ray misses.
-double SphereDepthAt(const camera::PinholeCamera& camera, double u, double v);
+/// Depth of the sphere's surface along the ray of pixel (u, v), or 0 when the ray misses;
+/// `cos_incidence` (optional) gets |cos| of the angle between the ray and the normal.
+double SphereDepthAt(const camera::PinholeCamera& camera, double u, double v,
+                     double* cos_incidence = nullptr);
+
+/// Tolerance of a rasterized sphere's depth against SphereDepthAt: the 40-segment UV
+/// sphere lies inside the true one by up to r (1 - cos(pi / 40) cos(pi / 80)) = 1.9e-3
+/// radially, which a ray sees divided by the cosine of its incidence angle; pixels with
+/// cos < 0.3 (the silhouette) are not compared (returns < 0).
+double SphereDepthTolerance(double cos_incidence);
 
 }  // namespace tests
 }  // namespace open3d

@@ -9,6 +9,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <cstring>
 
 #include "open3d/core/Exception.h"
 #include "open3d/core/Timer.h"
@@ -124,7 +125,21 @@ FrameResult FilamentRenderer::Draw(FilamentScene& scene, FilamentView& view,
         // A frame Filament wants to skip is drawn anyway: the caller asked for this one.
         renderer_->beginFrame(swap_chain);
         renderer_->render(view.GetComposeView());
+        std::vector<uint8_t> screen;
+        if (request.read_screen) {
+            screen.resize(size_t(w) * h * 4);
+            renderer_->readPixels(
+                0, 0, uint32_t(w), uint32_t(h),
+                filament::backend::PixelBufferDescriptor(screen.data(), screen.size(),
+                                                         filament::backend::PixelDataFormat::RGBA,
+                                                         filament::backend::PixelDataType::UBYTE));
+        }
         renderer_->endFrame();
+        if (request.read_screen) {
+            engine.flushAndWait();
+            result.screen = t::geometry::Image(h, w, 4, core::Dtype::UInt8);
+            std::memcpy(result.screen.Data<uint8_t>(), screen.data(), screen.size());
+        }
         result.times.compose_ms = core::MillisecondsSince(t);
     }
     if (request.read_color) {

@@ -30,6 +30,9 @@ struct FrameRequest {
     RenderConfig splat_config;
     /// Read the composed colour back (FrameResult::color).
     bool read_color = false;
+    /// Read the swap chain's pixels after the compose view (FrameResult::screen); needs a
+    /// swap chain made with CONFIG_READABLE.
+    bool read_screen = false;
     /// Merge and read the depth back (FrameResult::linear_depth / normalized_depth).
     bool read_depth = false;
     float depth_near = 0.2f;  ///< normalisation of normalized_depth
@@ -49,6 +52,8 @@ struct FrameTimes {
 struct FrameResult {
     /// UInt8 [H, W, 4], top row first: splat colour blended "over" the mesh view's colour.
     t::geometry::Image color;
+    /// UInt8 [H, W, 4], top row first: what the compose view drew (read_screen).
+    t::geometry::Image screen;
     /// Float32 [H, W, 1] nearer of splat and mesh view z, 0 where nothing is.
     t::geometry::Image linear_depth;
     /// UInt16 [H, W, 1] normalised, 65535 where nothing is.
