@@ -125,6 +125,7 @@ FrameResult FilamentRenderer::Draw(FilamentScene& scene, FilamentView& view,
         // A frame Filament wants to skip is drawn anyway: the caller asked for this one.
         renderer_->beginFrame(swap_chain);
         renderer_->render(view.GetComposeView());
+        for (filament::View* overlay : request.overlay_views) renderer_->render(overlay);
         std::vector<uint8_t> screen;
         if (request.read_screen) {
             screen.resize(size_t(w) * h * 4);

@@ -7,6 +7,7 @@
 #pragma once
 
 #include <memory>
+#include <vector>
 
 #include "open3d/t/geometry/Image.h"
 #include "open3d/visualization/rendering/gaussian_splat/RenderConfig.h"
@@ -14,6 +15,7 @@
 namespace filament {
 class Renderer;
 class SwapChain;
+class View;
 }  // namespace filament
 
 namespace open3d {
@@ -33,6 +35,9 @@ struct FrameRequest {
     /// Read the swap chain's pixels after the compose view (FrameResult::screen); needs a
     /// swap chain made with CONFIG_READABLE.
     bool read_screen = false;
+    /// Views drawn on the swap chain after the compose view, in order (e.g. an ImGui
+    /// overlay); read_screen includes them. Ignored without a swap chain.
+    std::vector<filament::View*> overlay_views;
     /// Merge and read the depth back (FrameResult::linear_depth / normalized_depth).
     bool read_depth = false;
     float depth_near = 0.2f;  ///< normalisation of normalized_depth

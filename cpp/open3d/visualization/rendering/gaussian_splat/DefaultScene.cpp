@@ -171,6 +171,10 @@ camera::PinholeCamera GetDefaultSceneCamera(int width, int height) {
     return camera::PinholeCamera::FromLookAt(GetDefaultSceneLookAt(), width, height);
 }
 
+DefaultSceneMeshSphere GetDefaultSceneMeshSphere() {
+    return {Eigen::Vector3d(1.05, 0.4, 0.75), 0.4};
+}
+
 }  // namespace rendering
 }  // namespace visualization
 }  // namespace open3d

@@ -16,6 +16,15 @@ t::geometry::PointCloud CreateDefaultGaussianSplatScene();
 /// The look-at camera that frames the default scene (up = +y, 45 degree vertical fov).
 camera::LookAtCamera GetDefaultSceneLookAt();
 
+/// Where a mesh sphere shows depth compositing in the default scene: resting on the ground
+/// in front of the splat sphere and crossing the ring, so some splats hide parts of it and
+/// it hides others.
+struct DefaultSceneMeshSphere {
+    Eigen::Vector3d center;
+    double radius = 0.0;
+};
+DefaultSceneMeshSphere GetDefaultSceneMeshSphere();
+
 /// The default camera at a size (default 640x480).
 camera::PinholeCamera GetDefaultSceneCamera(int width = 640, int height = 480);
 
