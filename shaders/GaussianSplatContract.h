@@ -141,6 +141,12 @@ namespace shader {
 
 // Side of the square screen tiles in pixels (== RenderConfig.h kTileSize, asserted there).
 OPEN3D_SHADER_CONST uint kGaussianTileSize = 16u;
+// Upper bound of a projected splat's 3-sigma radius (pixels). ceil(3 sqrt(lambda)) passes
+// 2^32 (and 2^31, the CPU's int) for a 1e4-scale splat next to a telephoto camera; the
+// float-to-int conversion would be undefined. Clamped, a splat centred within ~1e9 px of
+// the image still covers the whole grid (at most 65535 tiles, ~1e6 px, per axis) as its
+// true radius would; farther out a float32 centre is not resolved to a tile anyway.
+OPEN3D_SHADER_CONST uint kMaxSplatRadius = 1073741824u;  // 2^30, exact in float32
 // Workgroup sizes of the Stage A passes (one invocation per splat / per visible splat).
 OPEN3D_SHADER_CONST uint kProjectWorkgroupSize = 256u;
 OPEN3D_SHADER_CONST uint kEmitWorkgroupSize = 256u;
@@ -202,19 +208,22 @@ OPEN3D_SHADER_CONST uint kCounterNumSplatsIndex = 7u;  // N, written by the reco
 // Per-frame view parameters (a readonly storage buffer; only 16-byte members, so std430,
 // std140 and C++ agree).
 struct GaussianViewParams {
-    vec4 world_to_camera_row0;  // R row 0 | t.x: p_cam.x = dot(row0.xyz, p) + row0.w
-    vec4 world_to_camera_row1;
-    vec4 world_to_camera_row2;
-    vec4 camera_center;  // xyz: camera centre in world space (SH view direction)
-    vec4 intrinsics;     // fx, fy, cx, cy (pixels)
-    vec4 clip;           // guard band 1.3 tan(fov_x / 2), 1.3 tan(fov_y / 2), near plane,
-                         // packed-key depth scale 1 / (far - near); 0 = exact depth order
-    uvec4 image;         // width, height, tiles_x, tiles_y
-    uvec4 limits;        // entry capacity used (<= allocated), max_tiles_per_splat,
-                         // max_tile_entries_total (clamped below 2^31), tile_bits
-    uvec4 scene;         // num_splats, sh_degree evaluated, antialias, sh_words_per_splat
-    uvec4 flags;         // scene depth present, precision, shape_words_per_splat,
-                         // entry capacity allocated
+    // Camera-relative projection: p_cam = R ((p - c_hi) - c_lo) (CameraRelative), exact to
+    // float32 rounding of p - c even 1e5 from the origin, where R p + t loses ~1e-2.
+    vec4 world_to_camera_row0;  // xyz: row 0 of R (world to camera); w: c_lo.x
+    vec4 world_to_camera_row1;  // xyz: row 1 of R; w: c_lo.y
+    vec4 world_to_camera_row2;  // xyz: row 2 of R; w: c_lo.z
+    vec4 camera_center;         // xyz: c_hi, the camera centre rounded to float32; w: 0.
+                                // c_lo = float(c - c_hi), the rounding error (double on the host)
+    vec4 intrinsics;            // fx, fy, cx, cy (pixels)
+    vec4 clip;                  // guard band 1.3 tan(fov_x / 2), 1.3 tan(fov_y / 2), near plane,
+                                // packed-key depth scale 1 / (far - near); 0 = exact depth order
+    uvec4 image;                // width, height, tiles_x, tiles_y
+    uvec4 limits;               // entry capacity used (<= allocated), max_tiles_per_splat,
+                                // max_tile_entries_total (clamped below 2^31), tile_bits
+    uvec4 scene;                // num_splats, sh_degree evaluated, antialias, sh_words_per_splat
+    uvec4 flags;                // scene depth present, precision, shape_words_per_splat,
+                                // entry capacity allocated
 };
 
 // One projected splat, written for visible splats only, indexed by splat index (std430).
@@ -298,16 +307,24 @@ OPEN3D_SHADER_FUNC uint PackedSortKey(uint tile, float norm_depth, uint tile_bit
     return (tile << (kSortKeyBits - tile_bits)) | depth_field;
 }
 
-// The view depth that orders splats (both sorts) and that the composite reads: float32 with
-// a fixed operation order, every product and sum rounded (`precise`: no fused multiply-add,
-// no reordering), from row 2 of the float32 world-to-camera matrix and the float32
-// position. The CPU reference sorts by the same function, so near-tied splats come out in
-// the same order on every device (a double depth rounded once differs by an ulp and flips
-// pairs; docs/vulkan.md "Sort depth").
-OPEN3D_SHADER_FUNC float SortDepth(float r0, float r1, float r2, float t, float x, float y,
-                                   float z) {
-    OPEN3D_SHADER_PRECISE float xy = r0 * x + r1 * y;
-    OPEN3D_SHADER_PRECISE float d = (xy + r2 * z) + t;
+// One coordinate of the camera-relative position (p - c_hi) - c_lo (GaussianViewParams):
+// p - c_hi is exact when p is within a factor 2 of c_hi (Sterbenz), i.e. for everything
+// near a camera far from the origin, and c_lo restores the centre's float32 rounding.
+OPEN3D_SHADER_FUNC float CameraRelative(float p, float c_hi, float c_lo) {
+    OPEN3D_SHADER_PRECISE float d = (p - c_hi) - c_lo;
+    return d;
+}
+
+// The view depth that orders splats (both sorts), culls at the near plane and that the
+// composite reads: float32 with a fixed operation order, every product and sum rounded
+// (`precise`: no fused multiply-add, no reordering), from row 2 of the float32
+// world-to-camera rotation and the camera-relative position (CameraRelative). The CPU
+// reference sorts and near-culls by the same function, so near-tied splats come out in
+// the same order and a splat at the near plane is culled on every device alike (a double
+// depth rounded once differs by an ulp; docs/vulkan.md "Sort depth").
+OPEN3D_SHADER_FUNC float SortDepth(float r0, float r1, float r2, float dx, float dy, float dz) {
+    OPEN3D_SHADER_PRECISE float xy = r0 * dx + r1 * dy;
+    OPEN3D_SHADER_PRECISE float d = xy + r2 * dz;
     return d;
 }
 #undef OPEN3D_SHADER_FUNC

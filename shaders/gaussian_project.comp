@@ -77,9 +77,10 @@ float ShValue(uint i, uint j, uint c) {
     return uintBitsToFloat(sh[base + k]);
 }
 
-// R diag(s^2) R^T for a (w, x, y, z) quaternion normalised at packing; the formula is the
-// one Eigen's toRotationMatrix uses, so a zero quaternion gives the identity as on the CPU.
-mat3 Covariance3D(vec3 s, vec4 q) {
+// M = R diag(s) (the 3D covariance is M M^T) for a (w, x, y, z) quaternion normalised at
+// packing; the formula is the one Eigen's toRotationMatrix uses, so a zero quaternion gives
+// the identity as on the CPU.
+mat3 CovarianceFactor(vec3 s, vec4 q) {
     float tx = 2.0 * q.y, ty = 2.0 * q.z, tz = 2.0 * q.w;
     float twx = tx * q.x, twy = ty * q.x, twz = tz * q.x;
     float txx = tx * q.y, txy = ty * q.y, txz = tz * q.y;
@@ -88,15 +89,15 @@ mat3 Covariance3D(vec3 s, vec4 q) {
     mat3 r = mat3(1.0 - (tyy + tzz), txy + twz, txz - twy,  // column 0
                   txy - twz, 1.0 - (txx + tzz), tyz + twx,  // column 1
                   txz + twy, tyz - twx, 1.0 - (txx + tyy));  // column 2
-    mat3 m = r * mat3(s.x, 0.0, 0.0, 0.0, s.y, 0.0, 0.0, 0.0, s.z);
-    return m * transpose(m);
+    return r * mat3(s.x, 0.0, 0.0, 0.0, s.y, 0.0, 0.0, 0.0, s.z);
 }
 
-vec3 ShColor(uint i, vec3 position) {
+// `relative`: the camera-relative position (never 0: the splat passed the near plane).
+vec3 ShColor(uint i, vec3 relative) {
     vec3 dc = vec3(ShapeValue(i, 7u), ShapeValue(i, 8u), ShapeValue(i, 9u));
     vec3 rgb = kSH_C0 * dc;
     if (kShDegree >= 1u) {
-        vec3 d = normalize(position - view.camera_center.xyz);
+        vec3 d = normalize(relative);
         float x = d.x, y = d.y, z = d.z;
         float basis[16];
         basis[1] = -kSH_C1 * y;
@@ -142,10 +143,19 @@ bool Project(uint i, out float depth) {
     if ((visibility[i >> 5u] & (1u << (i & 31u))) == 0u) return false;
     vec4 position_opacity = positions[i];
     vec3 p = position_opacity.xyz;
-    vec3 v = vec3(dot(view.world_to_camera_row0.xyz, p) + view.world_to_camera_row0.w,
-                  dot(view.world_to_camera_row1.xyz, p) + view.world_to_camera_row1.w,
-                  dot(view.world_to_camera_row2.xyz, p) + view.world_to_camera_row2.w);
-    if (!(v.z > view.clip.z)) return false;  // near plane (also NaN)
+    // Camera-relative (p - c_hi) - c_lo: precise 1e5 from the origin too (contract header).
+    vec3 c_hi = view.camera_center.xyz;
+    vec3 c_lo = vec3(view.world_to_camera_row0.w, view.world_to_camera_row1.w,
+                     view.world_to_camera_row2.w);
+    vec3 rel = vec3(CameraRelative(p.x, c_hi.x, c_lo.x), CameraRelative(p.y, c_hi.y, c_lo.y),
+                    CameraRelative(p.z, c_hi.z, c_lo.z));
+    vec3 r2 = view.world_to_camera_row2.xyz;
+    // The sort depth is the view z: the near cull, the sorts and the composite all read the
+    // value the CPU reference computes bit for bit (SortDepth).
+    float sort_depth = SortDepth(r2.x, r2.y, r2.z, rel.x, rel.y, rel.z);
+    if (!(sort_depth > view.clip.z)) return false;  // near plane (also NaN)
+    vec3 v = vec3(dot(view.world_to_camera_row0.xyz, rel), dot(view.world_to_camera_row1.xyz, rel),
+                  sort_depth);
     float fx = view.intrinsics.x, fy = view.intrinsics.y;
     float px = fx * v.x / v.z + view.intrinsics.z;
     float py = fy * v.y / v.z + view.intrinsics.w;
@@ -161,23 +171,30 @@ bool Project(uint i, out float depth) {
     vec3 t1 = (fy / v.z) * w1 + (-fy * ty / z2) * w2;
     vec3 scale = vec3(ShapeValue(i, 0u), ShapeValue(i, 1u), ShapeValue(i, 2u));
     vec4 rot = vec4(ShapeValue(i, 3u), ShapeValue(i, 4u), ShapeValue(i, 5u), ShapeValue(i, 6u));
-    mat3 sigma = Covariance3D(scale, rot);
-    vec3 s_t0 = sigma * t0, s_t1 = sigma * t1;
-    float cov_a = dot(t0, s_t0), cov_b = dot(t0, s_t1), cov_c = dot(t1, s_t1);
+    // cov2D = T M (T M)^T: rows u0 = M^T t0, u1 = M^T t1, and det(cov2D) = |u0 x u1|^2
+    // (Lagrange's identity), which cannot cancel the way a c - b^2 does in float32 (a flat
+    // splat seen edge-on is rank one: a c and b^2 agree to rounding, their difference is noise).
+    mat3 m = CovarianceFactor(scale, rot);
+    vec3 u0 = t0 * m, u1 = t1 * m;
+    float cov_a = dot(u0, u0), cov_b = dot(u0, u1), cov_c = dot(u1, u1);
+    vec3 u_cross = cross(u0, u1);
+    float det_raw = dot(u_cross, u_cross);
 
-    // Low-pass dilation, conic, antialias factor, 3-sigma radius (ComputeScreenEllipse).
-    float det_raw = cov_a * cov_c - cov_b * cov_b;
+    // Low-pass dilation, conic, antialias factor, 3-sigma radius (ComputeScreenEllipse with
+    // det_raw): det(cov + 0.3 I) expanded, >= 0.09 unless not finite.
+    float det = det_raw + 0.3 * (cov_a + cov_c) + 0.09;
+    if (!(det > 0.0)) return false;
+    float half_diff = 0.5 * (cov_a - cov_c);
     cov_a += 0.3;
     cov_c += 0.3;
-    float det = cov_a * cov_c - cov_b * cov_b;
-    if (det == 0.0) return false;
     float opacity_scale = 1.0;
     if (kAntialias != 0u) opacity_scale = sqrt(max(0.000025, det_raw / det));
     vec3 conic = vec3(cov_c / det, -cov_b / det, cov_a / det);
     float mid = 0.5 * (cov_a + cov_c);
-    float lambda1 = mid + sqrt(max(0.1, mid * mid - det));
-    float lambda2 = mid - sqrt(max(0.1, mid * mid - det));
-    uint radius = uint(ceil(3.0 * sqrt(max(lambda1, lambda2))));
+    // mid^2 - det written as ((a - c) / 2)^2 + b^2: the same value without the cancellation.
+    float lambda1 = mid + sqrt(max(0.1, half_diff * half_diff + cov_b * cov_b));
+    // Clamped before the conversion, which is undefined past 2^32 (kMaxSplatRadius).
+    uint radius = uint(min(ceil(3.0 * sqrt(lambda1)), float(kMaxSplatRadius)));
 
     uint tiles_x = view.image.z, tiles_y = view.image.w;
     float r = float(radius);
@@ -187,10 +204,8 @@ bool Project(uint i, out float depth) {
     uint num_tiles = (rect_max.x - rect_min.x) * (rect_max.y - rect_min.y);
     if (num_tiles == 0u) return false;
 
-    vec3 color = ShColor(i, p);
+    vec3 color = ShColor(i, rel);
     GaussianProjectedSplat out_splat;
-    vec4 r2 = view.world_to_camera_row2;
-    float sort_depth = SortDepth(r2.x, r2.y, r2.z, r2.w, p.x, p.y, p.z);
     out_splat.center_depth_opacity =
         vec4(px, py, sort_depth, position_opacity.w * opacity_scale);
     out_splat.conic = vec4(conic, 0.0);

@@ -180,6 +180,19 @@ double PackedSortKeyFar(const camera::PinholeCamera& camera, double near_plane,
     return std::isfinite(far) && far > near_plane ? far : near_plane + 1.0;
 }
 
+CameraCenterSplit SplitCameraCenter(const camera::PinholeCamera& camera) {
+    const Eigen::Vector3d c = camera.GetCenter();
+    CameraCenterSplit split;
+    for (int i = 0; i < 3; ++i) {
+        // volatile: GCC 12.2 -O2 folds c - double(float(c)) to 0 in this loop for i = 1, 2
+        // (reproduced in isolation), losing the low part.
+        volatile float high = static_cast<float>(c[i]);
+        split.high[i] = high;
+        split.low[i] = static_cast<float>(c[i] - double(high));
+    }
+    return split;
+}
+
 bool UsesPackedSortKey(const shader::GaussianViewParams& params) { return params.clip.w > 0.0f; }
 
 shader::GaussianViewParams PackGaussianViewParams(const camera::PinholeCamera& camera,
@@ -187,10 +200,10 @@ shader::GaussianViewParams PackGaussianViewParams(const camera::PinholeCamera& c
                                                   const ViewPackingInputs& inputs) {
     camera.Validate();
     const Eigen::Matrix3d r = camera.GetRotation();
-    const Eigen::Vector3d t = camera.GetTranslation();
-    const Eigen::Vector3d center = camera.GetCenter();
+    // The camera centre as float32 c_hi plus its rounding error c_lo (shader::CameraRelative).
+    const CameraCenterSplit center = SplitCameraCenter(camera);
     auto row = [&](int i) {
-        return shader::vec4{float(r(i, 0)), float(r(i, 1)), float(r(i, 2)), float(t(i))};
+        return shader::vec4{float(r(i, 0)), float(r(i, 1)), float(r(i, 2)), center.low[i]};
     };
     const cpu::TileGrid grid = cpu::TileGrid::ForImage(camera.width, camera.height);
     if (grid.tiles_x > 0xFFFF || grid.tiles_y > 0xFFFF) {
@@ -209,7 +222,7 @@ shader::GaussianViewParams PackGaussianViewParams(const camera::PinholeCamera& c
     p.world_to_camera_row0 = row(0);
     p.world_to_camera_row1 = row(1);
     p.world_to_camera_row2 = row(2);
-    p.camera_center = {float(center.x()), float(center.y()), float(center.z()), 0.0f};
+    p.camera_center = {center.high[0], center.high[1], center.high[2], 0.0f};
     p.intrinsics = {float(camera.fx), float(camera.fy), float(camera.cx), float(camera.cy)};
     // clip.w > 0 selects the packed key: its depth scale, kept finite for a tiny range.
     float depth_scale = 0.0f;

@@ -99,6 +99,15 @@ uint32_t SortKeyTileBits(uint64_t num_tiles);
 double PackedSortKeyFar(const camera::PinholeCamera& camera, double near_plane,
                         const Eigen::Vector3d& center_min, const Eigen::Vector3d& center_max);
 
+/// The camera centre c as float32 `high` = float(c) plus `low` = float(c - high): the
+/// projection works on (p - high) - low (shader::CameraRelative), so a scene far from the
+/// origin keeps its precision. The CPU reference's sort depth uses the same split.
+struct CameraCenterSplit {
+    float high[3] = {0.f, 0.f, 0.f};
+    float low[3] = {0.f, 0.f, 0.f};
+};
+CameraCenterSplit SplitCameraCenter(const camera::PinholeCamera& camera);
+
 /// True when `params` select the packed 32-bit key (clip.w > 0), false for exact order.
 bool UsesPackedSortKey(const shader::GaussianViewParams& params);
 

@@ -7,6 +7,7 @@
 #include "open3d/core/Exception.h"
 #include "open3d/core/ParallelFor.h"
 #include "open3d/t/geometry/SphericalHarmonics.h"
+#include "open3d/visualization/rendering/gaussian_splat/GaussianSplatDataPacking.h"
 #include "shaders/GaussianSplatContract.h"
 
 namespace open3d {
@@ -14,27 +15,62 @@ namespace visualization {
 namespace rendering {
 namespace cpu {
 
-ScreenEllipse ComputeScreenEllipse(double cov_a, double cov_b, double cov_c, bool antialias) {
-    // The low-pass filter: every splat covers at least about one pixel.
-    constexpr double kDilation = 0.3;
-    ScreenEllipse e;
-    const double det_raw = cov_a * cov_c - cov_b * cov_b;
-    e.cov_a = cov_a + kDilation;
-    e.cov_b = cov_b;
-    e.cov_c = cov_c + kDilation;
-    const double det = e.cov_a * e.cov_c - e.cov_b * e.cov_b;
-    if (det == 0.0) {
-        e.degenerate = true;
-        return e;
-    }
+namespace {
+
+// The low-pass filter: every splat covers at least about one pixel.
+constexpr double kDilation = 0.3;
+
+// Conic, antialias factor and radius of e (dilated covariance set) from the undilated
+// det_raw and the dilated det (> 0).
+void FinishEllipse(double det_raw, double det, bool antialias, ScreenEllipse& e) {
     if (antialias) e.opacity_scale = std::sqrt(std::max(0.000025, det_raw / det));
     e.conic_a = e.cov_c / det;
     e.conic_b = -e.cov_b / det;
     e.conic_c = e.cov_a / det;
+    // lambda_max = mid + sqrt(max(0.1, mid^2 - det)), with mid^2 - det written as
+    // ((a - c) / 2)^2 + b^2 (the same value, without the cancellation).
     const double mid = 0.5 * (e.cov_a + e.cov_c);
-    const double lambda1 = mid + std::sqrt(std::max(0.1, mid * mid - det));
-    const double lambda2 = mid - std::sqrt(std::max(0.1, mid * mid - det));
-    e.radius = static_cast<int>(std::ceil(3.0 * std::sqrt(std::max(lambda1, lambda2))));
+    const double half_diff = 0.5 * (e.cov_a - e.cov_c);
+    const double lambda1 =
+        mid + std::sqrt(std::max(0.1, half_diff * half_diff + e.cov_b * e.cov_b));
+    // Clamped before the conversion (shader::kMaxSplatRadius): a radius this large covers the
+    // whole grid anyway.
+    e.radius = static_cast<int>(
+        std::min(std::ceil(3.0 * std::sqrt(lambda1)), double(shader::kMaxSplatRadius)));
+}
+
+}  // namespace
+
+ScreenEllipse ComputeScreenEllipse(double cov_a, double cov_b, double cov_c, bool antialias) {
+    ScreenEllipse e;
+    e.cov_a = cov_a + kDilation;
+    e.cov_b = cov_b;
+    e.cov_c = cov_c + kDilation;
+    const double det = e.cov_a * e.cov_c - e.cov_b * e.cov_b;
+    if (det == 0.0 || !std::isfinite(det)) {
+        e.degenerate = true;
+        return e;
+    }
+    FinishEllipse(cov_a * cov_c - cov_b * cov_b, det, antialias, e);
+    return e;
+}
+
+ScreenEllipse ComputeScreenEllipse(double cov_a, double cov_b, double cov_c, double det_raw,
+                                   bool antialias) {
+    ScreenEllipse e;
+    e.cov_a = cov_a + kDilation;
+    e.cov_b = cov_b;
+    e.cov_c = cov_c + kDilation;
+    // det(cov + 0.3 I) expanded: no cancellation between a c and b^2 (a rank-one footprint,
+    // e.g. a flat splat seen edge-on, made them cancel to noise in float32); >= 0.09 for any
+    // positive semi-definite covariance, so only a non-finite one is culled here (3DGS culls
+    // det == 0, which exact arithmetic never reaches).
+    const double det = det_raw + kDilation * (cov_a + cov_c) + kDilation * kDilation;
+    if (!(det > 0.0)) {
+        e.degenerate = true;
+        return e;
+    }
+    FinishEllipse(det_raw, det, antialias, e);
     return e;
 }
 
@@ -57,21 +93,23 @@ namespace {
 struct ViewParams {
     Eigen::Matrix3d rotation;  // world to camera
     Eigen::Vector3d translation;
-    Eigen::Vector3d center;  // camera centre, world space
+    Eigen::Vector3d center;          // camera centre, world space
+    CameraCenterSplit center_split;  // the same as float32 high + low (the sort depth's)
     double fx, fy, cx, cy;
     double lim_x, lim_y;  // 1.3 tan(fov / 2): the Jacobian guard band
     TileGrid grid;
 };
 
-// R diag(s^2) R^T for a (w, x, y, z) quaternion, normalised here because 3DGS normalises
-// rotations before the rasterizer sees them.
-Eigen::Matrix3d Covariance3D(const float* scale, const float* rot) {
+// M = R diag(s), so the 3D covariance is M M^T, for a (w, x, y, z) quaternion normalised
+// here because 3DGS normalises rotations before the rasterizer sees them. Any norm > 0
+// works (a float32 subnormal squares to ~1e-90, fine in double); the zero quaternion stays
+// zero and Eigen's formula makes it the identity, as the shader's does.
+Eigen::Matrix3d CovarianceFactor(const float* scale, const float* rot) {
     Eigen::Quaterniond q(rot[0], rot[1], rot[2], rot[3]);
     const double norm = q.norm();
     if (norm > 0.0) q.coeffs() /= norm;
-    const Eigen::Matrix3d r = q.toRotationMatrix();
     const Eigen::Vector3d s(scale[0], scale[1], scale[2]);
-    return r * s.cwiseProduct(s).asDiagonal() * r.transpose();
+    return q.toRotationMatrix() * s.asDiagonal();
 }
 
 ProjectedSplat ProjectOne(const ViewParams& view, const RenderConfig& config, int sh_degree,
@@ -83,10 +121,17 @@ ProjectedSplat ProjectOne(const ViewParams& view, const RenderConfig& config, in
     const Eigen::Vector3d v = view.rotation * p + view.translation;
     out.depth = v.z();
     const Eigen::Matrix3d& r = view.rotation;
+    float rel[3];
+    for (int i = 0; i < 3; ++i) {
+        rel[i] = shader::CameraRelative(position[i], view.center_split.high[i],
+                                        view.center_split.low[i]);
+    }
     out.sort_depth =
-        shader::SortDepth(float(r(2, 0)), float(r(2, 1)), float(r(2, 2)),
-                          float(view.translation.z()), position[0], position[1], position[2]);
-    if (!(v.z() > config.near_plane)) {
+        shader::SortDepth(float(r(2, 0)), float(r(2, 1)), float(r(2, 2)), rel[0], rel[1], rel[2]);
+    // The near cull compares the GPU's float32 depth with the float32 near plane (3DGS:
+    // p_view.z <= 0.2f in float), so a splat within rounding of the plane is culled or kept
+    // on every backend alike; the double z would keep a splat at 0.2f (> 0.2).
+    if (!(out.sort_depth > static_cast<float>(config.near_plane))) {
         out.cull = CullReason::kNearPlane;
         return out;
     }
@@ -100,10 +145,12 @@ ProjectedSplat ProjectOne(const ViewParams& view, const RenderConfig& config, in
     Eigen::Matrix<double, 2, 3> j;
     j << view.fx / v.z(), 0.0, -view.fx * tx / (v.z() * v.z()), 0.0, view.fy / v.z(),
         -view.fy * ty / (v.z() * v.z());
-    const Eigen::Matrix<double, 2, 3> t = j * view.rotation;
-    const Eigen::Matrix2d cov = t * Covariance3D(scale, rot) * t.transpose();
-
-    const ScreenEllipse e = ComputeScreenEllipse(cov(0, 0), cov(0, 1), cov(1, 1), config.antialias);
+    // cov2D = T Sigma T^T = U U^T with U = T M (rows u0, u1): det(cov2D) = |u0 x u1|^2
+    // (Lagrange's identity) cannot cancel the way a c - b^2 does.
+    const Eigen::Matrix<double, 2, 3> u = j * view.rotation * CovarianceFactor(scale, rot);
+    const Eigen::Vector3d u0 = u.row(0).transpose(), u1 = u.row(1).transpose();
+    const ScreenEllipse e = ComputeScreenEllipse(u0.squaredNorm(), u0.dot(u1), u1.squaredNorm(),
+                                                 u0.cross(u1).squaredNorm(), config.antialias);
     out.cov_a = e.cov_a;
     out.cov_b = e.cov_b;
     out.cov_c = e.cov_c;
@@ -141,6 +188,7 @@ std::vector<ProjectedSplat> ProjectSplats(const t::geometry::PointCloud& cloud,
     view.rotation = camera.GetRotation();
     view.translation = camera.GetTranslation();
     view.center = camera.GetCenter();
+    view.center_split = SplitCameraCenter(camera);
     view.fx = camera.fx;
     view.fy = camera.fy;
     view.cx = camera.cx;

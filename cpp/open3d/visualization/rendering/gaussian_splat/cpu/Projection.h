@@ -19,7 +19,7 @@ namespace cpu {
 enum class CullReason : uint8_t {
     kVisible = 0,
     kNearPlane,   ///< view-space z <= RenderConfig::near_plane
-    kDegenerate,  ///< det(cov2D + 0.3 I) == 0
+    kDegenerate,  ///< det(cov2D + 0.3 I) <= 0 or not finite (never for finite inputs)
     kNoTiles,     ///< the tile rectangle of the 3-sigma square is empty
 };
 
@@ -68,7 +68,14 @@ struct ScreenEllipse {
 };
 
 /// Adds 0.3 to the diagonal, inverts, and takes the 3-sigma radius from the larger
-/// eigenvalue mid + sqrt(max(0.1, mid^2 - det)); antialias gives the opacity factor.
+/// eigenvalue mid + sqrt(max(0.1, mid^2 - det)) (clamped to shader::kMaxSplatRadius);
+/// antialias gives the opacity factor. `det_raw` is det of the undilated covariance, given
+/// by a caller that can compute it without cancellation; the dilated det is
+/// det_raw + 0.3 (a + c) + 0.09, and a non-positive or non-finite one culls.
+ScreenEllipse ComputeScreenEllipse(double cov_a, double cov_b, double cov_c, double det_raw,
+                                   bool antialias);
+/// The 3DGS form for callers that only have the covariance (tests): the dilated det is
+/// (a + 0.3)(c + 0.3) - b^2, and 0 (or a non-finite value) culls.
 ScreenEllipse ComputeScreenEllipse(double cov_a, double cov_b, double cov_c, bool antialias);
 
 /// 3DGS getRect: rect_min = clamp((int)((p - r) / 16)), rect_max = clamp((int)((p + r + 15) / 16))
