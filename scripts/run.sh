@@ -1,9 +1,9 @@
 #!/usr/bin/env bash
-# README command 1: builds what is needed and renders the built-in default scene
-# (SH degree 3, anisotropic, semi-transparent splats) with a red sphere through Filament
-# (meshes and splats composited with the depth test) to a PNG with gs-render.
+# README command 1: builds what is needed, then shows the built-in default scene (SH degree
+# 3, anisotropic, semi-transparent splats) with a red sphere composited depth-aware through
+# Filament: in the interactive viewer when a display is available, otherwise rendered to a
+# PNG with gs-render under xvfb-run (and it says so).
 # Any arguments are passed to gs-render instead (try: scripts/run.sh --help).
-# Filament needs an X server: without a display the command runs under xvfb-run.
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 build_dir="${BUILD_DIR:-$root/build}"
@@ -15,6 +15,12 @@ if ! bash "$root/scripts/build.sh" >"$build_dir/build.log" 2>&1; then
   exit 1
 fi
 if [ $# -eq 0 ]; then
+  if [ -n "${DISPLAY:-}" ]; then
+    # A display: the interactive viewer on the default scene with a red sphere.
+    exec "$build_dir/bin/GaussianSplat"
+  fi
+  echo "run.sh: no display (DISPLAY is unset), so the default scene is rendered to a PNG" \
+       "instead of opening the viewer (build/bin/GaussianSplat)."
   set -- --sphere --output "$build_dir/default_scene.png" --depth-output "$build_dir/default_scene_depth.png"
 fi
 if [ -z "${DISPLAY:-}" ] && command -v xvfb-run >/dev/null; then

@@ -1,0 +1,408 @@
+#include "open3d/visualization/visualizer/Visualizer.h"
+
+#include <GLFW/glfw3.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstring>
+#include <filesystem>
+
+#include "open3d/core/Exception.h"
+#include "open3d/core/Logging.h"
+#include "open3d/t/io/ImageIO.h"
+#include "open3d/visualization/rendering/filament/FilamentEngine.h"
+#include "open3d/visualization/rendering/filament/FilamentRenderer.h"
+#include "open3d/visualization/visualizer/filament/ImGuiOverlay.h"
+#include "open3d/visualization/visualizer/filament/VisualizerWindow.h"
+
+namespace open3d {
+namespace visualization {
+
+namespace {
+
+double NowSeconds() {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch())
+        .count();
+}
+
+// UInt8 [H, W, 4] -> [H, W, 3].
+t::geometry::Image DropAlpha(const t::geometry::Image& rgba) {
+    t::geometry::Image rgb(rgba.GetRows(), rgba.GetCols(), 3, core::Dtype::UInt8);
+    const uint8_t* src = rgba.Data<uint8_t>();
+    uint8_t* dst = rgb.Data<uint8_t>();
+    for (int64_t i = 0; i < rgba.NumPixels(); ++i) std::memcpy(dst + 3 * i, src + 4 * i, 3);
+    return rgb;
+}
+
+}  // namespace
+
+Visualizer::Visualizer(const VisualizerOptions& options) {
+    owned_engine_ = std::make_unique<rendering::FilamentEngine>();
+    owned_renderer_ = std::make_unique<rendering::FilamentRenderer>(*owned_engine_);
+    renderer_ = owned_renderer_.get();
+    Init(options);
+}
+
+Visualizer::Visualizer(rendering::FilamentRenderer& renderer, const VisualizerOptions& options)
+    : renderer_(&renderer) {
+    Init(options);
+}
+
+void Visualizer::Init(const VisualizerOptions& options) {
+    view_control_.SetUp(options.up);
+    view_control_.SetVerticalFov(options.vertical_fov_deg);
+    view_control_.SetHomePitch(options.home_pitch_deg);
+    view_control_.SetViewSize(options.width, options.height);
+    show_settings_ = options.show_settings;
+    screenshot_dir_ = options.screenshot_dir.empty() ? "." : options.screenshot_dir;
+    rendering::FilamentEngine& engine = renderer_->GetEngine();
+    window_ = std::make_unique<VisualizerWindow>(engine, options.title, options.width,
+                                                 options.height, this);
+    scene_ = std::make_unique<rendering::Open3DScene>(*renderer_, options.scene);
+    overlay_ = std::make_unique<ImGuiOverlay>(engine);
+    int w = 0, h = 0;
+    window_->GetFramebufferSize(&w, &h);
+    OnFramebufferSize(w, h);
+}
+
+Visualizer::~Visualizer() {
+    // Filament objects first (the overlay's view, the scene's views and targets), then the
+    // swap chain and the window, then the engine when it is ours.
+    overlay_.reset();
+    scene_.reset();
+    window_.reset();
+    owned_renderer_.reset();
+    owned_engine_.reset();
+}
+
+void Visualizer::AddGeometry(const std::string& name, const t::geometry::PointCloud& cloud) {
+    scene_->AddGeometry(name, cloud);
+    names_.push_back(name);
+    PostRedraw();
+}
+
+void Visualizer::AddGeometry(const std::string& name, const t::geometry::TriangleMesh& mesh,
+                             const rendering::MeshMaterial& material) {
+    scene_->AddGeometry(name, mesh, material);
+    names_.push_back(name);
+    PostRedraw();
+}
+
+void Visualizer::UpdateGeometry(const std::string& name, const t::geometry::PointCloud& cloud) {
+    scene_->UpdateGeometry(name, cloud);
+    PostRedraw();
+}
+
+void Visualizer::UpdateGeometry(const std::string& name, const t::geometry::TriangleMesh& mesh) {
+    scene_->UpdateGeometry(name, mesh);
+    PostRedraw();
+}
+
+bool Visualizer::RemoveGeometry(const std::string& name) {
+    if (!scene_->RemoveGeometry(name)) return false;
+    names_.erase(std::find(names_.begin(), names_.end(), name));
+    PostRedraw();
+    return true;
+}
+
+void Visualizer::ShowGeometry(const std::string& name, bool show) {
+    scene_->ShowGeometry(name, show);
+    PostRedraw();
+}
+
+bool Visualizer::HasGeometry(const std::string& name) const { return scene_->HasGeometry(name); }
+
+bool Visualizer::IsGeometryVisible(const std::string& name) const {
+    return scene_->GetScene().IsGeometryVisible(name);
+}
+
+void Visualizer::ToggleGeometry(size_t index) {
+    if (index >= names_.size()) return;
+    ShowGeometry(names_[index], !IsGeometryVisible(names_[index]));
+}
+
+void Visualizer::ResetCamera() {
+    Eigen::Vector3d lo, hi;
+    if (!scene_->GetScene().GetBounds(lo, hi)) {
+        lo = Eigen::Vector3d::Constant(-1.0);
+        hi = Eigen::Vector3d::Constant(1.0);
+    }
+    view_control_.FitBounds(lo, hi);
+    PostRedraw();
+}
+
+void Visualizer::SetCamera(const camera::LookAtCamera& look_at) {
+    view_control_.SetLookAt(look_at);
+    PostRedraw();
+}
+
+void Visualizer::SetCamera(const camera::PinholeCamera& camera) {
+    camera.Validate();
+    double distance = 1.0;
+    Eigen::Vector3d lo, hi;
+    if (scene_->GetScene().GetBounds(lo, hi)) {
+        const Eigen::Vector3d forward = camera.GetRotation().row(2).transpose();
+        distance = (0.5 * (lo + hi) - camera.GetCenter()).dot(forward);
+        if (!(distance > 1e-6)) distance = std::max(0.5 * (hi - lo).norm(), 1e-3);
+    }
+    view_control_.SetLookAt(camera.ToLookAt(distance));
+    PostRedraw();
+}
+
+void Visualizer::SetBackground(const Eigen::Vector4f& rgba) {
+    scene_->SetBackground(rgba);
+    PostRedraw();
+}
+
+const Eigen::Vector4f& Visualizer::GetBackground() const {
+    return scene_->GetView().GetBackground();
+}
+
+std::string Visualizer::GetBackendName() const { return scene_->GetScene().GetBackend().GetName(); }
+
+bool Visualizer::PollEvents() {
+    VisualizerWindow::PollEvents();
+    return !window_->ShouldClose();
+}
+
+void Visualizer::Close() { window_->SetShouldClose(true); }
+
+bool Visualizer::BuildOverlay() {
+    if (!show_settings_) return true;
+    if (overlay_width_ != fb_width_ || overlay_height_ != fb_height_) {
+        overlay_->SetSize(fb_width_, fb_height_);
+        overlay_width_ = fb_width_;
+        overlay_height_ = fb_height_;
+    }
+    const double dt = last_present_s_ < 0.0 ? 1.0 / 60.0 : NowSeconds() - last_present_s_;
+    overlay_->Build(dt, [this] { BuildPanel(); });
+    if (!overlay_->HasPendingInput()) return true;
+    redraw_frames_ = std::max(redraw_frames_, 1);
+    return false;
+}
+
+rendering::FrameResult Visualizer::DrawToWindow(bool read_screen) {
+    scene_->SetupCamera(view_control_.GetCamera());
+    rendering::FrameRequest request;
+    request.splat_config = scene_->GetSplatConfig();
+    request.read_screen = read_screen;
+    if (show_settings_) request.overlay_views.push_back(overlay_->GetView());
+    return renderer_->Draw(scene_->GetScene(), scene_->GetView(), request, window_->GetSwapChain());
+}
+
+bool Visualizer::RenderFrame() {
+    if (fb_width_ <= 0 || fb_height_ <= 0) {
+        last_present_s_ = -1.0;  // the time minimised is not a frame time
+        return false;
+    }
+    if (redraw_frames_ > 0) --redraw_frames_;
+    // A screenshot waits until ImGui has seen all input (a click takes two frames), so it
+    // shows the state after everything that came before the request.
+    const bool settled = BuildOverlay();
+    const bool screenshot = settled && !pending_screenshot_.empty();
+    last_frame_ = DrawToWindow(screenshot);
+    const double now = NowSeconds();
+    if (last_present_s_ >= 0.0)
+        frame_stats_.Add(1000.0 * (now - last_present_s_), last_frame_.times);
+    last_present_s_ = now;
+    if (screenshot) {
+        const std::string path = std::move(pending_screenshot_);
+        pending_screenshot_.clear();
+        const std::filesystem::path folder = std::filesystem::path(path).parent_path();
+        if (!folder.empty()) std::filesystem::create_directories(folder);
+        // Written under another name, then renamed: a watcher never sees half a file.
+        const std::string partial = path + ".part";
+        t::io::WritePNG(partial, DropAlpha(last_frame_.screen));
+        std::filesystem::rename(partial, path);
+        last_screenshot_ = path;
+        core::LogInfo("Saved screenshot {}", path);
+    }
+    return true;
+}
+
+void Visualizer::Run(const RunOptions& options) {
+    const double start = NowSeconds();
+    int64_t frames = 0;
+    while (PollEvents()) {
+        if (fb_width_ <= 0 || fb_height_ <= 0 || !(options.continuous || redraw_frames_ > 0)) {
+            // Minimised or idle: sleep until input. The gap is not a frame time.
+            last_present_s_ = -1.0;
+            VisualizerWindow::WaitEvents(0.1);
+        } else {
+            if (options.before_frame) options.before_frame();
+            RenderFrame();
+            ++frames;
+            if (options.max_frames > 0 && frames >= options.max_frames) break;
+        }
+        if (options.max_seconds > 0.0 && NowSeconds() - start >= options.max_seconds) break;
+    }
+}
+
+t::geometry::Image Visualizer::CaptureScreenImage() {
+    if (fb_width_ <= 0 || fb_height_ <= 0) {
+        core::ThrowError("CaptureScreenImage: the window is minimised (nothing is drawn)");
+    }
+    BuildOverlay();
+    last_frame_ = DrawToWindow(true);
+    return DropAlpha(last_frame_.screen);
+}
+
+std::string Visualizer::RequestScreenshot() {
+    pending_screenshot_ = (std::filesystem::path(screenshot_dir_) /
+                           fmt::format("screenshot_{:04d}.png", screenshot_index_++))
+                              .string();
+    PostRedraw();
+    return pending_screenshot_;
+}
+
+t::geometry::Image Visualizer::RenderToImage(bool with_alpha) {
+    scene_->SetupCamera(view_control_.GetCamera());
+    t::geometry::Image image = scene_->RenderToImage(with_alpha);
+    last_frame_ = scene_->GetLastFrame();
+    return image;
+}
+
+t::geometry::Image Visualizer::RenderToDepthImage(bool normalized, float near, float far) {
+    scene_->SetupCamera(view_control_.GetCamera());
+    t::geometry::Image image = scene_->RenderToDepthImage(normalized, near, far);
+    last_frame_ = scene_->GetLastFrame();
+    return image;
+}
+
+void Visualizer::SetWindowSize(int width, int height) { window_->SetSize(width, height); }
+void Visualizer::Minimize() { window_->Iconify(); }
+void Visualizer::Maximize() { window_->Maximize(); }
+void Visualizer::Restore() { window_->Restore(); }
+uint64_t Visualizer::GetX11WindowId() const { return window_->GetX11WindowId(); }
+
+bool Visualizer::PanelContains(double x, double y) const {
+    return show_settings_ && x >= panel_rect_[0] && y >= panel_rect_[1] &&
+           x < panel_rect_[0] + panel_rect_[2] && y < panel_rect_[1] + panel_rect_[3];
+}
+
+void Visualizer::OnMouseButton(int button, bool pressed, int mods) {
+    PostRedraw();
+    if (!pressed) {
+        overlay_->OnMouseButton(button, false);
+        drag_ = Drag::kNone;
+        return;
+    }
+    if (drag_ != Drag::kNone) return;  // one drag at a time
+    if (PanelContains(cursor_x_, cursor_y_) || (show_settings_ && overlay_->HasPopup())) {
+        drag_ = Drag::kPanel;
+        overlay_->OnMouseButton(button, true);
+    } else if (button == GLFW_MOUSE_BUTTON_LEFT && !(mods & GLFW_MOD_SHIFT)) {
+        drag_ = Drag::kRotate;
+    } else {
+        drag_ = Drag::kPan;  // right, middle, or shift + left
+    }
+}
+
+void Visualizer::OnCursorPos(double x, double y) {
+    const double dx = x - cursor_x_, dy = y - cursor_y_;
+    cursor_x_ = x;
+    cursor_y_ = y;
+    overlay_->OnCursorPos(x, y);
+    if (drag_ != Drag::kNone || show_settings_) PostRedraw();  // camera or panel hover
+    if (drag_ == Drag::kRotate) view_control_.Rotate(dx, dy);
+    if (drag_ == Drag::kPan) view_control_.Pan(dx, dy);
+}
+
+void Visualizer::OnScroll(double dx, double dy) {
+    PostRedraw();
+    if (PanelContains(cursor_x_, cursor_y_)) {
+        overlay_->OnScroll(dx, dy);
+    } else {
+        view_control_.Zoom(dy);  // wheel up: closer
+    }
+}
+
+void Visualizer::OnKey(int key, bool pressed, bool repeat, int mods) {
+    overlay_->OnKey(key, pressed, mods);
+    PostRedraw();
+    if (!pressed || overlay_->WantsTextInput()) return;
+    if (!repeat && key_callback_ && key_callback_(key, mods)) return;
+    const double step = view_control_.GetHeight() / 36.0;  // 5 degrees of orbit
+    const bool shift = (mods & GLFW_MOD_SHIFT) != 0;
+    switch (key) {
+        case GLFW_KEY_LEFT:
+        case GLFW_KEY_RIGHT: {
+            const double d = key == GLFW_KEY_LEFT ? -step : step;
+            shift ? view_control_.Pan(d, 0.0) : view_control_.Rotate(d, 0.0);
+            return;
+        }
+        case GLFW_KEY_UP:
+        case GLFW_KEY_DOWN: {
+            const double d = key == GLFW_KEY_UP ? -step : step;
+            shift ? view_control_.Pan(0.0, d) : view_control_.Rotate(0.0, d);
+            return;
+        }
+        case GLFW_KEY_EQUAL:
+        case GLFW_KEY_KP_ADD:
+            view_control_.Zoom(1.0);
+            return;
+        case GLFW_KEY_MINUS:
+        case GLFW_KEY_KP_SUBTRACT:
+            view_control_.Zoom(-1.0);
+            return;
+        default:
+            break;
+    }
+    if (repeat) return;  // toggles fire once per press
+    if (key >= GLFW_KEY_1 && key <= GLFW_KEY_9) {
+        ToggleGeometry(static_cast<size_t>(key - GLFW_KEY_1));
+        return;
+    }
+    switch (key) {
+        case GLFW_KEY_ESCAPE:
+        case GLFW_KEY_Q:
+            Close();
+            break;
+        case GLFW_KEY_R:
+            ResetCamera();
+            break;
+        case GLFW_KEY_H:
+            show_settings_ = !show_settings_;
+            break;
+        case GLFW_KEY_P:
+            RequestScreenshot();
+            break;
+        default:
+            break;
+    }
+}
+
+void Visualizer::OnChar(unsigned int codepoint) {
+    overlay_->OnChar(codepoint);
+    PostRedraw();
+}
+
+void Visualizer::OnFramebufferSize(int width, int height) {
+    if (width == fb_width_ && height == fb_height_) return;
+    PostRedraw();
+    fb_width_ = std::max(width, 0);
+    fb_height_ = std::max(height, 0);
+    // The targets of the old size go now, before anything of that size is drawn again;
+    // while minimised (0 x 0) nothing is drawn and the camera keeps its last size.
+    scene_->GetView().ReleaseTargets();
+    if (fb_width_ > 0 && fb_height_ > 0) view_control_.SetViewSize(fb_width_, fb_height_);
+}
+
+void Draw(const std::vector<DrawObject>& objects, const VisualizerOptions& options,
+          const RunOptions& run) {
+    Visualizer vis(options);
+    for (const DrawObject& object : objects) {
+        if (const auto* cloud = std::get_if<t::geometry::PointCloud>(&object.geometry)) {
+            vis.AddGeometry(object.name, *cloud);
+        } else {
+            vis.AddGeometry(object.name, std::get<t::geometry::TriangleMesh>(object.geometry),
+                            object.material);
+        }
+        if (!object.visible) vis.ShowGeometry(object.name, false);
+    }
+    vis.ResetCamera();
+    vis.Run(run);
+}
+
+}  // namespace visualization
+}  // namespace open3d

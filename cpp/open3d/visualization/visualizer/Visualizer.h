@@ -1,0 +1,260 @@
+// The Open3D-style visualizer (docs/viewer.md): a window showing an Open3DScene of named
+// splat clouds and meshes, an orbit camera driven by mouse and keys, a settings panel drawn
+// with ImGui over the picture, screenshots, and offscreen renders of the same scene.
+//
+//   Visualizer vis({.title = "scene", .width = 1280, .height = 720});
+//   vis.AddGeometry("splats", cloud);
+//   vis.ResetCamera();
+//   vis.Run();
+//
+// Everything runs on the calling thread (the one that made the Filament engine).
+#pragma once
+
+#include <Eigen/Core>
+
+#include <algorithm>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include "open3d/camera/PinholeCamera.h"
+#include "open3d/t/geometry/Image.h"
+#include "open3d/t/geometry/PointCloud.h"
+#include "open3d/t/geometry/TriangleMesh.h"
+#include "open3d/visualization/rendering/filament/Open3DScene.h"
+#include "open3d/visualization/visualizer/FrameStatistics.h"
+#include "open3d/visualization/visualizer/ViewControl.h"
+#include "open3d/visualization/visualizer/WindowEventHandler.h"
+
+namespace open3d {
+namespace visualization {
+
+namespace rendering {
+class FilamentEngine;
+class FilamentRenderer;
+}  // namespace rendering
+class ImGuiOverlay;
+class VisualizerWindow;
+
+struct VisualizerOptions {
+    std::string title = "Open3D";
+    /// Window size in pixels.
+    int width = 1280;
+    int height = 720;
+    /// Splat backend and image sharing (Open3DSceneOptions).
+    rendering::Open3DSceneOptions scene;
+    /// World up of the orbit camera: -y for 3DGS / COLMAP scenes.
+    Eigen::Vector3d up = Eigen::Vector3d(0, -1, 0);
+    double vertical_fov_deg = 60.0;
+    /// Pitch of ResetCamera's view in degrees (> 0 looks down on the scene).
+    double home_pitch_deg = 0.0;
+    /// Show the settings panel (key H toggles it).
+    bool show_settings = true;
+    /// Where SaveScreenshot and the P key write screenshot_NNNN.png.
+    std::string screenshot_dir = ".";
+};
+
+struct RunOptions {
+    /// Draw every loop iteration. Otherwise a frame is drawn only after input or a change
+    /// (geometry, camera, settings, screenshot request, resize), and the loop sleeps on
+    /// window events in between, so an idle viewer costs no CPU.
+    bool continuous = false;
+    /// Stop after this many drawn frames (0: until the window closes).
+    int64_t max_frames = 0;
+    /// Stop after this many seconds (0: no limit).
+    double max_seconds = 0.0;
+    /// Called before each frame is drawn (animation, scripted input; with continuous).
+    std::function<void()> before_frame;
+};
+
+class Visualizer : public WindowEventHandler {
+public:
+    /// Opens a window with its own Filament engine. Throws core::Open3DError when no X
+    /// server or GL context is available (the message says to use xvfb-run) or a named
+    /// backend cannot be made.
+    explicit Visualizer(const VisualizerOptions& options = {});
+    /// Opens a window drawn by an existing renderer (tests share one engine); `renderer`
+    /// must outlive the visualizer.
+    Visualizer(rendering::FilamentRenderer& renderer, const VisualizerOptions& options);
+    ~Visualizer() override;
+    Visualizer(const Visualizer&) = delete;
+    Visualizer& operator=(const Visualizer&) = delete;
+
+    // Geometry, by name (names are unique across clouds and meshes; errors throw
+    // core::Open3DError and leave the scene unchanged).
+    void AddGeometry(const std::string& name, const t::geometry::PointCloud& cloud);
+    void AddGeometry(const std::string& name, const t::geometry::TriangleMesh& mesh,
+                     const rendering::MeshMaterial& material = {});
+    void UpdateGeometry(const std::string& name, const t::geometry::PointCloud& cloud);
+    void UpdateGeometry(const std::string& name, const t::geometry::TriangleMesh& mesh);
+    /// False when the name is unknown.
+    bool RemoveGeometry(const std::string& name);
+    void ShowGeometry(const std::string& name, bool show);
+    bool HasGeometry(const std::string& name) const;
+    bool IsGeometryVisible(const std::string& name) const;
+    /// In the order they were added (the panel's order; keys 1-9 toggle the first nine).
+    const std::vector<std::string>& GetGeometryNames() const { return names_; }
+
+    // Camera. The orbit camera (GetViewControl) is the one truth; its image size is the
+    // window's framebuffer size.
+    /// Fits the visible geometry's bounds (a unit cube when nothing is visible) in view,
+    /// from the home direction (ViewControl::FitBounds).
+    void ResetCamera();
+    void SetCamera(const camera::LookAtCamera& look_at);
+    /// Takes the camera's pose and vertical field of view; the image size stays the
+    /// window's, with square pixels and a centred principal point. The orbit centre is the
+    /// point in front of the camera at the depth of the scene's centre.
+    void SetCamera(const camera::PinholeCamera& camera);
+    camera::PinholeCamera GetCamera() const { return view_control_.GetCamera(); }
+    /// The orbit camera (asks for a redraw: the caller may move it).
+    ViewControl& GetViewControl() {
+        PostRedraw();
+        return view_control_;
+    }
+
+    // Appearance.
+    /// Linear RGBA where nothing is drawn.
+    void SetBackground(const Eigen::Vector4f& rgba);
+    const Eigen::Vector4f& GetBackground() const;
+    /// Splat settings (SH degree cap, antialias, ...) used by every frame (asks for a
+    /// redraw: the caller may change them).
+    rendering::RenderConfig& GetSplatConfig() {
+        PostRedraw();
+        return scene_->GetSplatConfig();
+    }
+    void ShowSettings(bool show) {
+        show_settings_ = show;
+        PostRedraw();
+    }
+    bool IsSettingsShown() const { return show_settings_; }
+
+    // The loop.
+    /// Handles pending window events; false once the window was asked to close.
+    bool PollEvents();
+    /// Draws one frame to the window (panel included); false when nothing was drawn
+    /// because the window is minimised (0 x 0 framebuffer).
+    bool RenderFrame();
+    /// Polls and draws until the window closes or a limit in `options` is reached.
+    /// Minimised, it sleeps on events instead of drawing.
+    void Run(const RunOptions& options = {});
+    /// Makes Run draw the next frames even when no input arrives (after changing what
+    /// the visualizer cannot see, e.g. a geometry edited through GetScene()).
+    void PostRedraw() { redraw_frames_ = std::max(redraw_frames_, 2); }
+    /// Asks the loop to end (Esc and Q do the same).
+    void Close();
+
+    // Images.
+    /// Draws a frame and reads the window back: UInt8 [H, W, 3], top row first, exactly
+    /// what the window shows (panel included). Throws while minimised.
+    t::geometry::Image CaptureScreenImage();
+    /// Writes the next drawn frame to screenshot_dir/screenshot_NNNN.png (P key, panel
+    /// button) and returns that path; the file appears complete (written, then renamed).
+    /// The frame waits until the panel has taken all earlier input (a click needs two).
+    std::string RequestScreenshot();
+    /// Folder of later screenshots (made when missing).
+    void SetScreenshotDir(const std::string& dir) { screenshot_dir_ = dir.empty() ? "." : dir; }
+    /// Path of the last screenshot written, empty before the first.
+    const std::string& GetLastScreenshotPath() const { return last_screenshot_; }
+    /// Offscreen render of the same scene and camera: UInt8 [H, W, 3] (or 4 with alpha).
+    t::geometry::Image RenderToImage(bool with_alpha = false);
+    /// Offscreen depth: Float32 view z (0 = nothing) or normalised UInt16.
+    t::geometry::Image RenderToDepthImage(bool normalized = false, float near = 0.2f,
+                                          float far = 100.0f);
+
+    // Window.
+    /// Requests a window size; the new size is used from the next frame on.
+    void SetWindowSize(int width, int height);
+    /// Framebuffer size in pixels (0 x 0 while minimised).
+    int GetWidth() const { return fb_width_; }
+    int GetHeight() const { return fb_height_; }
+    void Minimize();
+    void Maximize();
+    void Restore();
+    /// The X11 window id (for xdotool).
+    uint64_t GetX11WindowId() const;
+
+    // State for the panel, tests and logs.
+    /// The last frame drawn to the window or offscreen (times, splat stats).
+    const rendering::FrameResult& GetLastFrame() const { return last_frame_; }
+    const FrameStatistics& GetFrameStatistics() const { return frame_stats_; }
+    std::string GetBackendName() const;
+    /// The scene behind the window (asks for a redraw).
+    rendering::Open3DScene& GetScene() {
+        PostRedraw();
+        return *scene_;
+    }
+    /// Extra keys: called on every key press before the built-in shortcuts; return true
+    /// to consume the key.
+    void SetKeyCallback(std::function<bool(int key, int mods)> callback) {
+        key_callback_ = std::move(callback);
+    }
+    /// Extra panel widgets, drawn at the end of the settings panel (ImGui calls).
+    void SetPanelCallback(std::function<void()> callback) { panel_callback_ = std::move(callback); }
+
+    // WindowEventHandler: GLFW's callbacks arrive here; tests may inject events.
+    void OnMouseButton(int button, bool pressed, int mods) override;
+    void OnCursorPos(double x, double y) override;
+    void OnScroll(double dx, double dy) override;
+    void OnKey(int key, bool pressed, bool repeat, int mods) override;
+    void OnChar(unsigned int codepoint) override;
+    void OnFramebufferSize(int width, int height) override;
+
+private:
+    enum class Drag { kNone, kRotate, kPan, kPanel };
+
+    void Init(const VisualizerOptions& options);
+    void ToggleGeometry(size_t index);
+    bool PanelContains(double x, double y) const;
+    void BuildPanel();
+    /// Runs the panel's ImGui frame (when shown); false while input is still pending.
+    bool BuildOverlay();
+    rendering::FrameResult DrawToWindow(bool read_screen);
+    void WriteScreenshot(const t::geometry::Image& rgba);
+
+    std::unique_ptr<rendering::FilamentEngine> owned_engine_;
+    std::unique_ptr<rendering::FilamentRenderer> owned_renderer_;
+    rendering::FilamentRenderer* renderer_ = nullptr;
+    std::unique_ptr<VisualizerWindow> window_;
+    std::unique_ptr<rendering::Open3DScene> scene_;
+    std::unique_ptr<ImGuiOverlay> overlay_;
+    ViewControl view_control_;
+    std::vector<std::string> names_;
+
+    int fb_width_ = 0, fb_height_ = 0;
+    int overlay_width_ = 0, overlay_height_ = 0;
+    double cursor_x_ = 0.0, cursor_y_ = 0.0;
+    Drag drag_ = Drag::kNone;
+    bool show_settings_ = true;
+    int redraw_frames_ = 2;               // frames Run still draws without new input
+    float panel_rect_[4] = {0, 0, 0, 0};  // x, y, w, h of the panel in the last frame
+
+    std::string screenshot_dir_;
+    int screenshot_index_ = 0;
+    std::string pending_screenshot_;  // path to write at the next drawn frame
+    std::string last_screenshot_;
+
+    rendering::FrameResult last_frame_;
+    FrameStatistics frame_stats_;
+    double last_present_s_ = -1.0;  // steady clock seconds of the last presented frame
+    std::function<bool(int, int)> key_callback_;
+    std::function<void()> panel_callback_;
+};
+
+/// A geometry for Draw: a splat cloud or a mesh, by name.
+struct DrawObject {
+    std::string name;
+    std::variant<t::geometry::PointCloud, t::geometry::TriangleMesh> geometry;
+    rendering::MeshMaterial material;  ///< meshes only
+    bool visible = true;
+};
+
+/// Open3D's draw(): opens a window with the objects, fits the camera, and runs until the
+/// window closes (or `run` says otherwise).
+void Draw(const std::vector<DrawObject>& objects, const VisualizerOptions& options = {},
+          const RunOptions& run = {});
+
+}  // namespace visualization
+}  // namespace open3d

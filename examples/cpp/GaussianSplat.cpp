@@ -1,0 +1,265 @@
+// GaussianSplat: the interactive viewer (docs/viewer.md). Opens a 3DGS .ply / .splat (or the
+// built-in default scene), adds a red sphere mesh that shows the depth compositing of
+// meshes and splats, and runs the Visualizer: orbit/pan/zoom, the ImGui settings panel,
+// screenshots. Test and benchmark flags: --frames, --exit-after-seconds, --screenshot-dir,
+// --screenshot-on-exit, --spin.
+#include <CLI/CLI.hpp>
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "open3d/camera/CamerasJson.h"
+#include "open3d/core/Exception.h"
+#include "open3d/core/Timer.h"
+#include "open3d/t/io/PointCloudIO.h"
+#include "open3d/visualization/rendering/filament/FilamentEngine.h"
+#include "open3d/visualization/rendering/gaussian_splat/DefaultScene.h"
+#include "open3d/visualization/visualizer/Visualizer.h"
+
+namespace {
+
+using namespace open3d;
+namespace rendering = open3d::visualization::rendering;
+namespace vis = open3d::visualization;
+
+struct Options {
+    std::string input;
+    int width = 1280, height = 720;
+    std::string backend = "auto";
+    std::string sharing = "auto";
+    std::string cameras;
+    int view = 0;
+    std::vector<double> up;
+    bool no_sphere = false;
+    double sphere_radius = 0.0;
+    bool hide_panel = false;
+    int sh_degree = 3;
+    bool antialias = false;
+    std::string screenshot_dir = ".";
+    int64_t frames = 0;
+    double exit_after_seconds = 0.0;
+    bool screenshot_on_exit = false;
+    double spin_degrees = 0.0;
+    bool continuous = false;
+};
+
+// Median of the positions per axis: a centre that ignores stray far-away splats.
+Eigen::Vector3d RobustCenter(const t::geometry::PointCloud& cloud) {
+    const int64_t n = cloud.NumPoints();
+    if (n == 0) return Eigen::Vector3d::Zero();
+    const float* p = cloud.GetPointPositions().Data<float>();  // [N, 3]
+    Eigen::Vector3d c;
+    std::vector<float> axis(n);
+    for (int a = 0; a < 3; ++a) {
+        for (int64_t i = 0; i < n; ++i) axis[i] = p[3 * i + a];
+        std::nth_element(axis.begin(), axis.begin() + n / 2, axis.end());
+        c[a] = axis[n / 2];
+    }
+    return c;
+}
+
+// 80th percentile distance from the centre: the sphere's size follows the scene's.
+double RobustRadius(const t::geometry::PointCloud& cloud, const Eigen::Vector3d& center) {
+    const int64_t n = cloud.NumPoints();
+    if (n == 0) return 1.0;
+    const float* p = cloud.GetPointPositions().Data<float>();  // [N, 3]
+    std::vector<double> d(n);
+    for (int64_t i = 0; i < n; ++i) {
+        d[i] = (Eigen::Vector3d(p[3 * i], p[3 * i + 1], p[3 * i + 2]) - center).norm();
+    }
+    std::nth_element(d.begin(), d.begin() + n * 8 / 10, d.end());
+    return std::max(1e-3, d[n * 8 / 10]);
+}
+
+int Run(const Options& opt) {
+    // Fail before reading a large scene when no window can be opened.
+    const std::string no_display = rendering::FilamentUnavailableReason();
+    if (!no_display.empty()) core::ThrowError("cannot open a window: {}", no_display);
+    const bool default_scene = opt.input.empty();
+    t::geometry::PointCloud cloud;
+    const auto start = std::chrono::steady_clock::now();
+    if (default_scene) {
+        cloud = rendering::CreateDefaultGaussianSplatScene();
+    } else {
+        t::io::ReadPointCloud(opt.input, cloud);
+        if (!cloud.IsGaussianSplat()) {
+            core::ThrowError(
+                "{} has points but no Gaussian splat attributes (f_dc, opacity, "
+                "scale, rot)",
+                opt.input);
+        }
+    }
+    const std::string name =
+        default_scene ? "default_scene" : std::filesystem::path(opt.input).stem().string();
+    std::printf("GaussianSplat: scene %s, %lld splats, SH degree %d, loaded in %.1f ms\n",
+                default_scene ? "built-in default" : opt.input.c_str(),
+                static_cast<long long>(cloud.NumPoints()), cloud.GaussianSplatGetSHOrder(),
+                core::MillisecondsSince(start));
+
+    vis::VisualizerOptions vo;
+    vo.title = "GaussianSplat - " + name;
+    vo.width = opt.width;
+    vo.height = opt.height;
+    vo.scene.backend = opt.backend;
+    vo.scene.sharing = rendering::ParseSplatSharing(opt.sharing);
+    vo.up = opt.up.size() == 3 ? Eigen::Vector3d(opt.up[0], opt.up[1], opt.up[2])
+            : default_scene    ? Eigen::Vector3d(0, 1, 0)
+                               : Eigen::Vector3d(0, -1, 0);
+    vo.home_pitch_deg = 20.0;  // look down on the scene a little: ground planes show
+    vo.show_settings = !opt.hide_panel;
+    vo.screenshot_dir = opt.screenshot_dir;
+    vis::Visualizer viewer(vo);
+    viewer.AddGeometry(name, cloud);
+    if (!opt.no_sphere) {
+        Eigen::Vector3d center;
+        double radius = 0.0;
+        if (default_scene) {
+            center = rendering::GetDefaultSceneMeshSphere().center;
+            radius = rendering::GetDefaultSceneMeshSphere().radius;
+        } else {
+            center = RobustCenter(cloud);
+            radius = 0.3 * RobustRadius(cloud, center);
+        }
+        if (opt.sphere_radius > 0.0) radius = opt.sphere_radius;
+        t::geometry::TriangleMesh sphere = t::geometry::TriangleMesh::CreateSphere(radius, 40);
+        sphere.Translate(center);
+        rendering::MeshMaterial red;
+        red.base_color = Eigen::Vector4f(1.0f, 0.0f, 0.0f, 1.0f);
+        red.shading = 0.35f;
+        viewer.AddGeometry("sphere", sphere, red);
+    }
+    viewer.GetSplatConfig().sh_degree = opt.sh_degree;
+    viewer.GetSplatConfig().antialias = opt.antialias;
+    viewer.SetBackground(Eigen::Vector4f(0.1f, 0.1f, 0.12f, 1.0f));
+    if (!opt.cameras.empty()) {
+        const std::vector<camera::CameraView> views = camera::ReadCamerasJson(opt.cameras);
+        if (opt.view < 0 || opt.view >= static_cast<int>(views.size())) {
+            core::ThrowError("--view {}: {} has {} views (0..{})", opt.view, opt.cameras,
+                             views.size(), static_cast<int>(views.size()) - 1);
+        }
+        viewer.SetCamera(views[opt.view].camera);
+    } else if (default_scene) {
+        viewer.SetCamera(rendering::GetDefaultSceneLookAt());
+    } else {
+        viewer.ResetCamera();
+    }
+    std::printf(
+        "GaussianSplat: window 0x%llx, %dx%d, backend %s; press H for the panel, Q to quit\n",
+        static_cast<unsigned long long>(viewer.GetX11WindowId()), viewer.GetWidth(),
+        viewer.GetHeight(), viewer.GetBackendName().c_str());
+    std::fflush(stdout);
+
+    vis::RunOptions run;
+    run.continuous = opt.continuous || opt.frames > 0 || opt.spin_degrees != 0.0;
+    run.max_frames = opt.frames;
+    run.max_seconds = opt.exit_after_seconds;
+    if (opt.spin_degrees != 0.0) {
+        run.before_frame = [&viewer, &opt] {
+            viewer.GetViewControl().Orbit(opt.spin_degrees, 0.0);
+        };
+    }
+    viewer.Run(run);
+    if (opt.screenshot_on_exit && viewer.GetWidth() > 0) {
+        viewer.RequestScreenshot();
+        viewer.RenderFrame();
+    }
+    std::printf("GaussianSplat: %dx%d, %s\n", viewer.GetWidth(), viewer.GetHeight(),
+                vis::FormatSummary(viewer.GetFrameStatistics().Summarize()).c_str());
+    const rendering::RenderStats& s = viewer.GetLastFrame().splat_stats;
+    std::printf(
+        "GaussianSplat: last frame: %lld of %lld splats visible, %lld tile entries, GPU project "
+        "%.2f ms, sort %.2f ms, composite %.2f ms%s\n",
+        static_cast<long long>(s.num_visible), static_cast<long long>(s.num_splats),
+        static_cast<long long>(s.num_tile_entries), s.gpu_project_ms, s.gpu_sort_ms,
+        s.gpu_composite_ms, s.geometry_reused ? " (stage A reused: the camera did not move)" : "");
+    return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    Options opt;
+    CLI::App app{
+        "GaussianSplat: interactive viewer for 3D Gaussian Splatting scenes, drawn with\n"
+        "Vulkan compute (splats) and Filament (meshes, the panel). Opens SCENE (3DGS .ply or\n"
+        ".splat) or, without one, the built-in default scene, and adds a red sphere mesh to\n"
+        "show depth compositing. Needs an X server (run under `xvfb-run -a` without a display).\n"
+        "\n"
+        "Mouse: left drag orbits, right/middle/shift+left drag pans, wheel zooms.\n"
+        "Keys: arrows orbit (shift: pan), +/- zoom, R resets the camera (fits the visible\n"
+        "geometry), 1-9 toggle the objects in panel order (1 = the scene, 2 = the sphere),\n"
+        "H hides/shows the panel, P saves a screenshot into --screenshot-dir, Q/Esc quit.\n"
+        "A frame is drawn after input or a change only (an idle viewer sleeps), unless\n"
+        "--continuous, --frames or --spin is given. At exit it prints the frame time summary\n"
+        "(back-to-back frames only, without the first 3) and the last frame's GPU times.",
+        "GaussianSplat"};
+    app.add_option("scene", opt.input, "3DGS .ply or .splat file (default: built-in scene)")
+        ->check(CLI::ExistingFile);
+    app.add_option("--width", opt.width, "Window width in pixels")
+        ->check(CLI::Range(1, 16384))
+        ->capture_default_str();
+    app.add_option("--height", opt.height, "Window height in pixels")
+        ->check(CLI::Range(1, 16384))
+        ->capture_default_str();
+    app.add_option("--backend", opt.backend,
+                   "Splat backend: auto (vulkan where a device exists, else placeholder, which "
+                   "draws no splats and says so), vulkan, cpu, placeholder")
+        ->check(CLI::IsMember({"auto", "vulkan", "cpu", "placeholder"}))
+        ->capture_default_str();
+    app.add_option("--sharing", opt.sharing,
+                   "How splat images reach Filament: auto, zero-copy, host-copy")
+        ->check(CLI::IsMember({"auto", "zero-copy", "host-copy"}))
+        ->capture_default_str();
+    app.add_option("--cameras", opt.cameras, "Start from a view of this 3DGS cameras.json")
+        ->check(CLI::ExistingFile);
+    app.add_option("--view", opt.view, "View index in --cameras")->capture_default_str();
+    app.add_option("--up", opt.up,
+                   "World up x,y,z of the orbit camera (default 0,-1,0 for files, the 3DGS "
+                   "convention; 0,1,0 for the built-in scene)")
+        ->delimiter(',')
+        ->expected(3);
+    app.add_flag("--no-sphere", opt.no_sphere, "Do not add the red sphere");
+    app.add_option("--sphere-radius", opt.sphere_radius,
+                   "Sphere radius. The sphere is centred on the median splat position, with "
+                   "radius 0.3 x the 80th-percentile splat distance from there by default (the "
+                   "built-in scene has its own place and size for it)")
+        ->check(CLI::PositiveNumber);
+    app.add_flag("--hide-panel", opt.hide_panel, "Start with the settings panel hidden");
+    app.add_option("--sh-degree", opt.sh_degree, "Initial SH degree cap")
+        ->check(CLI::Range(0, 3))
+        ->capture_default_str();
+    app.add_flag("--antialias", opt.antialias, "Start with antialiasing on");
+    app.add_option("--screenshot-dir", opt.screenshot_dir,
+                   "Folder for screenshot_NNNN.png (P key, panel button, --screenshot-on-exit); "
+                   "made when missing")
+        ->capture_default_str();
+    app.add_flag("--continuous", opt.continuous,
+                 "Draw frames back to back even when nothing changes (timing)");
+    app.add_option("--frames", opt.frames,
+                   "Draw continuously and exit after this many frames (0: no limit)")
+        ->check(CLI::NonNegativeNumber)
+        ->capture_default_str();
+    app.add_option("--exit-after-seconds", opt.exit_after_seconds,
+                   "Exit after this many seconds (0: no limit)")
+        ->check(CLI::NonNegativeNumber)
+        ->capture_default_str();
+    app.add_flag("--screenshot-on-exit", opt.screenshot_on_exit,
+                 "Draw one more frame at exit and save it as a screenshot");
+    app.add_option("--spin", opt.spin_degrees,
+                   "Orbit the camera by this many degrees every frame, drawing continuously "
+                   "(timing: the splat geometry stage then runs every frame)")
+        ->capture_default_str();
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::ParseError& e) {
+        return app.exit(e);
+    }
+    try {
+        return Run(opt);
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "GaussianSplat: error: %s\n", e.what());
+        return 1;
+    }
+}

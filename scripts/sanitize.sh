@@ -1,0 +1,20 @@
+#!/usr/bin/env bash
+# The CPU and lavapipe tests under AddressSanitizer + UndefinedBehaviorSanitizer (a second
+# build in $BUILD_DIR, default build-asan). Run by CI after README command 2.
+# The Vulkan validation layer stays off here: with it loaded LeakSanitizer reports
+# allocations it cannot attribute (docs/environment-notes.md); the main test run keeps
+# validation on. Extra arguments go to ctest.
+set -euo pipefail
+root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+build_dir="${BUILD_DIR:-$root/build-asan}"
+bash "$root/scripts/setup.sh"
+cmake -S "$root" -B "$build_dir" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DOPEN3D_SANITIZE=ON \
+  -DOPEN3D_BUILD_BENCHMARKS=OFF >/dev/null
+cmake --build "$build_dir" -j"$(nproc)" --target tests_core tests_geometry tests_io tests_camera \
+  tests_gaussian_splat tests_gaussian_splat_cpu tests_gaussian_splat_vulkan gs-render
+cd "$build_dir"
+export OPEN3D_VULKAN_VALIDATION=0
+export ASAN_OPTIONS="detect_leaks=1:abort_on_error=1"
+export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
+# The gs-render command-line tests run the binary: they are sanitized too.
+ctest --output-on-failure -j"$(nproc)" --timeout 1200 -L "^(cpu|vulkan)$" "$@"

@@ -1,0 +1,278 @@
+// The Visualizer in a real (Xvfb) window: geometry by name, camera fitting, the window
+// picture against the offscreen render, the panel, injected input, resize and minimise,
+// screenshots.
+#include "open3d/visualization/visualizer/Visualizer.h"
+
+#include <GLFW/glfw3.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+
+#include "TestUtility.h"
+#include "open3d/core/Exception.h"
+#include "open3d/t/geometry/TriangleMesh.h"
+#include "open3d/t/io/ImageIO.h"
+#include "visualization/visualizer/VisualizerTestFixture.h"
+
+namespace open3d {
+namespace tests {
+namespace {
+
+using visualization::Visualizer;
+
+Eigen::Vector3d Project(const camera::PinholeCamera& camera, const Eigen::Vector3d& p) {
+    const Eigen::Vector3d c = camera.GetRotation() * p + camera.GetTranslation();
+    return Eigen::Vector3d(camera.fx * c.x() / c.z() + camera.cx,
+                           camera.fy * c.y() / c.z() + camera.cy, c.z());
+}
+
+void PressKey(Visualizer& vis, int key) {
+    vis.OnKey(key, true, false, 0);
+    vis.OnKey(key, false, false, 0);
+}
+
+void Drag(Visualizer& vis, int button, double x0, double y0, double x1, double y1) {
+    vis.OnCursorPos(x0, y0);
+    vis.OnMouseButton(button, true, 0);
+    vis.OnCursorPos(0.5 * (x0 + x1), 0.5 * (y0 + y1));
+    vis.OnCursorPos(x1, y1);
+    vis.OnMouseButton(button, false, 0);
+}
+
+TEST_F(VisualizerTest, GeometryByName) {
+    Visualizer& vis = MakeVisualizer();
+    AddWallAndSphere(vis);
+    EXPECT_EQ(vis.GetGeometryNames(), (std::vector<std::string>{"wall", "sphere"}));
+    EXPECT_TRUE(vis.HasGeometry("wall"));
+    EXPECT_TRUE(vis.IsGeometryVisible("sphere"));
+    // A taken name throws and changes nothing.
+    EXPECT_THROW(vis.AddGeometry("wall", t::geometry::TriangleMesh::CreateSphere(1.0, 8)),
+                 core::Open3DError);
+    EXPECT_EQ(vis.GetGeometryNames().size(), 2u);
+    vis.ShowGeometry("sphere", false);
+    EXPECT_FALSE(vis.IsGeometryVisible("sphere"));
+    // Update keeps the visibility.
+    vis.UpdateGeometry("sphere", t::geometry::TriangleMesh::CreateSphere(0.25, 10));
+    EXPECT_FALSE(vis.IsGeometryVisible("sphere"));
+    EXPECT_THROW(vis.ShowGeometry("nothing", true), core::Open3DError);
+    EXPECT_FALSE(vis.RemoveGeometry("nothing"));
+    EXPECT_TRUE(vis.RemoveGeometry("wall"));
+    EXPECT_EQ(vis.GetGeometryNames(), (std::vector<std::string>{"sphere"}));
+    // Keys 1-9 toggle by panel order.
+    PressKey(vis, GLFW_KEY_1);
+    EXPECT_TRUE(vis.IsGeometryVisible("sphere"));
+    PressKey(vis, GLFW_KEY_5);  // no fifth object: nothing happens
+    EXPECT_TRUE(vis.RenderFrame());
+}
+
+TEST_F(VisualizerTest, ResetCameraFitsTheVisibleBounds) {
+    Visualizer& vis = MakeVisualizer(200, 300);  // tall: the horizontal fov limits
+    AddWallAndSphere(vis);
+    t::geometry::TriangleMesh far_box = t::geometry::TriangleMesh::CreateSphere(1.0, 8);
+    far_box.Translate(Eigen::Vector3d(50, 0, 0));
+    vis.AddGeometry("far", far_box);
+    for (bool far_visible : {true, false}) {
+        SCOPED_TRACE(far_visible ? "far object visible" : "far object hidden");
+        vis.ShowGeometry("far", far_visible);
+        vis.ResetCamera();
+        Eigen::Vector3d lo, hi;
+        ASSERT_TRUE(vis.GetScene().GetScene().GetBounds(lo, hi));
+        EXPECT_EQ(hi.x() > 40.0, far_visible);
+        const camera::PinholeCamera camera = vis.GetCamera();
+        EXPECT_EQ(camera.width, 200);
+        EXPECT_EQ(camera.height, 300);
+        for (int i = 0; i < 8; ++i) {
+            const Eigen::Vector3d corner(i & 1 ? hi.x() : lo.x(), i & 2 ? hi.y() : lo.y(),
+                                         i & 4 ? hi.z() : lo.z());
+            const Eigen::Vector3d p = Project(camera, corner);
+            EXPECT_GT(p.z(), 0.0);
+            EXPECT_GE(p.x(), -0.5);
+            EXPECT_LE(p.x(), camera.width - 0.5);
+            EXPECT_GE(p.y(), -0.5);
+            EXPECT_LE(p.y(), camera.height - 0.5);
+        }
+    }
+    // The red sphere is in the picture once the far object is hidden.
+    EXPECT_GT(CountRed(vis.CaptureScreenImage()), 50);
+}
+
+TEST_F(VisualizerTest, WindowShowsWhatRenderToImageRenders) {
+    Visualizer& vis = MakeVisualizer();
+    AddWallAndSphere(vis);
+    const t::geometry::Image screen = vis.CaptureScreenImage();
+    const t::geometry::Image offscreen = vis.RenderToImage();
+    ASSERT_EQ(screen.GetRows(), 160);
+    ASSERT_EQ(screen.GetCols(), 240);
+    ASSERT_EQ(offscreen.NumPixels(), screen.NumPixels());
+    // The compose view blends 8-bit mesh colour with the fp16 overlay in the 8-bit swap
+    // chain; the offscreen path blends the same inputs in float on the host: 1 LSB apart
+    // at most (InteractivePathTest measures the same).
+    const uint8_t* a = screen.Data<uint8_t>();
+    const uint8_t* b = offscreen.Data<uint8_t>();
+    int worst = 0;
+    for (int64_t i = 0; i < screen.NumPixels() * 3; ++i) {
+        worst = std::max(worst, std::abs(int(a[i]) - int(b[i])));
+    }
+    EXPECT_LE(worst, 1);
+    EXPECT_GT(CountRed(screen), 100);
+    // Depth of the centre pixel: the sphere's front (z = 1.5) seen from the eye on the axis.
+    const t::geometry::Image depth = vis.RenderToDepthImage();
+    const float* z = depth.Data<float>();
+    const double expected = 1.5 - vis.GetViewControl().GetEye().z();
+    EXPECT_NEAR(z[80 * 240 + 120], expected, 2e-2 * expected);
+}
+
+TEST_F(VisualizerTest, PanelIsDrawnOverTheScene) {
+    Visualizer& vis = MakeVisualizer(480, 320, true);
+    AddWallAndSphere(vis);
+    vis.RenderFrame();  // the panel's first frame sizes its window
+    const t::geometry::Image with_panel = vis.CaptureScreenImage();
+    vis.ShowSettings(false);
+    const t::geometry::Image without = vis.CaptureScreenImage();
+    const std::string dir = TempDir();
+    t::io::WritePNG(dir + "/with_panel.png", with_panel);
+    t::io::WritePNG(dir + "/without_panel.png", without);
+    std::printf("panel screenshots in %s\n", dir.c_str());
+    // The panel's title bar and first lines sit in the top-left corner; the right edge of
+    // the window is outside the panel and unchanged.
+    EXPECT_GT(MeanAbsDiff(with_panel, without, 8, 8, 150, 60), 15.0);
+    EXPECT_LT(MeanAbsDiff(with_panel, without, 450, 0, 480, 320), 0.5);
+    PressKey(vis, GLFW_KEY_H);
+    EXPECT_TRUE(vis.IsSettingsShown());
+}
+
+TEST_F(VisualizerTest, HidingAnObjectRemovesItsPixels) {
+    Visualizer& vis = MakeVisualizer();
+    AddWallAndSphere(vis);
+    EXPECT_GT(CountRed(vis.CaptureScreenImage()), 100);
+    PressKey(vis, GLFW_KEY_2);  // the second object: the sphere
+    EXPECT_FALSE(vis.IsGeometryVisible("sphere"));
+    EXPECT_EQ(CountRed(vis.CaptureScreenImage()), 0);
+    PressKey(vis, GLFW_KEY_2);
+    EXPECT_GT(CountRed(vis.CaptureScreenImage()), 100);
+}
+
+TEST_F(VisualizerTest, InjectedInputMovesTheCamera) {
+    Visualizer& vis = MakeVisualizer(480, 320, true);
+    AddWallAndSphere(vis);
+    vis.RenderFrame();  // lays out the panel
+    visualization::ViewControl& view = vis.GetViewControl();
+    const Eigen::Vector3d center = view.GetCenter(), eye = view.GetEye();
+    const double distance = view.GetDistance();
+
+    // A drag that starts on the panel belongs to ImGui: the camera stays.
+    Drag(vis, GLFW_MOUSE_BUTTON_LEFT, 30, 20, 200, 120);
+    EXPECT_TRUE(view.GetEye().isApprox(eye));
+
+    // Left drag outside the panel orbits about the centre.
+    vis.ShowSettings(false);  // the pictures compare the scene alone
+    const t::geometry::Image before = vis.CaptureScreenImage();
+    Drag(vis, GLFW_MOUSE_BUTTON_LEFT, 400, 200, 440, 180);
+    EXPECT_TRUE(view.GetCenter().isApprox(center));
+    EXPECT_NEAR(view.GetDistance(), distance, 1e-9);
+    EXPECT_GT((view.GetEye() - eye).norm(), 0.05 * distance);
+    const t::geometry::Image orbited = vis.CaptureScreenImage();
+    EXPECT_GT(MeanAbsDiff(before, orbited, 0, 0, 480, 320), 1.0);
+
+    // Wheel up zooms in; right drag pans.
+    vis.OnCursorPos(400, 200);
+    vis.OnScroll(0.0, 2.0);
+    EXPECT_NEAR(view.GetDistance(), distance * 0.81, 1e-9);
+    Drag(vis, GLFW_MOUSE_BUTTON_RIGHT, 400, 200, 420, 200);
+    EXPECT_FALSE(view.GetCenter().isApprox(center));
+    PressKey(vis, GLFW_KEY_R);
+    EXPECT_TRUE(view.GetCenter().isApprox(center));
+    EXPECT_TRUE(view.GetEye().isApprox(eye));
+}
+
+TEST_F(VisualizerTest, ResizeAndMinimise) {
+    Visualizer& vis = MakeVisualizer(240, 160, true);
+    AddWallAndSphere(vis);
+    ASSERT_TRUE(vis.RenderFrame());
+    const int64_t builds = vis.GetScene().GetView().GetTargetBuilds();
+    // Shrink and grow a few times: each size gets its own targets, the old ones are
+    // released before the new frame (ASan builds catch a use after free here).
+    for (auto [w, h] : {std::pair{320, 200}, std::pair{200, 120}, std::pair{300, 220}}) {
+        vis.SetWindowSize(w, h);
+        ASSERT_TRUE(WaitForSize(vis, w, h)) << "the window never became " << w << "x" << h;
+        const t::geometry::Image image = vis.CaptureScreenImage();
+        EXPECT_EQ(image.GetCols(), w);
+        EXPECT_EQ(image.GetRows(), h);
+        EXPECT_EQ(vis.GetCamera().width, w);
+        vis.ShowSettings(false);  // the panel covers the sphere in such small windows
+        EXPECT_GT(CountRed(vis.CaptureScreenImage()), 50);
+        vis.ShowSettings(true);
+    }
+    EXPECT_EQ(vis.GetScene().GetView().GetTargetBuilds(), builds + 3);
+
+    // Minimised: GLFW reports a 0 x 0 framebuffer. Nothing is drawn, nothing crashes.
+    vis.OnFramebufferSize(0, 0);
+    EXPECT_FALSE(vis.RenderFrame());
+    EXPECT_THROW(vis.CaptureScreenImage(), core::Open3DError);
+    visualization::RunOptions run;
+    run.max_seconds = 0.2;
+    vis.Run(run);
+    EXPECT_EQ(vis.GetCamera().width, 300);  // the camera keeps its last size
+    vis.OnFramebufferSize(300, 220);
+    EXPECT_EQ(vis.CaptureScreenImage().GetCols(), 300);
+
+    // The window manager's requests (without one, as under plain Xvfb, nothing changes).
+    vis.Minimize();
+    vis.PollEvents();
+    vis.Restore();
+    vis.Maximize();
+    for (int i = 0; i < 20; ++i) vis.PollEvents();
+    if (vis.GetWidth() > 0) {
+        EXPECT_EQ(vis.CaptureScreenImage().GetCols(), vis.GetWidth());
+    }
+}
+
+TEST_F(VisualizerTest, ScreenshotKeyWritesThePicture) {
+    Visualizer& vis = MakeVisualizer();
+    AddWallAndSphere(vis);
+    const std::string dir = TempDir();
+    vis.SetScreenshotDir(dir);
+    PressKey(vis, GLFW_KEY_P);
+    ASSERT_TRUE(vis.RenderFrame());
+    const std::string path = dir + "/screenshot_0000.png";
+    ASSERT_EQ(vis.GetLastScreenshotPath(), path);
+    ASSERT_TRUE(std::filesystem::exists(path));
+    const t::geometry::Image saved = t::io::ReadPNG(path);
+    const t::geometry::Image shown = vis.CaptureScreenImage();
+    ASSERT_EQ(saved.GetChannels(), 3);
+    ASSERT_EQ(saved.NumPixels(), shown.NumPixels());
+    EXPECT_EQ(MeanAbsDiff(saved, shown, 0, 0, 240, 160), 0.0);
+    EXPECT_FALSE(std::filesystem::exists(path + ".part"));
+}
+
+TEST_F(VisualizerTest, RunStopsAfterTheFrameLimit) {
+    Visualizer& vis = MakeVisualizer();
+    AddWallAndSphere(vis);
+    int before_frame_calls = 0;
+    visualization::RunOptions run;
+    run.continuous = true;
+    run.max_frames = 4;
+    run.before_frame = [&] { ++before_frame_calls; };
+    vis.Run(run);
+    EXPECT_EQ(before_frame_calls, 4);
+    EXPECT_EQ(vis.GetFrameStatistics().GetCount(), 3);  // times between 4 presented frames
+    EXPECT_GT(vis.GetFrameStatistics().GetSmoothedFrameMs(), 0.0);
+    EXPECT_GT(vis.GetLastFrame().splat_stats.num_visible, 0);
+    // Without `continuous`, an idle visualizer draws the frames it was asked for, then
+    // sleeps on events until the time limit.
+    run = {};
+    run.max_seconds = 0.5;
+    run.before_frame = [&] { ++before_frame_calls; };
+    before_frame_calls = 0;
+    vis.PostRedraw();
+    vis.Run(run);
+    EXPECT_EQ(before_frame_calls, 2);
+    // Q asks the loop to end.
+    PressKey(vis, GLFW_KEY_Q);
+    EXPECT_FALSE(vis.PollEvents());
+}
+
+}  // namespace
+}  // namespace tests
+}  // namespace open3d
