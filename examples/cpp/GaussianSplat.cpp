@@ -13,6 +13,7 @@
 #include "open3d/camera/CamerasJson.h"
 #include "open3d/core/Exception.h"
 #include "open3d/core/Timer.h"
+#include "open3d/t/geometry/PointCloudStatistics.h"
 #include "open3d/t/io/PointCloudIO.h"
 #include "open3d/visualization/rendering/filament/FilamentEngine.h"
 #include "open3d/visualization/rendering/gaussian_splat/DefaultScene.h"
@@ -44,34 +45,6 @@ struct Options {
     double spin_degrees = 0.0;
     bool continuous = false;
 };
-
-// Median of the positions per axis: a centre that ignores stray far-away splats.
-Eigen::Vector3d RobustCenter(const t::geometry::PointCloud& cloud) {
-    const int64_t n = cloud.NumPoints();
-    if (n == 0) return Eigen::Vector3d::Zero();
-    const float* p = cloud.GetPointPositions().Data<float>();  // [N, 3]
-    Eigen::Vector3d c;
-    std::vector<float> axis(n);
-    for (int a = 0; a < 3; ++a) {
-        for (int64_t i = 0; i < n; ++i) axis[i] = p[3 * i + a];
-        std::nth_element(axis.begin(), axis.begin() + n / 2, axis.end());
-        c[a] = axis[n / 2];
-    }
-    return c;
-}
-
-// 80th percentile distance from the centre: the sphere's size follows the scene's.
-double RobustRadius(const t::geometry::PointCloud& cloud, const Eigen::Vector3d& center) {
-    const int64_t n = cloud.NumPoints();
-    if (n == 0) return 1.0;
-    const float* p = cloud.GetPointPositions().Data<float>();  // [N, 3]
-    std::vector<double> d(n);
-    for (int64_t i = 0; i < n; ++i) {
-        d[i] = (Eigen::Vector3d(p[3 * i], p[3 * i + 1], p[3 * i + 2]) - center).norm();
-    }
-    std::nth_element(d.begin(), d.begin() + n * 8 / 10, d.end());
-    return std::max(1e-3, d[n * 8 / 10]);
-}
 
 int Run(const Options& opt) {
     // Fail before reading a large scene when no window can be opened.
@@ -119,8 +92,8 @@ int Run(const Options& opt) {
             center = rendering::GetDefaultSceneMeshSphere().center;
             radius = rendering::GetDefaultSceneMeshSphere().radius;
         } else {
-            center = RobustCenter(cloud);
-            radius = 0.3 * RobustRadius(cloud, center);
+            center = t::geometry::ComputeMedianCenter(cloud);
+            radius = 0.3 * t::geometry::ComputeDistanceQuantile(cloud, center, 0.8);
         }
         if (opt.sphere_radius > 0.0) radius = opt.sphere_radius;
         t::geometry::TriangleMesh sphere = t::geometry::TriangleMesh::CreateSphere(radius, 40);

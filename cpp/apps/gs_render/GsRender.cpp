@@ -14,6 +14,7 @@
 #include "open3d/core/Exception.h"
 #include "open3d/core/ParallelFor.h"
 #include "open3d/core/Timer.h"
+#include "open3d/t/geometry/PointCloudStatistics.h"
 #include "open3d/t/io/ImageIO.h"
 #include "open3d/t/io/PointCloudIO.h"
 #include "open3d/visualization/rendering/gaussian_splat/DefaultScene.h"
@@ -53,34 +54,6 @@ struct Options {
 
 Eigen::Vector3d ToVec(const std::vector<double>& v) { return Eigen::Vector3d(v[0], v[1], v[2]); }
 
-// Median of the positions per axis: a centre that ignores stray far-away splats.
-Eigen::Vector3d RobustCenter(const t::geometry::PointCloud& cloud) {
-    const int64_t n = cloud.NumPoints();
-    if (n == 0) return Eigen::Vector3d::Zero();
-    const float* p = cloud.GetPointPositions().Data<float>();  // [N, 3]
-    Eigen::Vector3d c;
-    std::vector<float> axis(n);
-    for (int a = 0; a < 3; ++a) {
-        for (int64_t i = 0; i < n; ++i) axis[i] = p[3 * i + a];
-        std::nth_element(axis.begin(), axis.begin() + n / 2, axis.end());
-        c[a] = axis[n / 2];
-    }
-    return c;
-}
-
-// 80th percentile distance from the centre, for framing a scene without cameras.
-double RobustRadius(const t::geometry::PointCloud& cloud, const Eigen::Vector3d& center) {
-    const int64_t n = cloud.NumPoints();
-    if (n == 0) return 1.0;
-    const float* p = cloud.GetPointPositions().Data<float>();  // [N, 3]
-    std::vector<double> d(n);
-    for (int64_t i = 0; i < n; ++i) {
-        d[i] = (Eigen::Vector3d(p[3 * i], p[3 * i + 1], p[3 * i + 2]) - center).norm();
-    }
-    std::nth_element(d.begin(), d.begin() + n * 8 / 10, d.end());
-    return std::max(1e-3, d[n * 8 / 10]);
-}
-
 camera::PinholeCamera ChooseCamera(const Options& opt, const t::geometry::PointCloud& cloud,
                                    bool default_scene) {
     const bool look_at_flags =
@@ -96,16 +69,18 @@ camera::PinholeCamera ChooseCamera(const Options& opt, const t::geometry::PointC
         cam = views[opt.view].camera;
         // Look-at edits pivot on the point of the view axis nearest the scene centre.
         const Eigen::Vector3d forward = cam.GetRotation().row(2).transpose();
-        const double distance = std::max(0.1, (RobustCenter(cloud) - cam.GetCenter()).dot(forward));
+        const double distance =
+            std::max(0.1, (t::geometry::ComputeMedianCenter(cloud) - cam.GetCenter()).dot(forward));
         look_at = cam.ToLookAt(distance);
     } else if (default_scene) {
         look_at = rendering::GetDefaultSceneLookAt();
         cam = rendering::GetDefaultSceneCamera();
     } else {
         // No cameras: look at the scene centre from -z (3DGS captures are usually y-down).
-        look_at.center = RobustCenter(cloud);
-        look_at.eye =
-            look_at.center + Eigen::Vector3d(0, 0, -2.5 * RobustRadius(cloud, look_at.center));
+        look_at.center = t::geometry::ComputeMedianCenter(cloud);
+        look_at.eye = look_at.center + Eigen::Vector3d(0, 0,
+                                                       -2.5 * t::geometry::ComputeDistanceQuantile(
+                                                                  cloud, look_at.center, 0.8));
         look_at.up = Eigen::Vector3d(0, -1, 0);
         look_at.vertical_fov_deg = 50.0;
         cam = camera::PinholeCamera::FromLookAt(look_at, 800, 800);
@@ -176,11 +151,12 @@ int Run(const Options& opt) {
         gs_render::FilamentRenderOptions fo;
         fo.backend = backend_name;
         fo.sphere = opt.sphere;
-        fo.sphere_center =
-            default_scene ? rendering::GetDefaultSceneMeshSphere().center : RobustCenter(cloud);
+        fo.sphere_center = default_scene ? rendering::GetDefaultSceneMeshSphere().center
+                                         : t::geometry::ComputeMedianCenter(cloud);
         fo.sphere_radius =
             opt.sphere_radius.value_or(default_scene ? rendering::GetDefaultSceneMeshSphere().radius
-                                                     : 0.3 * RobustRadius(cloud, fo.sphere_center));
+                                                     : 0.3 * t::geometry::ComputeDistanceQuantile(
+                                                                 cloud, fo.sphere_center, 0.8));
         fo.background = config.background;
         fo.frames = opt.frames;
         fo.output = opt.output;

@@ -108,13 +108,7 @@ void SplatTargets::CreateZeroCopy(GaussianSplatBackend& backend) {
     gl.CheckError("importing the Vulkan splat images (glImportMemoryFdEXT)");
     // Filament's context must see complete objects.
     gl.Finish();
-    filament::Engine& e = engine_.GetEngine();
-    color_texture_ =
-        ImportTexture(e, gl_color_, width_, height_, filament::Texture::InternalFormat::RGBA16F,
-                      filament::Texture::Usage::SAMPLEABLE);
-    depth_texture_ = ImportTexture(
-        e, gl_depth_, width_, height_, filament::Texture::InternalFormat::DEPTH32F,
-        filament::Texture::Usage::DEPTH_ATTACHMENT | filament::Texture::Usage::SAMPLEABLE);
+    ImportIntoFilament();
 }
 
 void SplatTargets::CreateHostCopy() {
@@ -127,6 +121,10 @@ void SplatTargets::CreateHostCopy() {
                         static_cast<GLsizei>(height_));
     gl.CheckError("creating the host-copy splat textures");
     gl.Finish();
+    ImportIntoFilament();
+}
+
+void SplatTargets::ImportIntoFilament() {
     filament::Engine& e = engine_.GetEngine();
     color_texture_ =
         ImportTexture(e, gl_color_, width_, height_, filament::Texture::InternalFormat::RGBA16F,

@@ -96,6 +96,8 @@ private:
     t::geometry::Image ReadSceneDepth(float scene_near);
     void CreateZeroCopy(GaussianSplatBackend& backend);
     void CreateHostCopy();
+    // Wraps the two GL textures (complete, finished) as Filament textures.
+    void ImportIntoFilament();
     void CompositeHostCopy(GaussianSplatBackend& backend, const SplatCompositeRequest& request,
                            SplatFrame& frame);
 
