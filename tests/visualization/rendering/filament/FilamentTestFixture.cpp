@@ -88,6 +88,18 @@ uint64_t FilamentTest::ValidationProblems() const {
     return problems;
 }
 
+std::string SharingTestName(const ::testing::TestParamInfo<rendering::SplatSharing>& info) {
+    switch (info.param) {
+        case rendering::SplatSharing::kZeroCopy:
+            return "ZeroCopy";
+        case rendering::SplatSharing::kHostCopy:
+            return "HostCopy";
+        case rendering::SplatSharing::kAuto:
+            break;
+    }
+    return "Auto";
+}
+
 camera::PinholeCamera MakeFilamentTestCamera(int width, int height) {
     camera::PinholeCamera camera;
     camera.width = width;

@@ -53,6 +53,9 @@ protected:
     uint64_t headless_problems_ = 0;
 };
 
+/// Test-name suffix of a SplatSharing parameter ("ZeroCopy", "HostCopy", "Auto").
+std::string SharingTestName(const ::testing::TestParamInfo<rendering::SplatSharing>& info);
+
 /// Camera at the origin looking along +z, fx = fy = 0.9 * width, principal point at the
 /// image centre.
 camera::PinholeCamera MakeFilamentTestCamera(int width, int height);

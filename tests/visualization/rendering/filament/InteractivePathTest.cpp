@@ -51,9 +51,7 @@ TEST_P(InteractivePath, SwapChainMatchesOffscreenBlend) {
 
 INSTANTIATE_TEST_SUITE_P(Sharing, InteractivePath,
                          ::testing::Values(SplatSharing::kZeroCopy, SplatSharing::kHostCopy),
-                         [](const auto& info) {
-                             return info.param == SplatSharing::kZeroCopy ? "ZeroCopy" : "HostCopy";
-                         });
+                         SharingTestName);
 
 }  // namespace
 }  // namespace tests

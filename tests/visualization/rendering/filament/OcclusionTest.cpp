@@ -100,9 +100,7 @@ TEST_P(OcclusionTest, SphereHidesExactlyTheSplatsBehindIt) {
 
 INSTANTIATE_TEST_SUITE_P(Sharing, OcclusionTest,
                          ::testing::Values(SplatSharing::kZeroCopy, SplatSharing::kHostCopy),
-                         [](const auto& info) {
-                             return info.param == SplatSharing::kZeroCopy ? "ZeroCopy" : "HostCopy";
-                         });
+                         SharingTestName);
 
 }  // namespace
 }  // namespace tests

@@ -17,6 +17,15 @@ void LoadProc(T& pointer, const char* name) {
     pointer = reinterpret_cast<T>(glfwGetProcAddress(name));
 }
 
+// A core 4.5 entry point: missing means the context is too old.
+template <typename T>
+void LoadRequired(T& pointer, const char* name) {
+    LoadProc(pointer, name);
+    if (pointer == nullptr) {
+        core::ThrowError("OpenGL: the context lacks {} (need OpenGL 4.5 core)", name);
+    }
+}
+
 }  // namespace
 
 GlFunctions GlFunctions::Load() {
@@ -24,25 +33,16 @@ GlFunctions GlFunctions::Load() {
         core::ThrowError("OpenGL: no current context to load entry points from");
     }
     GlFunctions gl;
-    LoadProc(gl.GetStringi, "glGetStringi");
-    LoadProc(gl.GetIntegerv, "glGetIntegerv");
-    LoadProc(gl.GetError, "glGetError");
-    LoadProc(gl.Finish, "glFinish");
-    LoadProc(gl.CreateTextures, "glCreateTextures");
-    LoadProc(gl.DeleteTextures, "glDeleteTextures");
-    LoadProc(gl.TextureStorage2D, "glTextureStorage2D");
-    LoadProc(gl.TextureSubImage2D, "glTextureSubImage2D");
-    LoadProc(gl.GetTextureImage, "glGetTextureImage");
-    LoadProc(gl.PixelStorei, "glPixelStorei");
-    for (const void* p :
-         {(const void*)gl.GetStringi, (const void*)gl.GetIntegerv, (const void*)gl.GetError,
-          (const void*)gl.Finish, (const void*)gl.CreateTextures, (const void*)gl.DeleteTextures,
-          (const void*)gl.TextureStorage2D, (const void*)gl.TextureSubImage2D,
-          (const void*)gl.GetTextureImage, (const void*)gl.PixelStorei}) {
-        if (p == nullptr) {
-            core::ThrowError("OpenGL: the context lacks a 4.5 core entry point (need OpenGL 4.5)");
-        }
-    }
+    LoadRequired(gl.GetStringi, "glGetStringi");
+    LoadRequired(gl.GetIntegerv, "glGetIntegerv");
+    LoadRequired(gl.GetError, "glGetError");
+    LoadRequired(gl.Finish, "glFinish");
+    LoadRequired(gl.CreateTextures, "glCreateTextures");
+    LoadRequired(gl.DeleteTextures, "glDeleteTextures");
+    LoadRequired(gl.TextureStorage2D, "glTextureStorage2D");
+    LoadRequired(gl.TextureSubImage2D, "glTextureSubImage2D");
+    LoadRequired(gl.GetTextureImage, "glGetTextureImage");
+    LoadRequired(gl.PixelStorei, "glPixelStorei");
     LoadProc(gl.CreateMemoryObjectsEXT, "glCreateMemoryObjectsEXT");
     LoadProc(gl.DeleteMemoryObjectsEXT, "glDeleteMemoryObjectsEXT");
     LoadProc(gl.MemoryObjectParameterivEXT, "glMemoryObjectParameterivEXT");

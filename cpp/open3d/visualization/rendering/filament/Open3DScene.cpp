@@ -2,7 +2,6 @@
 
 #include <cmath>
 #include <cstdlib>
-#include <cstring>
 
 #include "open3d/camera/CamerasJson.h"
 #include "open3d/core/Exception.h"
@@ -112,13 +111,7 @@ t::geometry::Image Open3DScene::RenderToImage(bool with_alpha) {
     request.splat_config = splat_config_;
     request.read_color = true;
     last_frame_ = renderer_.Draw(*scene_, *view_, request);
-    if (with_alpha) return last_frame_.color;
-    const t::geometry::Image& rgba = last_frame_.color;
-    t::geometry::Image rgb(rgba.GetRows(), rgba.GetCols(), 3, core::Dtype::UInt8);
-    const uint8_t* src = rgba.Data<uint8_t>();
-    uint8_t* dst = rgb.Data<uint8_t>();
-    for (int64_t i = 0; i < rgba.NumPixels(); ++i) std::memcpy(dst + 3 * i, src + 4 * i, 3);
-    return rgb;
+    return with_alpha ? last_frame_.color : last_frame_.color.SelectChannels(0, 3);
 }
 
 t::geometry::Image Open3DScene::RenderToDepthImage(bool normalized, float near, float far) {

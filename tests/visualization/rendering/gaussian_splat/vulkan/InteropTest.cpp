@@ -115,12 +115,7 @@ protected:
 
     std::unique_ptr<GaussianSplatVulkanBackend> MakeBackend(uint32_t entry_capacity = 1u << 22,
                                                             bool export_enabled = true) {
-        vulkan::BorrowedVulkanHandles handles;
-        handles.instance = Context().GetInstance();
-        handles.physical_device = Context().GetPhysicalDevice();
-        handles.device = Context().GetDevice();
-        handles.queue = Context().GetQueue();
-        handles.queue_family_index = Context().GetQueueFamilyIndex();
+        vulkan::BorrowedVulkanHandles handles = BorrowedHandles();
         handles.external_memory_fd_enabled = export_enabled;
         return std::make_unique<GaussianSplatVulkanBackend>(
             vulkan::VulkanContext::CreateFromBorrowed(handles), entry_capacity);

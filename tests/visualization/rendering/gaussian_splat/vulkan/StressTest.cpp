@@ -50,12 +50,7 @@ Bounds MakeBounds(double min_psnr_db, double max_abs, double max_depth_rel) {
 class Stress : public VulkanTest {
 protected:
     std::unique_ptr<GaussianSplatVulkanBackend> MakeBackend() {
-        vulkan::BorrowedVulkanHandles handles;
-        handles.instance = Context().GetInstance();
-        handles.physical_device = Context().GetPhysicalDevice();
-        handles.device = Context().GetDevice();
-        handles.queue = Context().GetQueue();
-        handles.queue_family_index = Context().GetQueueFamilyIndex();
+        vulkan::BorrowedVulkanHandles handles = BorrowedHandles();
         return std::make_unique<GaussianSplatVulkanBackend>(
             vulkan::VulkanContext::CreateFromBorrowed(handles));
     }

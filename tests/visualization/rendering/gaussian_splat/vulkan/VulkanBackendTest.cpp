@@ -26,12 +26,7 @@ using vulkan::GaussianSplatVulkanBackend;
 class VulkanBackend : public VulkanTest {
 protected:
     std::unique_ptr<GaussianSplatVulkanBackend> MakeBackend(uint32_t entry_capacity = 1u << 22) {
-        vulkan::BorrowedVulkanHandles handles;
-        handles.instance = Context().GetInstance();
-        handles.physical_device = Context().GetPhysicalDevice();
-        handles.device = Context().GetDevice();
-        handles.queue = Context().GetQueue();
-        handles.queue_family_index = Context().GetQueueFamilyIndex();
+        vulkan::BorrowedVulkanHandles handles = BorrowedHandles();
         return std::make_unique<GaussianSplatVulkanBackend>(
             vulkan::VulkanContext::CreateFromBorrowed(handles), entry_capacity);
     }

@@ -27,6 +27,16 @@ protected:
     void TearDown() override;
 
     static visualization::rendering::vulkan::VulkanContext& Context() { return *context_; }
+    /// The shared context's handles, for backends that borrow them.
+    static visualization::rendering::vulkan::BorrowedVulkanHandles BorrowedHandles() {
+        visualization::rendering::vulkan::BorrowedVulkanHandles handles;
+        handles.instance = Context().GetInstance();
+        handles.physical_device = Context().GetPhysicalDevice();
+        handles.device = Context().GetDevice();
+        handles.queue = Context().GetQueue();
+        handles.queue_family_index = Context().GetQueueFamilyIndex();
+        return handles;
+    }
     static visualization::rendering::vulkan::CommandPool& Pool() { return *pool_; }
 
     /// Creates a context as the fixture does; on failure returns nullptr and sets
