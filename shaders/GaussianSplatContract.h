@@ -41,9 +41,14 @@ OPEN3D_SHADER_CONST uint kRadixSortDigitBits = 8u;
 OPEN3D_SHADER_CONST uint kRadixSortBins = 256u;  // 1 << kRadixSortDigitBits
 // One invocation per bin in the histogram, scan and scatter shaders (asserted below).
 OPEN3D_SHADER_CONST uint kRadixSortWorkgroupSize = 256u;
-// Elements per invocation: a workgroup owns a block of 256 * 16 = 4096 elements.
-OPEN3D_SHADER_CONST uint kRadixSortItemsPerInvocation = 16u;
-OPEN3D_SHADER_CONST uint kRadixSortBlockSize = 4096u;
+// A workgroup owns a block of 256 * chunks elements, chunks = 1..16 chosen per sort by
+// radix_sort_setup.comp from the GPU-side count: the fewest chunks that keep the block count
+// at or below kRadixSortTargetBlocks (about one wave of a large GPU), so a small sort still
+// spreads over the whole GPU instead of queueing 16 chunks in a handful of workgroups
+// (the H100 sorted 125k depth keys 5x slower with fixed 4096-element blocks).
+OPEN3D_SHADER_CONST uint kRadixSortItemsPerInvocation = 16u;  // chunks per block, at most
+OPEN3D_SHADER_CONST uint kRadixSortBlockSize = 4096u;         // elements per block, at most
+OPEN3D_SHADER_CONST uint kRadixSortTargetBlocks = 1024u;      // GPUs; CPU devices use fewer
 // Upper bound of gl_NumSubgroups, sizing the shared arrays of per-subgroup totals, so
 // RadixSort requires minSubgroupSize >= kRadixSortWorkgroupSize / kRadixSortMaxSubgroups = 4.
 OPEN3D_SHADER_CONST uint kRadixSortMaxSubgroups = 64u;
@@ -61,27 +66,32 @@ OPEN3D_SHADER_CONST uint kRadixSortNumBindings = 7u;
 // Written on the GPU by radix_sort_setup.comp from the element count; the first three
 // members are a VkDispatchIndirectCommand for the per-block passes.
 struct RadixSortParams {
-    uint dispatch_x;  // number of blocks = ceil(count / kRadixSortBlockSize)
+    uint dispatch_x;  // number of blocks = ceil(count / block_size)
     uint dispatch_y;  // 1
     uint dispatch_z;  // 1
     uint count;       // min(count from the producer, max_count)
     uint num_blocks;  // == dispatch_x, row stride of the histogram table
     uint flags;       // kErrorCountsClamped when the producer's count exceeded max_count
-    uint reserved0;
+    uint block_size;  // elements per block: kRadixSortWorkgroupSize * (1..16)
     uint reserved1;
 };
 
 // Push constants of every radix-sort pipeline.
 struct RadixSortPushConstants {
-    uint shift;        // first key bit of this pass's digit
-    uint digit_bits;   // 1..8: bits of this pass's digit (the last pass may be narrower)
-    uint count_index;  // uint index of the count within the count binding
-    uint max_count;    // capacity of the key/value buffers
+    uint shift;          // first key bit of this pass's digit
+    uint digit_bits;     // 1..8: bits of this pass's digit (the last pass may be narrower)
+    uint count_index;    // uint index of the count within the count binding
+    uint max_count;      // capacity of the key/value buffers
+    uint target_blocks;  // 1..kRadixSortTargetBlocks: block count the setup aims at
+    uint reserved0;
+    uint reserved1;
+    uint reserved2;
 };
 
 // ---- Sort-key layout of the seed's packed (tile, depth) key, a measured option ----
 // key = (tile << depth_bits) | ((floatBitsToUint(norm_depth) << 1) >> tile_bits), with
-// tile_bits = ceil(log2(tile_count)) clamped to [kSortKeyMinTileBits, kSortKeyMaxTileBits]
+// tile_bits = bit width of tile_count (the indices and one filler key past them) clamped to
+// [kSortKeyMinTileBits, kSortKeyMaxTileBits]
 // and depth_bits = kSortKeyBits - tile_bits. The exact default sorts depth (32 bits) and
 // then tiles (tile_bits) in two stable sorts (docs/DESIGN.md section 3).
 OPEN3D_SHADER_CONST uint kSortKeyBits = 32u;
@@ -102,10 +112,11 @@ static_assert(offsetof(RadixSortParams, dispatch_z) == 8);
 static_assert(offsetof(RadixSortParams, count) == 12);
 static_assert(offsetof(RadixSortParams, num_blocks) == 16);
 static_assert(offsetof(RadixSortParams, flags) == 20);
-static_assert(offsetof(RadixSortParams, reserved0) == 24);
+static_assert(offsetof(RadixSortParams, block_size) == 24);
 static_assert(offsetof(RadixSortParams, reserved1) == 28);
 
-static_assert(sizeof(RadixSortPushConstants) == 16);
+static_assert(sizeof(RadixSortPushConstants) == 32);
+static_assert(offsetof(RadixSortPushConstants, target_blocks) == 16);
 static_assert(offsetof(RadixSortPushConstants, shift) == 0);
 static_assert(offsetof(RadixSortPushConstants, digit_bits) == 4);
 static_assert(offsetof(RadixSortPushConstants, count_index) == 8);
@@ -129,6 +140,7 @@ static_assert(offsetof(RadixSortPushConstants, max_count) == 12);
 
 #ifdef __cplusplus
 #include <bit>
+#include <cmath>
 
 namespace open3d {
 namespace visualization {
@@ -229,10 +241,13 @@ struct GaussianViewParams {
 // One projected splat, written for visible splats only, indexed by splat index (std430).
 struct GaussianProjectedSplat {
     vec4 center_depth_opacity;  // x, y (pixels), view-space z, opacity (antialias applied)
-    vec4 conic;                 // inverse dilated 2D covariance a, b, c; w = 0
-    vec4 color;                 // rgb = max(0, 0.5 + SH), not clamped above; w = 0
-    uvec4 tiles;                // rect min (x | y << 16), rect max (x | y << 16), tile
-                                // count, radius (pixels); rect is [min, max) in tiles
+    vec4 conic;                 // inverse dilated 2D covariance a, b, c; w = the tile-culling
+                                // threshold TileCullThreshold
+    vec4 color;                 // rgb = max(0, 0.5 + SH), not clamped above; w = det_q,
+                                // a c - b^2 of the conic (1 / det of the dilated covariance)
+    uvec4 tiles;                // rect min (x | y << 16), rect max (x | y << 16), entries to
+                                // emit (the rect's tiles that TileRowSpan keeps), radius
+                                // (pixels); rect is [min, max) in tiles
 };
 
 // Indirect dispatch of one scan level: (x, y, z) groups, then the level's element count.
@@ -327,6 +342,78 @@ OPEN3D_SHADER_FUNC float SortDepth(float r0, float r1, float r2, float dx, float
     OPEN3D_SHADER_PRECISE float d = xy + r2 * dz;
     return d;
 }
+
+// ---- Tile culling: which tiles of the 3DGS rectangle a splat can change ----
+// The composite skips a splat at a pixel when alpha = o exp(-q / 2) < 1/255, where
+// q = a dx^2 + 2 b dx dy + c dy^2 is the conic's quadratic form at the pixel offset. So only
+// tiles that meet the ellipse q <= 2 ln(255 o) get entries; the others could only receive
+// skips, and every image stays bit for bit what the full rectangle gives (docs/vulkan.md
+// "Tile culling"). Both functions run in float32 with `precise` on the GPU (projection
+// count and emission call them on the same stored values) and on the CPU reference.
+#ifdef __cplusplus
+using std::ceil;
+using std::floor;
+using std::log;
+using std::sqrt;
+#endif
+
+// The splat's threshold on q, widened so that rounding cannot cull a tile the composite
+// would blend into: +1% (+0.01 absolute), plus 4e-4 (1 + t) a c / det_q for the
+// composite's own float32 rounding of q, which is about 8 eps q / (1 - |rho|) <= 1.1e-5 q a c
+// / det_q for a conic with correlation rho (1 - |rho| >= det_q / (2 a c)): 40x that bound.
+// det_q = a c - b^2 = 1 / det(cov), passed in from the cancellation-free determinant.
+// <= 0 (opacity below 1/255, or 0): no pixel reaches the blending threshold.
+OPEN3D_SHADER_FUNC float TileCullThreshold(float opacity, float a, float c, float det_q) {
+    OPEN3D_SHADER_PRECISE float t = 2.0f * log(255.0f * opacity);
+    OPEN3D_SHADER_PRECISE float slack = 1.0f + (t > 0.0f ? t : 0.0f);
+    OPEN3D_SHADER_PRECISE float margin = slack * (0.01f + 4e-4f * (a * c / det_q));
+    OPEN3D_SHADER_PRECISE float widened = t + margin;
+    return widened;
+}
+
+// Tile columns [first, last) of tile row `ty` that the ellipse q <= t of a splat centred at
+// (cx, cy) touches, within the rectangle's columns [rect_x0, rect_x1), packed as
+// first | last << 16 (empty: first == last == rect_x0). Pixel (x, y) is evaluated at (x, y), so row
+// ty covers pixel rows 16 ty .. 16 ty + 15 and column tx pixel columns 16 tx .. 16 tx + 15. For a
+// band of rows the ellipse's right edge x_r(dy) = (-b dy + sqrt(a t - det_q dy^2)) / a is concave
+// in dy with its peak at dy* = -b sqrt(t / (det_q c)), so its maximum over the band is at dy*
+// clamped to the band (the left edge mirrors it). The reach is widened by 0.5 px + 1/256 of the
+// extent for this function's own rounding; anything not finite falls back to the whole rectangle
+// row.
+OPEN3D_SHADER_FUNC uint TileRowSpan(float cx, float cy, float a, float b, float c, float det_q,
+                                    float t, uint ty, uint rect_x0, uint rect_x1) {
+    uint whole = rect_x0 | (rect_x1 << 16u);
+    uint none = rect_x0 | (rect_x0 << 16u);
+    if (!(t > 0.0f)) return none;
+    OPEN3D_SHADER_PRECISE float y_ext = sqrt(a * t / det_q);
+    OPEN3D_SHADER_PRECISE float x_ext = sqrt(c * t / det_q);
+    if (!(y_ext < 1e30f && x_ext < 1e30f && a > 0.0f && c > 0.0f)) return whole;
+    OPEN3D_SHADER_PRECISE float reach = y_ext * (1.0f + 1.0f / 256.0f) + 0.5f;
+    OPEN3D_SHADER_PRECISE float lo = float(ty * kGaussianTileSize) - cy;
+    OPEN3D_SHADER_PRECISE float hi = lo + float(kGaussianTileSize - 1u);
+    lo = lo > -reach ? lo : -reach;
+    hi = hi < reach ? hi : reach;
+    if (!(lo <= hi)) return none;
+    OPEN3D_SHADER_PRECISE float peak = -b * (x_ext / c);
+    OPEN3D_SHADER_PRECISE float dy_r = peak < lo ? lo : (peak > hi ? hi : peak);
+    OPEN3D_SHADER_PRECISE float dy_l = -peak < lo ? lo : (-peak > hi ? hi : -peak);
+    OPEN3D_SHADER_PRECISE float s_r = a * t - det_q * (dy_r * dy_r);
+    OPEN3D_SHADER_PRECISE float s_l = a * t - det_q * (dy_l * dy_l);
+    OPEN3D_SHADER_PRECISE float x_r = (sqrt(s_r > 0.0f ? s_r : 0.0f) - b * dy_r) / a;
+    OPEN3D_SHADER_PRECISE float x_l = (-sqrt(s_l > 0.0f ? s_l : 0.0f) - b * dy_l) / a;
+    OPEN3D_SHADER_PRECISE float margin = 0.5f + x_ext * (1.0f / 256.0f);
+    OPEN3D_SHADER_PRECISE float first = ceil((cx + x_l - margin - 15.0f) / 16.0f);
+    OPEN3D_SHADER_PRECISE float last = floor((cx + x_r + margin) / 16.0f) + 1.0f;
+    if (!(first <= last || first > last)) return whole;  // NaN
+    first = first > float(rect_x0) ? first : float(rect_x0);
+    first = first < float(rect_x1) ? first : float(rect_x1);
+    last = last > first ? last : first;
+    last = last < float(rect_x1) ? last : float(rect_x1);
+    return uint(first) | (uint(last) << 16u);
+}
+
+// Tiles of a span from TileRowSpan.
+OPEN3D_SHADER_FUNC uint TileSpanCount(uint span) { return (span >> 16u) - (span & 0xFFFFu); }
 #undef OPEN3D_SHADER_FUNC
 #undef OPEN3D_SHADER_PRECISE
 

@@ -4,8 +4,9 @@
 // is its own SPIR-V module that defines OPEN3D_COMPOSITE_COLOR_FORMAT and includes this.
 //
 // One workgroup per 16x16 tile, one invocation per pixel. A fixed grid of workgroups steals
-// tiles from a global atomic counter until none is left. A tile's entries are the range of
-// the tile-sorted entry keys found by binary search (depth order preserved inside a tile);
+// tiles from a global atomic counter until none is left. A tile's entries are its range of
+// the tile-sorted entries, found beforehand by gaussian_tile_ranges.comp (depth order
+// preserved inside a tile);
 // its splats are loaded cooperatively into shared memory in batches of 256 and blended front
 // to back with exactly the 3DGS rules (docs/DESIGN.md section 3, cpu/Composite.cpp).
 #ifndef OPEN3D_GAUSSIAN_COMPOSITE_GLSL
@@ -27,17 +28,12 @@ layout(push_constant, std430) uniform PushConstantsBlock {
 layout(std430, set = 0, binding = kCompositeProjectedBinding) readonly buffer ProjectedBlock {
     GaussianProjectedSplat projected[];
 };
-layout(std430, set = 0, binding = kCompositeEntryKeysBinding) readonly buffer KeysBlock {
-    uint entry_keys[];  // tile index, ascending
-};
 layout(std430, set = 0, binding = kCompositeEntryValuesBinding) readonly buffer ValuesBlock {
     uint entry_values[];  // splat index, front to back inside a tile
 };
-layout(std430, set = 0, binding = kCompositeCountBinding) readonly buffer CountBlock {
-    uint counts[];
-};
 layout(std430, set = 0, binding = kCompositeStateBinding) coherent buffer StateBlock {
     GaussianCompositeState state;
+    uvec2 tile_ranges[];  // [begin, end) of each tile's entries (gaussian_tile_ranges.comp)
 };
 layout(set = 0, binding = kCompositeColorBinding, OPEN3D_COMPOSITE_COLOR_FORMAT) writeonly
 uniform image2D out_color;
@@ -52,23 +48,8 @@ shared vec4 s_center_depth_opacity[kCompositeBatchSize];
 shared vec4 s_conic[kCompositeBatchSize];
 shared vec4 s_color[kCompositeBatchSize];
 shared uint s_tile;
-shared uint s_range[2];
 // Pixels of the current tile that need no more splats (outside the image or T-stopped).
 shared uint s_done;
-
-// First entry whose tile is >= tile, in [0, count).
-uint LowerBound(uint tile, uint count) {
-    uint lo = 0u, hi = count;
-    while (lo < hi) {
-        uint mid = (lo + hi) >> 1u;
-        if (entry_keys[mid] < tile) {
-            lo = mid + 1u;
-        } else {
-            hi = mid;
-        }
-    }
-    return lo;
-}
 
 // View-space z of the scene at a pixel. The texture holds Filament's reversed-Z depth
 // d = near / z_view (infinite far plane, cleared to 0), so z_view = near / d; d <= 0 (clear,
@@ -130,13 +111,11 @@ void main() {
     uvec2 size = pc.image.xy;
     uint tiles_x = pc.image.z;
     uint num_tiles = pc.image.z * pc.image.w;
-    uint count = min(counts[pc.entries.x], pc.entries.y);
     // Workgroup i starts with tile i, then steals tiles num_workgroups, num_workgroups + 1...
     // from the counter: with as many workgroups as tiles (CPU devices) each does one tile.
     uint tile = gl_WorkGroupID.x;
 
     while (tile < num_tiles) {  // uniform: tile comes from shared memory after a barrier
-        if (local < 2u) s_range[local] = LowerBound(tile + local, count);
         if (local == 0u) s_done = 0u;
 
         ivec2 pixel = ivec2((tile % tiles_x) * kCompositeTileSize + local % kCompositeTileSize,
@@ -153,10 +132,11 @@ void main() {
         p.median_depth = 0.0;
         p.median_found = false;
         p.done = !inside;
-        barrier();  // s_range visible; s_done reset before the increments below
+        barrier();  // s_done reset before the increments below
         if (p.done) atomicAdd(s_done, 1u);
-        uint begin = s_range[0];
-        uint end = s_range[1];
+        uvec2 range = tile_ranges[tile];
+        uint begin = range.x;
+        uint end = range.y;
 
         for (uint batch = begin; batch < end; batch += kCompositeBatchSize) {
             barrier();  // the previous batch is consumed and its s_done increments made
@@ -198,7 +178,7 @@ void main() {
             imageStore(out_median_depth, pixel, vec4(p.median_depth));
         }
         // Claim the next tile. The barrier also makes sure every invocation has read
-        // s_range and s_done before they are reset for that tile.
+        // s_done before it is reset for that tile.
         barrier();
         if (local == 0u) s_tile = gl_NumWorkGroups.x + atomicAdd(state.next_tile, 1u);
         barrier();

@@ -69,14 +69,28 @@ void main() {
                                                 view.clip.z, view.clip.w)
                            : 0.0;
     uint tile_bits = view.limits.w;
+    vec4 cdo = projected[splat].center_depth_opacity;
+    vec4 conic = projected[splat].conic;
+    float det_q = projected[splat].color.w;
     uint out_index = begin;
-    for (uint ty = min_y; ty < max_y; ++ty) {
-        for (uint tx = min_x; tx < max_x; ++tx) {
+    for (uint ty = min_y; ty < max_y && out_index < end; ++ty) {
+        uint span = TileRowSpan(cdo.x, cdo.y, conic.x, conic.y, conic.z, det_q, conic.w, ty,
+                                min_x, max_x);
+        uint last = min(span >> 16u, (span & 0xFFFFu) + (end - out_index));
+        for (uint tx = span & 0xFFFFu; tx < last; ++tx) {
             uint tile = ty * tiles_x + tx;
             entry_keys[out_index] =
                 kEmitMode == kEmitPackedKeys ? PackedSortKey(tile, norm_depth, tile_bits) : tile;
             entry_values[out_index] = splat;
             ++out_index;
         }
+    }
+    // The projection counted these spans from the same stored values with the same
+    // `precise` code, so this never runs; should a driver still round differently, the
+    // slots get a key past every tile (tile bits cover tiles_x * tiles_y + 1 values), which
+    // sorts last and is never composited, instead of leaving stale entries.
+    for (; out_index < end; ++out_index) {
+        entry_keys[out_index] = 0xFFFFFFFFu;
+        entry_values[out_index] = splat;
     }
 }

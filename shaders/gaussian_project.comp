@@ -201,15 +201,24 @@ bool Project(uint i, out float depth) {
     uvec2 rect_min = uvec2(TileBound(px - r, tiles_x), TileBound(py - r, tiles_y));
     uvec2 rect_max = uvec2(TileBound(px + r + float(kGaussianTileSize - 1u), tiles_x),
                            TileBound(py + r + float(kGaussianTileSize - 1u), tiles_y));
-    uint num_tiles = (rect_max.x - rect_min.x) * (rect_max.y - rect_min.y);
-    if (num_tiles == 0u) return false;
+    if (rect_max.x == rect_min.x || rect_max.y == rect_min.y) return false;
+
+    // Tiles of the rectangle that the alpha >= 1/255 ellipse meets (TileRowSpan): the
+    // entries this splat will emit. A visible splat may emit none (opacity < 1/255).
+    float opacity = position_opacity.w * opacity_scale;
+    float det_q = 1.0 / det;  // a c - b^2 of the conic, without its cancellation
+    float cull_t = TileCullThreshold(opacity, conic.x, conic.z, det_q);
+    uint num_tiles = 0u;
+    for (uint ty = rect_min.y; ty < rect_max.y; ++ty) {
+        num_tiles += TileSpanCount(TileRowSpan(px, py, conic.x, conic.y, conic.z, det_q, cull_t,
+                                               ty, rect_min.x, rect_max.x));
+    }
 
     vec3 color = ShColor(i, rel);
     GaussianProjectedSplat out_splat;
-    out_splat.center_depth_opacity =
-        vec4(px, py, sort_depth, position_opacity.w * opacity_scale);
-    out_splat.conic = vec4(conic, 0.0);
-    out_splat.color = vec4(color, 0.0);
+    out_splat.center_depth_opacity = vec4(px, py, sort_depth, opacity);
+    out_splat.conic = vec4(conic, cull_t);
+    out_splat.color = vec4(color, det_q);
     out_splat.tiles = uvec4(rect_min.x | (rect_min.y << 16u), rect_max.x | (rect_max.y << 16u),
                             num_tiles, radius);
     projected[i] = out_splat;

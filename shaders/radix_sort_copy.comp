@@ -24,9 +24,10 @@ layout(std430, set = 0, binding = kRadixSortValuesOutBinding) writeonly buffer V
 
 void main() {
     uint count = params.count;
-    uint block_begin = gl_WorkGroupID.x * kRadixSortBlockSize;
-    for (uint i = 0u; i < kRadixSortItemsPerInvocation; ++i) {
-        uint index = block_begin + i * kRadixSortWorkgroupSize + gl_LocalInvocationIndex;
+    uint block_size = params.block_size;
+    uint block_begin = gl_WorkGroupID.x * block_size;
+    for (uint i = gl_LocalInvocationIndex; i < block_size; i += kRadixSortWorkgroupSize) {
+        uint index = block_begin + i;
         if (index < count) {
             keys_out[index] = keys_in[index];
             values_out[index] = values_in[index];

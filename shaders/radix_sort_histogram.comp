@@ -24,9 +24,10 @@ void main() {
     s_counts[local] = 0u;
     barrier();
     uint count = params.count;
-    uint block_begin = gl_WorkGroupID.x * kRadixSortBlockSize;
-    for (uint i = 0u; i < kRadixSortItemsPerInvocation; ++i) {
-        uint index = block_begin + i * kRadixSortWorkgroupSize + local;
+    uint block_size = params.block_size;
+    uint block_begin = gl_WorkGroupID.x * block_size;
+    for (uint i = local; i < block_size; i += kRadixSortWorkgroupSize) {
+        uint index = block_begin + i;
         if (index < count) atomicAdd(s_counts[DigitOf(keys_in[index])], 1u);
     }
     barrier();

@@ -81,9 +81,10 @@ void main() {
                 digit_base + histogram[kRadixSortBins + g_slot * num_blocks + block];
     }
 
-    uint block_begin = block * kRadixSortBlockSize;
-    for (uint chunk = 0u; chunk < kRadixSortItemsPerInvocation; ++chunk) {
-        uint chunk_begin = block_begin + chunk * kRadixSortWorkgroupSize;
+    uint block_size = params.block_size;
+    uint block_begin = block * block_size;
+    for (uint chunk_begin = block_begin; chunk_begin < block_begin + block_size;
+         chunk_begin += kRadixSortWorkgroupSize) {
         if (chunk_begin >= count) break;  // uniform over the workgroup
         uint num_valid = min(count - chunk_begin, kRadixSortWorkgroupSize);
 

@@ -157,9 +157,9 @@ int EvaluatedShDegree(const RenderConfig& config, int packed_sh_degree) {
 }
 
 uint32_t SortKeyTileBits(uint64_t num_tiles) {
-    // ceil(log2(n)) = bit width of n - 1: 4096 tiles (indices 0..4095) need 12 bits.
-    const uint32_t bits =
-        num_tiles <= 1 ? 0u : static_cast<uint32_t>(std::bit_width(num_tiles - 1));
+    // Tile indices 0..n - 1 plus one key past them (gaussian_emit.comp's filler for a
+    // span it could not reproduce): the bit width of n, 13 bits for 4096 tiles.
+    const uint32_t bits = static_cast<uint32_t>(std::bit_width(num_tiles));
     return std::clamp(bits, shader::kSortKeyMinTileBits, shader::kSortKeyMaxTileBits);
 }
 

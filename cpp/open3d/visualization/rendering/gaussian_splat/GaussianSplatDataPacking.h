@@ -88,8 +88,8 @@ shader::GaussianViewParams PackGaussianViewParams(const camera::PinholeCamera& c
 /// SH degree the shader evaluates: config.sh_degree clamped to [0, packed degree].
 int EvaluatedShDegree(const RenderConfig& config, int packed_sh_degree);
 
-/// Key bits that hold a tile index: ceil(log2(num_tiles)), clamped to
-/// [shader::kSortKeyMinTileBits, shader::kSortKeyMaxTileBits].
+/// Key bits that hold a tile index or the one key past them (gaussian_emit.comp's filler):
+/// bit width of num_tiles, clamped to [shader::kSortKeyMinTileBits, kSortKeyMaxTileBits].
 uint32_t SortKeyTileBits(uint64_t num_tiles);
 
 /// Far plane of the packed key's depth normalisation: the largest view depth of the eight

@@ -38,6 +38,10 @@ struct CompositeInputs {
     /// A splat is skipped at a pixel when its depth is greater than the scene depth there;
     /// values <= 0 mean no geometry at that pixel (as Filament's cleared depth does).
     const t::geometry::Image* scene_depth = nullptr;
+    /// False: GPU backends composite without copying the images to the host (`output`'s
+    /// images are left as they were); the CPU backend ignores it. Benchmarks time frames
+    /// this way so that the GPU is not left idle, its clocks falling, during the copies.
+    bool read_back = true;
 };
 
 class GaussianSplatBackend {

@@ -24,7 +24,7 @@ TEST(CpuTileLists, ListsMatchRectanglesAndAreSortedByDepth) {
     const TileLists lists = BuildTileLists(splats, grid, RenderConfig{});
     EXPECT_EQ(lists.error_flags, 0u);
     int64_t expected_entries = 0;
-    for (const auto& s : splats) expected_entries += s.IsVisible() ? s.NumTiles() : 0;
+    for (const auto& s : splats) expected_entries += s.IsVisible() ? s.NumEntries() : 0;
     EXPECT_EQ(lists.NumEntries(), expected_entries);
     ASSERT_GT(expected_entries, 1000);
     for (int64_t t = 0; t < grid.NumTiles(); ++t) {
@@ -34,6 +34,8 @@ TEST(CpuTileLists, ListsMatchRectanglesAndAreSortedByDepth) {
             ASSERT_TRUE(s.IsVisible());
             ASSERT_TRUE(tx >= s.rect_min_x && tx < s.rect_max_x && ty >= s.rect_min_y &&
                         ty < s.rect_max_y);
+            const auto [first, last] = s.RowSpan(ty);
+            ASSERT_TRUE(tx >= first && tx < last);
             if (k > lists.offsets[t]) {
                 const uint32_t prev = lists.splat_indices[k - 1];
                 const float d0 = splats[prev].sort_depth;
@@ -64,6 +66,7 @@ TEST(CpuTileLists, CapacityLimitsDropEntriesAndFlag) {
     big.scale = {0.5, 0.5, 0.5};  // covers all 16 tiles of 64x64
     const auto splats = ProjectSplats(MakeCloud({big}), MakeTestCamera(), RenderConfig{});
     ASSERT_EQ(splats[0].NumTiles(), 16);
+    ASSERT_EQ(splats[0].NumEntries(), 16);
     RenderConfig config;
     config.max_tiles_per_splat = 15;
     TileLists lists = BuildTileLists(splats, TileGrid::ForImage(64, 64), config);

@@ -22,7 +22,7 @@ TEST(GaussianSplatContract, CompilesAsCpp) {
     EXPECT_EQ(shader::kRadixSortBlockSize,
               shader::kRadixSortWorkgroupSize * shader::kRadixSortItemsPerInvocation);
     EXPECT_EQ(sizeof(shader::RadixSortParams), 32u);
-    EXPECT_EQ(sizeof(shader::RadixSortPushConstants), 16u);
+    EXPECT_EQ(sizeof(shader::RadixSortPushConstants), 32u);
 }
 
 using GaussianSplatContractGpu = VulkanTest;
@@ -42,6 +42,7 @@ TEST_F(GaussianSplatContractGpu, ShaderLayoutMatchesCpp) {
     push.digit_bits = 202;
     push.count_index = 203;
     push.max_count = 204;
+    push.target_blocks = 205;
     SubmitAndWait(Context(), Pool(), [&](VkCommandBuffer cmd) {
         VkDescriptorBufferInfo infos[2] = {{params.Get(), 0, VK_WHOLE_SIZE},
                                            {push_out.Get(), 0, VK_WHOLE_SIZE}};
@@ -70,7 +71,7 @@ TEST_F(GaussianSplatContractGpu, ShaderLayoutMatchesCpp) {
     EXPECT_EQ(p.count, 104u);
     EXPECT_EQ(p.num_blocks, 105u);
     EXPECT_EQ(p.flags, 106u);
-    EXPECT_EQ(p.reserved0, 107u);
+    EXPECT_EQ(p.block_size, 107u);
     EXPECT_EQ(p.reserved1, 108u);
     shader::RadixSortPushConstants q;
     std::memcpy(&q, push_out.GetMapped(), sizeof(q));
@@ -78,6 +79,7 @@ TEST_F(GaussianSplatContractGpu, ShaderLayoutMatchesCpp) {
     EXPECT_EQ(q.digit_bits, 202u);
     EXPECT_EQ(q.count_index, 203u);
     EXPECT_EQ(q.max_count, 204u);
+    EXPECT_EQ(q.target_blocks, 205u);
 }
 
 }  // namespace

@@ -285,7 +285,11 @@ TEST_F(RadixSortTest, StorageRequirements) {
     const auto need = RadixSort::GetStorageRequirements(10000);
     EXPECT_EQ(need.keys_alt_bytes, 40000u);
     EXPECT_EQ(need.values_alt_bytes, 40000u);
-    EXPECT_EQ(need.histogram_bytes, (256u + 256u * 3u) * 4u);  // ceil(10000 / 4096) = 3 blocks
+    // Up to kRadixSortTargetBlocks blocks of >= 256 elements: ceil(10000 / 256) = 40 blocks.
+    EXPECT_EQ(need.histogram_bytes, (256u + 256u * 40u) * 4u);
+    // Past 1024 * 4096 elements the blocks are 4096 long: 2^23 elements -> 2048 blocks.
+    EXPECT_EQ(RadixSort::GetStorageRequirements(1u << 23).histogram_bytes,
+              (256u + 256u * 2048u) * 4u);
     EXPECT_EQ(need.params_bytes, sizeof(shader::RadixSortParams));
     EXPECT_TRUE(need.params_usage & VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT);
     EXPECT_GT(RadixSort::GetStorageRequirements(0).keys_alt_bytes, 0u);  // no empty buffers

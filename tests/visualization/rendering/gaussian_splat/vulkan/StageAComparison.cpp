@@ -12,6 +12,14 @@ namespace tests {
 
 namespace {
 
+// shader::TileRowSpan of row ty on the GPU's own stored record (the emit pass's inputs).
+uint32_t GpuRowSpan(const visualization::rendering::shader::GaussianProjectedSplat& g,
+                    uint32_t ty) {
+    return visualization::rendering::shader::TileRowSpan(
+        g.center_depth_opacity.x, g.center_depth_opacity.y, g.conic.x, g.conic.y, g.conic.z,
+        g.color.w, g.conic.w, ty, g.tiles.x & 0xFFFFu, g.tiles.y & 0xFFFFu);
+}
+
 using visualization::rendering::kTileSize;
 using visualization::rendering::RenderConfig;
 using namespace visualization::rendering::cpu;
@@ -59,20 +67,17 @@ using OrderKey = std::pair<float, uint32_t>;  // (float32 depth, splat index)
 
 std::string StageAComparison::Summary() const {
     return fmt::format(
-        "splats {} visible cpu/gpu {}/{} cull flips {} (unexplained {}) | max "
-        "err: centre "
-        "{:.3g} px, depth {:.3g} rel, conic {:.3g} rel, opacity {:.3g}, colour "
-        "{:.3g}; radius "
-        "+-1 {} (more {}), rect differs {} | entries cpu/gpu {}/{}, border "
-        "splats {} "
-        "(entries {}), tiles misordered {}, depth-rounding swaps {} (max gap "
-        "{:.3g} rel), "
-        "visible list misordered {}",
+        "splats {} visible cpu/gpu {}/{} cull flips {} (unexplained {}) | max err: centre "
+        "{:.3g} px, depth {:.3g} rel, conic {:.3g} rel, opacity {:.3g}, colour {:.3g}; radius "
+        "+-1 {} (more {}), rect differs {}, span differs {} | entries cpu/gpu {}/{}, border "
+        "splats {} (entries {}), tiles misordered {}, gpu span mismatches {}, depth-rounding "
+        "swaps {} (max gap {:.3g} rel), visible list misordered {}",
         num_splats, visible_cpu, visible_gpu, cull_flips, cull_flips_unexplained, errors.center_px,
         errors.depth_rel, errors.conic_rel, errors.opacity_abs, errors.color_abs,
-        errors.radius_off_by_one, errors.radius_off_more, errors.rect_differs, entries_cpu,
-        entries_gpu, border_splats.size(), border_entries, tiles_misordered, depth_rounding_swaps,
-        depth_rounding_swap_max_rel, visible_list_misordered);
+        errors.radius_off_by_one, errors.radius_off_more, errors.rect_differs, errors.span_differs,
+        entries_cpu, entries_gpu, border_splats.size(), border_entries, tiles_misordered,
+        gpu_span_mismatches, depth_rounding_swaps, depth_rounding_swap_max_rel,
+        visible_list_misordered);
 }
 
 StageAComparison CompareStageA(const t::geometry::PointCloud& cloud,
@@ -124,6 +129,16 @@ StageAComparison CompareStageA(const t::geometry::PointCloud& cloud,
             ++e.rect_differs;
             if (!DecisionNearBorder(r, config, gpu_radius)) ++c.cull_flips_unexplained;
             border.insert(static_cast<uint32_t>(i));
+            continue;
+        }
+        for (int ty = r.rect_min_y; ty < r.rect_max_y; ++ty) {
+            const auto [first, last] = r.RowSpan(ty);
+            const uint32_t span = GpuRowSpan(*g, uint32_t(ty));
+            if (uint32_t(first) != (span & 0xFFFFu) || uint32_t(last) != (span >> 16)) {
+                ++e.span_differs;
+                border.insert(static_cast<uint32_t>(i));
+                break;
+            }
         }
     }
     c.border_splats.assign(border.begin(), border.end());
@@ -145,9 +160,25 @@ StageAComparison CompareStageA(const t::geometry::PointCloud& cloud,
     c.entries_cpu = lists.NumEntries();
     c.entries_gpu = static_cast<int64_t>(gpu.entry_tiles.size());
     std::vector<std::vector<uint32_t>> gpu_tiles(grid.NumTiles());
+    std::vector<int64_t> gpu_entries_of(n, 0);
     for (size_t k = 0; k < gpu.entry_tiles.size(); ++k) {
         if (k > 0 && gpu.entry_tiles[k] < gpu.entry_tiles[k - 1]) ++c.tiles_misordered;
+        if (gpu.entry_tiles[k] >= uint32_t(grid.NumTiles())) {  // gaussian_emit's filler
+            ++c.gpu_span_mismatches;
+            continue;
+        }
         gpu_tiles.at(gpu.entry_tiles[k]).push_back(gpu.entry_splats[k]);
+        ++gpu_entries_of.at(gpu.entry_splats[k]);
+    }
+    // Each emitting splat's GPU entries are exactly the spans of its own record.
+    for (uint32_t i : gpu.visible_in_depth_order) {
+        if (gpu_entries_of[i] == 0) continue;  // dropped by a limit, or no tile to emit
+        const shader::GaussianProjectedSplat& g = gpu.projected.at(i);
+        int64_t expected = 0;
+        for (uint32_t ty = g.tiles.x >> 16; ty < (g.tiles.y >> 16); ++ty) {
+            expected += shader::TileSpanCount(GpuRowSpan(g, ty));
+        }
+        if (expected != gpu_entries_of[i]) ++c.gpu_span_mismatches;
     }
     std::set<std::pair<uint32_t, uint32_t>> swapped_pairs;
     for (int64_t t = 0; t < grid.NumTiles(); ++t) {

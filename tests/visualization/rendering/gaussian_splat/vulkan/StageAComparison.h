@@ -31,6 +31,9 @@ struct ProjectionErrors {
     int64_t radius_off_by_one = 0;  ///< ceil() landed on the other integer
     int64_t radius_off_more = 0;    ///< must stay 0
     int64_t rect_differs = 0;       ///< tile rect differs (explained by radius or border)
+    /// Same rect, but a row's culled span (shader::TileRowSpan) differs: the float32 inputs
+    /// (centre, conic, opacity) differ by rounding on the two sides.
+    int64_t span_differs = 0;
 };
 
 struct StageAComparison {
@@ -57,6 +60,9 @@ struct StageAComparison {
     /// Largest relative depth gap of such a pair (must be a rounding-sized gap).
     double depth_rounding_swap_max_rel = 0.0;
     int64_t visible_list_misordered = 0;  ///< GPU visible list not sorted by its own keys
+    /// Splats whose GPU entries (when it emitted any) are not the TileRowSpan tiles of its
+    /// own stored record, computed here in C++, plus filler entries: a shader bug; must stay 0.
+    int64_t gpu_span_mismatches = 0;
 
     std::string Summary() const;
 };

@@ -42,14 +42,15 @@ uint32_t TileBitsFor(int width, int height) {
 }
 
 TEST(StageAPackedKey, TileAndDepthBitsAtCommonResolutions) {
-    // The seed's table (16x16 tiles): 1080p 8160 tiles, 4K 32400, 8K 129600. Of the D
+    // The seed's table (16x16 tiles): 1080p 8160 tiles, 4K 32400, 8K 129600 (256x256: 256
+    // tiles and the filler key need 9 bits). Of the D
     // depth bits, 8 hold the float exponent, so D - 8 mantissa bits resolve depth.
     struct Case {
         int width, height;
         uint32_t tile_bits, depth_bits;
     };
     for (const Case& c : {Case{1920, 1080, 13, 19}, Case{3840, 2160, 15, 17},
-                          Case{7680, 4320, 17, 15}, Case{256, 256, 8, 24}}) {
+                          Case{7680, 4320, 17, 15}, Case{256, 256, 9, 23}}) {
         const uint32_t t = TileBitsFor(c.width, c.height);
         EXPECT_EQ(t, c.tile_bits) << c.width << "x" << c.height;
         EXPECT_EQ(shader::kSortKeyBits - t, c.depth_bits) << c.width << "x" << c.height;
@@ -59,15 +60,16 @@ TEST(StageAPackedKey, TileAndDepthBitsAtCommonResolutions) {
 }
 
 TEST(StageAPackedKey, TileBitsAtExactPowersOfTwo) {
+    // Keys 0 .. n: the n tile indices and the filler key n (gaussian_emit.comp).
     EXPECT_EQ(SortKeyTileBits(0), 1u);  // clamped to kSortKeyMinTileBits
     EXPECT_EQ(SortKeyTileBits(1), 1u);
-    EXPECT_EQ(SortKeyTileBits(2), 1u);
+    EXPECT_EQ(SortKeyTileBits(2), 2u);
     EXPECT_EQ(SortKeyTileBits(3), 2u);
-    for (uint32_t bits = 2; bits <= 31; ++bits) {
+    for (uint32_t bits = 2; bits <= 30; ++bits) {
         const uint64_t tiles = uint64_t(1) << bits;
-        EXPECT_EQ(SortKeyTileBits(tiles), bits) << tiles;      // indices 0 .. 2^bits - 1
-        EXPECT_EQ(SortKeyTileBits(tiles - 1), bits) << tiles;  // 2^bits - 2 needs as many
-        EXPECT_EQ(SortKeyTileBits(tiles + 1), std::min(bits + 1, 31u)) << tiles;
+        EXPECT_EQ(SortKeyTileBits(tiles - 1), bits) << tiles;  // keys 0 .. 2^bits - 1
+        EXPECT_EQ(SortKeyTileBits(tiles), bits + 1) << tiles;  // key 2^bits needs one more
+        EXPECT_EQ(SortKeyTileBits(tiles + 1), bits + 1) << tiles;
     }
     EXPECT_EQ(SortKeyTileBits(uint64_t(1) << 40), 31u);  // clamped to kSortKeyMaxTileBits
 }

@@ -37,11 +37,11 @@ TEST(StageAPacking, SortKeyTileBits) {
     EXPECT_EQ(SortKeyTileBits(120 * 68), 13u);   // 8,160 tiles
     EXPECT_EQ(SortKeyTileBits(240 * 135), 15u);  // 32,400
     EXPECT_EQ(SortKeyTileBits(480 * 270), 17u);  // 129,600
-    // Exact powers of two: indices 0..2^k - 1 need k bits, one more tile needs k
-    // + 1.
+    // Exact powers of two: 2^k - 1 tiles and the filler key fit k bits; 2^k tiles and
+    // the filler need k + 1.
     for (uint32_t k = 1; k < 31; ++k) {
-        EXPECT_EQ(SortKeyTileBits(uint64_t(1) << k), k) << k;
-        EXPECT_EQ(SortKeyTileBits((uint64_t(1) << k) + 1), k + 1) << k;
+        EXPECT_EQ(SortKeyTileBits((uint64_t(1) << k) - 1), k) << k;
+        EXPECT_EQ(SortKeyTileBits(uint64_t(1) << k), k + 1) << k;
     }
     EXPECT_EQ(SortKeyTileBits(1), shader::kSortKeyMinTileBits);  // clamped up to 1
     EXPECT_EQ(SortKeyTileBits(uint64_t(1) << 40), shader::kSortKeyMaxTileBits);

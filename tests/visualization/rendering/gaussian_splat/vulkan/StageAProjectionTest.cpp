@@ -60,6 +60,7 @@ protected:
         EXPECT_EQ(c.cull_flips_unexplained, 0) << c.Summary();
         EXPECT_EQ(c.errors.radius_off_more, 0) << c.Summary();
         EXPECT_EQ(c.tiles_misordered, 0) << c.Summary();
+        EXPECT_EQ(c.gpu_span_mismatches, 0) << c.Summary();
         EXPECT_EQ(c.visible_list_misordered, 0) << c.Summary();
         EXPECT_LE(c.errors.center_px, kCenterTolPx) << c.Summary();
         EXPECT_LE(c.errors.depth_rel, kDepthTolRel) << c.Summary();

@@ -83,6 +83,7 @@ protected:
         EXPECT_EQ(a.cull_flips_unexplained, 0) << a.Summary();
         EXPECT_EQ(a.errors.radius_off_more, 0) << a.Summary();
         EXPECT_EQ(a.tiles_misordered, 0) << a.Summary();
+        EXPECT_EQ(a.gpu_span_mismatches, 0) << a.Summary();
         EXPECT_EQ(a.visible_list_misordered, 0) << a.Summary();
         // The cases keep their splats clear of tile borders, so no flip is allowed at all.
         EXPECT_EQ(a.border_splats.size(), 0u) << a.Summary();
@@ -500,6 +501,7 @@ TEST_F(Stress, Resolution8KStageA) {
     EXPECT_EQ(a.errors.rect_differs, 0) << a.Summary();
     EXPECT_EQ(a.errors.radius_off_more, 0) << a.Summary();
     EXPECT_EQ(a.tiles_misordered, 0) << a.Summary();
+    EXPECT_EQ(a.gpu_span_mismatches, 0) << a.Summary();
     EXPECT_EQ(a.visible_list_misordered, 0) << a.Summary();
     EXPECT_EQ(a.entries_gpu, a.entries_cpu);
     ASSERT_FALSE(gpu.entry_tiles.empty());

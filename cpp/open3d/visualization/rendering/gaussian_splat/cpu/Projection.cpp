@@ -27,6 +27,7 @@ void FinishEllipse(double det_raw, double det, bool antialias, ScreenEllipse& e)
     e.conic_a = e.cov_c / det;
     e.conic_b = -e.cov_b / det;
     e.conic_c = e.cov_a / det;
+    e.det_q = 1.0 / det;
     // lambda_max = mid + sqrt(max(0.1, mid^2 - det)), with mid^2 - det written as
     // ((a - c) / 2)^2 + b^2 (the same value, without the cancellation).
     const double mid = 0.5 * (e.cov_a + e.cov_c);
@@ -161,6 +162,7 @@ ProjectedSplat ProjectOne(const ViewParams& view, const RenderConfig& config, in
     out.conic_a = e.conic_a;
     out.conic_b = e.conic_b;
     out.conic_c = e.conic_c;
+    out.det_q = e.det_q;
     out.radius = e.radius;
     ComputeTileRect(out.x, out.y, out.radius, view.grid, out);
     if (out.NumTiles() == 0) {
@@ -178,6 +180,24 @@ ProjectedSplat ProjectOne(const ViewParams& view, const RenderConfig& config, in
 }
 
 }  // namespace
+
+std::pair<int, int> ProjectedSplat::RowSpan(int ty) const {
+    const float t =
+        shader::TileCullThreshold(float(opacity), float(conic_a), float(conic_c), float(det_q));
+    const uint32_t span = shader::TileRowSpan(float(x), float(y), float(conic_a), float(conic_b),
+                                              float(conic_c), float(det_q), t, uint32_t(ty),
+                                              uint32_t(rect_min_x), uint32_t(rect_max_x));
+    return {int(span & 0xFFFFu), int(span >> 16)};
+}
+
+int64_t ProjectedSplat::NumEntries() const {
+    int64_t n = 0;
+    for (int ty = rect_min_y; ty < rect_max_y; ++ty) {
+        const auto [first, last] = RowSpan(ty);
+        n += last - first;
+    }
+    return n;
+}
 
 std::vector<ProjectedSplat> ProjectSplats(const t::geometry::PointCloud& cloud,
                                           const camera::PinholeCamera& camera,

@@ -4,6 +4,7 @@
 
 #include <array>
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "open3d/camera/PinholeCamera.h"
@@ -36,6 +37,8 @@ struct ProjectedSplat {
     double cov_a = 0.0, cov_b = 0.0, cov_c = 0.0;
     /// Inverse of the dilated covariance: [[conic_a, conic_b], [conic_b, conic_c]].
     double conic_a = 0.0, conic_b = 0.0, conic_c = 0.0;
+    /// conic_a conic_c - conic_b^2 = 1 / det(dilated cov); 0 (unknown) keeps whole rows.
+    double det_q = 0.0;
     int radius = 0;                 ///< ceil(3 sqrt(lambda_max)) in pixels
     double opacity = 0.0;           ///< sigmoid(logit), times the antialias factor when enabled
     std::array<double, 3> color{};  ///< max(0, 0.5 + SH(direction))
@@ -43,9 +46,15 @@ struct ProjectedSplat {
     int rect_min_x = 0, rect_min_y = 0, rect_max_x = 0, rect_max_y = 0;
 
     bool IsVisible() const { return cull == CullReason::kVisible; }
+    /// Tiles of the 3DGS rectangle.
     int64_t NumTiles() const {
         return static_cast<int64_t>(rect_max_x - rect_min_x) * (rect_max_y - rect_min_y);
     }
+    /// Columns [first, last) of tile row ty (in the rectangle) that get an entry:
+    /// shader::TileRowSpan on this splat's values rounded to float32, as the GPU stores them.
+    std::pair<int, int> RowSpan(int ty) const;
+    /// Entries the splat emits: the rectangle's tiles that RowSpan keeps.
+    int64_t NumEntries() const;
 };
 
 /// Tiles covering the image: ceil(W / 16) x ceil(H / 16).
@@ -63,6 +72,7 @@ struct ScreenEllipse {
     bool degenerate = false;  ///< det of the dilated covariance == 0
     double cov_a = 0.0, cov_b = 0.0, cov_c = 0.0;
     double conic_a = 0.0, conic_b = 0.0, conic_c = 0.0;
+    double det_q = 0.0;  ///< 1 / det of the dilated covariance
     int radius = 0;
     double opacity_scale = 1.0;  ///< antialias factor (1 when antialias is off)
 };

@@ -40,7 +40,7 @@ TileLists BuildTileLists(const std::vector<ProjectedSplat>& splats, const TileGr
     emitting.reserve(order.size());
     uint64_t total = 0;
     for (uint32_t index : order) {
-        const uint64_t tiles = static_cast<uint64_t>(splats[index].NumTiles());
+        const uint64_t tiles = static_cast<uint64_t>(splats[index].NumEntries());
         if (tiles > config.max_tiles_per_splat) {  // this splat alone emits nothing
             lists.error_flags |= kEntriesDropped;
             continue;
@@ -57,24 +57,23 @@ TileLists BuildTileLists(const std::vector<ProjectedSplat>& splats, const TileGr
 
     // Counting sort by tile: stable, so each tile keeps the depth order.
     lists.offsets.assign(grid.NumTiles() + 1, 0);
-    for (uint32_t index : emitting) {
-        const ProjectedSplat& s = splats[index];
+    // Only the tiles the splat can change (ProjectedSplat::RowSpan, the GPU's culling).
+    const auto for_each_tile = [&](const ProjectedSplat& s, auto&& visit) {
         for (int ty = s.rect_min_y; ty < s.rect_max_y; ++ty) {
-            for (int tx = s.rect_min_x; tx < s.rect_max_x; ++tx) {
-                ++lists.offsets[static_cast<int64_t>(ty) * grid.tiles_x + tx + 1];
-            }
+            const auto [first, last] = s.RowSpan(ty);
+            for (int tx = first; tx < last; ++tx)
+                visit(static_cast<int64_t>(ty) * grid.tiles_x + tx);
         }
+    };
+    for (uint32_t index : emitting) {
+        for_each_tile(splats[index], [&](int64_t tile) { ++lists.offsets[tile + 1]; });
     }
     for (size_t t = 1; t < lists.offsets.size(); ++t) lists.offsets[t] += lists.offsets[t - 1];
     std::vector<uint64_t> cursor(lists.offsets.begin(), lists.offsets.end() - 1);
     lists.splat_indices.resize(total);
     for (uint32_t index : emitting) {
-        const ProjectedSplat& s = splats[index];
-        for (int ty = s.rect_min_y; ty < s.rect_max_y; ++ty) {
-            for (int tx = s.rect_min_x; tx < s.rect_max_x; ++tx) {
-                lists.splat_indices[cursor[static_cast<int64_t>(ty) * grid.tiles_x + tx]++] = index;
-            }
-        }
+        for_each_tile(splats[index],
+                      [&](int64_t tile) { lists.splat_indices[cursor[tile]++] = index; });
     }
     return lists;
 }

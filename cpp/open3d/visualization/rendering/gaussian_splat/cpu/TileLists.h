@@ -28,8 +28,9 @@ struct TileLists {
 /// Visible splats in composite order: ascending float32(depth), ties by splat index.
 std::vector<uint32_t> SortVisibleByDepth(const std::vector<ProjectedSplat>& splats);
 
-/// Builds the sorted per-tile lists. Limits: a splat touching more than
-/// config.max_tiles_per_splat tiles emits nothing; once config.max_tile_entries_total
+/// Builds the sorted per-tile lists: each splat in the tiles of its rectangle that its
+/// alpha >= 1/255 ellipse meets (ProjectedSplat::RowSpan). Limits: a splat with more than
+/// config.max_tiles_per_splat such tiles emits nothing; once config.max_tile_entries_total
 /// would be exceeded, farther splats emit nothing. Both set kEntriesDropped.
 TileLists BuildTileLists(const std::vector<ProjectedSplat>& splats, const TileGrid& grid,
                          const RenderConfig& config);

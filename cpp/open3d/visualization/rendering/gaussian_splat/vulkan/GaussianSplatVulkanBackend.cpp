@@ -60,10 +60,7 @@ GaussianSplatVulkanBackend::GaussianSplatVulkanBackend(std::unique_ptr<VulkanCon
       stage_b_(*context_),
       stage_a_timestamps_(*context_),
       stage_b_timestamps_(*context_),
-      initial_entry_capacity_(std::max(1u, initial_entry_capacity)) {
-    const StageBStorageRequirements need = GaussianStageB::GetStorageRequirements();
-    composite_state_ = Buffer(*context_, need.state_bytes, need.state_usage, MemoryUsage::kDevice);
-}
+      initial_entry_capacity_(std::max(1u, initial_entry_capacity)) {}
 
 GaussianSplatVulkanBackend::~GaussianSplatVulkanBackend() {
     // Nothing may still run on buffers we are about to free.
@@ -126,6 +123,8 @@ void GaussianSplatVulkanBackend::EnsureTargets(uint32_t width, uint32_t height) 
     depth_ = Image(*context_, width, height, need.scalar_format, usage);
     alpha_ = Image(*context_, width, height, need.scalar_format, usage);
     median_ = Image(*context_, width, height, need.scalar_format, usage);
+    composite_state_ = Buffer(*context_, GaussianStageB::StateBytes(width, height),
+                              need.state_usage, MemoryUsage::kDevice);
     width_ = width;
     height_ = height;
 }
@@ -207,7 +206,7 @@ class GaussianSplatVulkanBackend::ReadbackSink final : public CompositeSink {
 public:
     ReadbackSink(GaussianSplatVulkanBackend& backend, const CompositeInputs& inputs,
                  RenderOutput& output)
-        : backend_(backend), output_(output) {
+        : backend_(backend), output_(output), read_back_(inputs.read_back) {
         const uint32_t w = backend.color_.GetWidth(), h = backend.color_.GetHeight();
         if (inputs.scene_depth == nullptr || inputs.scene_depth->IsEmpty()) return;
         // Scene depth (view z) becomes Filament's reversed-Z texture d = near / z.
@@ -245,6 +244,7 @@ public:
     }
 
     void RecordAfter(const Frame& frame) override {
+        if (!read_back_) return;
         const std::pair<const Image*, const Buffer*> copies[] = {
             {&backend_.color_, &backend_.color_readback_},
             {frame.depth, &backend_.depth_readback_},
@@ -258,6 +258,7 @@ public:
     }
 
     void ReadBack() override {
+        if (!read_back_) return;
         const size_t pixels = size_t(backend_.width_) * backend_.height_;
         const int64_t h = backend_.height_, w = backend_.width_;
         output_.color = t::geometry::Image(h, w, 4, core::Dtype::Float32);
@@ -273,6 +274,7 @@ public:
 private:
     GaussianSplatVulkanBackend& backend_;
     RenderOutput& output_;
+    const bool read_back_;
     Image scene_image_;
     Buffer scene_upload_;
     SceneDepthTexture scene_;
@@ -282,8 +284,10 @@ void GaussianSplatVulkanBackend::RenderCompositeStage(RenderOutput& output,
                                                       const CompositeInputs& inputs) {
     if (!geometry_.valid)
         core::ThrowError("Vulkan backend: RenderCompositeStage before RenderGeometryStage");
-    EnsureReadback(static_cast<uint32_t>(geometry_.camera.width),
-                   static_cast<uint32_t>(geometry_.camera.height));
+    if (inputs.read_back) {
+        EnsureReadback(static_cast<uint32_t>(geometry_.camera.width),
+                       static_cast<uint32_t>(geometry_.camera.height));
+    }
     ReadbackSink sink(*this, inputs, output);
     output.stats = RenderComposite(sink);
 }

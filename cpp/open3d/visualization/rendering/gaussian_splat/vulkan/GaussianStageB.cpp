@@ -106,6 +106,8 @@ GaussianStageB::GaussianStageB(const VulkanContext& context) : context_(context)
     composite_set_layout_ = CreatePushLayout(context, composite);
     composite_layout_ = CreatePipelineLayout(context, composite_set_layout_.Get(),
                                              sizeof(GaussianCompositePushConstants));
+    tile_ranges_ = CreateComputePipeline(context, composite_layout_.Get(),
+                                         spirv::kGaussianTileRanges, "gaussian_tile_ranges");
     std::vector<VkDescriptorType> merge(kDepthMergeNumBindings, kStorage);
     merge[kDepthMergeSceneDepthBinding] = kSampled;
     merge_set_layout_ = CreatePushLayout(context, merge);
@@ -115,9 +117,13 @@ GaussianStageB::GaussianStageB(const VulkanContext& context) : context_(context)
 }
 
 StageBStorageRequirements GaussianStageB::GetStorageRequirements() {
-    StageBStorageRequirements requirements;
-    requirements.state_bytes = sizeof(GaussianCompositeState);
-    return requirements;
+    return StageBStorageRequirements{};
+}
+
+VkDeviceSize GaussianStageB::StateBytes(uint32_t width, uint32_t height) {
+    const uint64_t tiles_x = (uint64_t(width) + kCompositeTileSize - 1) / kCompositeTileSize;
+    const uint64_t tiles_y = (uint64_t(height) + kCompositeTileSize - 1) / kCompositeTileSize;
+    return sizeof(GaussianCompositeState) + sizeof(uint32_t) * 2 * tiles_x * tiles_y;
 }
 
 VkPipeline GaussianStageB::GetCompositePipeline(CompositeColorFormat format, bool scene_depth) {
@@ -180,6 +186,11 @@ void GaussianStageB::RecordComposite(VkCommandBuffer cmd, const StageBInputs& in
     if (inputs.entry_count.buffer == VK_NULL_HANDLE || inputs.entry_count.offset % 4 != 0) {
         core::ThrowError("GaussianStageB: entry_count needs a buffer and a 4-byte aligned offset");
     }
+    const VkDeviceSize state_bytes = StateBytes(targets.width, targets.height);
+    if (state.size != VK_WHOLE_SIZE && state.size < state_bytes) {
+        core::ThrowError("GaussianStageB: state holds {} bytes, a {}x{} image needs {}", state.size,
+                         targets.width, targets.height, state_bytes);
+    }
 
     const uint32_t tiles_x = (targets.width + kCompositeTileSize - 1) / kCompositeTileSize;
     const uint32_t tiles_y = (targets.height + kCompositeTileSize - 1) / kCompositeTileSize;
@@ -194,8 +205,8 @@ void GaussianStageB::RecordComposite(VkCommandBuffer cmd, const StageBInputs& in
     const uint32_t workgroups = static_cast<uint32_t>(
         std::min<uint64_t>(num_tiles, std::min(max_workgroups, kMaxWorkgroupsPerDispatch)));
 
-    // Work stealing starts from tile 0 in every dispatch.
-    vkCmdFillBuffer(cmd, state.buffer, state.offset, sizeof(GaussianCompositeState), 0u);
+    // Work stealing starts from tile 0 in every dispatch; tiles without entries keep [0, 0).
+    vkCmdFillBuffer(cmd, state.buffer, state.offset, state_bytes, 0u);
     RecordMemoryBarrier(cmd, VK_PIPELINE_STAGE_2_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
                         VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
                         VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
@@ -216,7 +227,7 @@ void GaussianStageB::RecordComposite(VkCommandBuffer cmd, const StageBInputs& in
         {inputs.entry_keys.buffer, inputs.entry_keys.offset, entry_bytes},
         {inputs.entry_values.buffer, inputs.entry_values.offset, entry_bytes},
         {inputs.entry_count.buffer, count_offset, VK_WHOLE_SIZE},
-        {state.buffer, state.offset, sizeof(GaussianCompositeState)},
+        {state.buffer, state.offset, state_bytes},
     }};
     const std::array<VkDescriptorImageInfo, 5> images{{
         StorageImage(targets.color),
@@ -237,12 +248,25 @@ void GaussianStageB::RecordComposite(VkCommandBuffer cmd, const StageBInputs& in
         ImageWrite(kCompositeMedianDepthBinding, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, &images[3]),
         ImageWrite(kCompositeSceneDepthBinding, VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE, &images[4]),
     }};
-    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE,
-                      GetCompositePipeline(targets.color_format, params.scene_depth != nullptr));
+    // Both pipelines share the layout: descriptors and push constants are set once.
     context_.GetCmdPushDescriptorSet()(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, composite_layout_.Get(),
                                        0, kCompositeNumBindings, writes.data());
     vkCmdPushConstants(cmd, composite_layout_.Get(), VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(push),
                        &push);
+    // Tile ranges: a grid-stride pass over the entries, at most kMaxRangeWorkgroups wide.
+    constexpr uint64_t kMaxRangeWorkgroups = 2048;
+    const uint64_t range_workgroups = std::min<uint64_t>(
+        kMaxRangeWorkgroups,
+        (uint64_t(std::max(inputs.entry_capacity, 1u)) + kCompositeWorkgroupSize - 1) /
+            kCompositeWorkgroupSize);
+    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, tile_ranges_.Get());
+    vkCmdDispatch(cmd, static_cast<uint32_t>(range_workgroups), 1, 1);
+    RecordMemoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                        VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
+                        VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                        VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
+    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE,
+                      GetCompositePipeline(targets.color_format, params.scene_depth != nullptr));
     vkCmdDispatch(cmd, workgroups, 1, 1);
 }
 

@@ -34,8 +34,7 @@ VkFormat ToVkFormat(CompositeColorFormat format);
 
 /// Formats and usages of what the caller allocates for Stage B.
 struct StageBStorageRequirements {
-    /// shader::GaussianCompositeState (work-stealing tile counter), zeroed per dispatch.
-    VkDeviceSize state_bytes = 0;
+    /// Usage of the composite's state buffer (its size: GaussianStageB::StateBytes).
     VkBufferUsageFlags state_usage =
         VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
     /// Expected depth, alpha, median depth and the merged linear depth.
@@ -127,9 +126,13 @@ public:
     explicit GaussianStageB(const VulkanContext& context);
 
     static StageBStorageRequirements GetStorageRequirements();
+    /// Bytes of the composite's state for a width x height image: shader::GaussianCompositeState
+    /// (the work-stealing tile counter) and each tile's entry range, both rewritten per frame.
+    static VkDeviceSize StateBytes(uint32_t width, uint32_t height);
 
-    /// Records the composite: zero `state` (vkCmdFillBuffer), then one dispatch of a fixed
-    /// grid of workgroups that take tiles until all ceil(W/16) x ceil(H/16) are done.
+    /// Records the composite: zero `state` (vkCmdFillBuffer, StateBytes(width, height)), find
+    /// each tile's range of the sorted entries (gaussian_tile_ranges.comp), then one dispatch
+    /// of a fixed grid of workgroups that take tiles until all ceil(W/16) x ceil(H/16) are done.
     ///
     /// Synchronisation: before, the caller makes the inputs (and scene depth) visible to
     /// COMPUTE_SHADER reads, has the targets in GENERAL layout, and orders earlier uses of
@@ -156,6 +159,7 @@ private:
     UniquePipelineLayout composite_layout_;
     UniqueDescriptorSetLayout merge_set_layout_;
     UniquePipelineLayout merge_layout_;
+    UniquePipeline tile_ranges_;
     std::array<UniquePipeline, 4> composite_;  // [format * 2 + scene depth]
     std::array<UniquePipeline, 2> merge_;      // [scene depth]
     Image placeholder_depth_;

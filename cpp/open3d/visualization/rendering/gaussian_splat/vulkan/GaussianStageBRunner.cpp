@@ -80,7 +80,8 @@ StageBReadback GaussianStageBRunner::Run(const StageBRunInputs& in) {
     const uint32_t count_words[4] = {0xDEADBEEFu, num_entries, 0u, 0u};
     Buffer count = UploadBuffer(context_, count_words, sizeof(count_words), storage);
     const StageBStorageRequirements need = GaussianStageB::GetStorageRequirements();
-    Buffer state(context_, need.state_bytes, need.state_usage, MemoryUsage::kDevice);
+    Buffer state(context_, GaussianStageB::StateBytes(w, h), need.state_usage,
+                 MemoryUsage::kDevice);
 
     const VkFormat color_format = ToVkFormat(in.color_format);
     const uint32_t color_texel = in.color_format == CompositeColorFormat::kRgba16f ? 8 : 16;

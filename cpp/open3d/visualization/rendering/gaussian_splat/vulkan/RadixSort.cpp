@@ -30,8 +30,14 @@ static_assert(offsetof(RadixSortParams, dispatch_x) == offsetof(VkDispatchIndire
 
 VkDeviceSize Words(uint64_t n) { return VkDeviceSize(std::max<uint64_t>(n, 1)) * 4; }
 
-uint32_t NumBlocks(uint32_t count) {
-    return static_cast<uint32_t>((uint64_t(count) + kRadixSortBlockSize - 1) / kRadixSortBlockSize);
+// Most blocks radix_sort_setup.comp can choose for any count <= max_count: up to
+// kRadixSortTargetBlocks blocks of 256..4096 elements, beyond that 4096-element blocks.
+uint32_t MaxBlocks(uint32_t max_count) {
+    const uint64_t smallest =
+        (uint64_t(max_count) + kRadixSortWorkgroupSize - 1) / kRadixSortWorkgroupSize;
+    const uint64_t largest = (uint64_t(max_count) + kRadixSortBlockSize - 1) / kRadixSortBlockSize;
+    return static_cast<uint32_t>(
+        std::max<uint64_t>(std::min<uint64_t>(smallest, kRadixSortTargetBlocks), largest));
 }
 
 }  // namespace
@@ -66,7 +72,7 @@ RadixSortStorageRequirements RadixSort::GetStorageRequirements(uint32_t max_coun
     requirements.keys_alt_bytes = Words(max_count);
     requirements.values_alt_bytes = Words(max_count);
     requirements.histogram_bytes =
-        Words(kRadixSortBins + uint64_t(kRadixSortBins) * NumBlocks(max_count));
+        Words(kRadixSortBins + uint64_t(kRadixSortBins) * MaxBlocks(max_count));
     requirements.params_bytes = sizeof(RadixSortParams);
     return requirements;
 }
@@ -123,6 +129,10 @@ void RadixSort::Record(VkCommandBuffer cmd, const BufferRange& keys, const Buffe
     RadixSortPushConstants push{};
     push.count_index = static_cast<uint32_t>((count.offset - count_binding_offset) / 4);
     push.max_count = max_count;
+    // GPUs want about one wave of blocks; a CPU device (lavapipe) runs workgroups on a few
+    // threads, where every block's fixed cost (digit offsets, slot scan) is pure overhead:
+    // 16 blocks keep it as fast as the fixed 4096-element blocks were.
+    push.target_blocks = context_->GetDeviceInfo().type == "CPU" ? 16u : kRadixSortTargetBlocks;
 
     const VkPipelineLayout layout = pipeline_layout_.Get();
     const auto bind = [&](const BufferRange& keys_in, const BufferRange& values_in,

@@ -24,11 +24,12 @@ void main() {
     params_out.count = 104u;
     params_out.num_blocks = 105u;
     params_out.flags = 106u;
-    params_out.reserved0 = 107u;
+    params_out.block_size = 107u;
     params_out.reserved1 = 108u;
     // Push constants read by member name, written back member by member.
     push_out.shift = pc.shift;
     push_out.digit_bits = pc.digit_bits;
     push_out.count_index = pc.count_index;
     push_out.max_count = pc.max_count;
+    push_out.target_blocks = pc.target_blocks;
 }

@@ -1,0 +1,128 @@
+// Tile culling (shader::TileRowSpan): a tile of a splat's 3DGS rectangle may only be dropped
+// when no pixel of it can blend the splat. Checked by brute force in double precision: at
+// every pixel of every dropped tile, alpha = o exp(-q / 2) stays below the composite's 1/255
+// with a 0.1% allowance for float32 rounding (the culling's own margin is about 0.5% in
+// alpha, so a missing margin fails here).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "SplatTestScene.h"
+#include "TestUtility.h"
+#include "open3d/camera/CamerasJson.h"
+#include "open3d/t/io/PointCloudIO.h"
+#include "open3d/visualization/rendering/gaussian_splat/DefaultScene.h"
+#include "open3d/visualization/rendering/gaussian_splat/cpu/Projection.h"
+
+namespace open3d {
+namespace tests {
+namespace {
+
+using namespace visualization::rendering;
+using namespace visualization::rendering::cpu;
+
+struct CullingCounts {
+    int64_t rect_tiles = 0;
+    int64_t kept_tiles = 0;
+    int64_t missed_tiles = 0;  // dropped although a pixel blends: must stay 0
+};
+
+// Largest alpha the composite could give the splat over the tile's pixels (integer pixel
+// positions inside the image), in double.
+double MaxAlphaInTile(const ProjectedSplat& s, int tx, int ty, int width, int height) {
+    double best = 0.0;
+    for (int y = ty * kTileSize; y < std::min((ty + 1) * kTileSize, height); ++y) {
+        for (int x = tx * kTileSize; x < std::min((tx + 1) * kTileSize, width); ++x) {
+            const double dx = s.x - x, dy = s.y - y;
+            const double q = s.conic_a * dx * dx + 2.0 * s.conic_b * dx * dy + s.conic_c * dy * dy;
+            best = std::max(best, s.opacity * std::exp(-0.5 * q));
+        }
+    }
+    return best;
+}
+
+CullingCounts CheckCulling(const std::vector<ProjectedSplat>& splats, int width, int height) {
+    constexpr double kBlendThreshold = (1.0 / 255.0) * (1.0 - 1e-3);
+    CullingCounts counts;
+    for (const ProjectedSplat& s : splats) {
+        if (!s.IsVisible()) continue;
+        int64_t kept = 0;
+        for (int ty = s.rect_min_y; ty < s.rect_max_y; ++ty) {
+            const auto [first, last] = s.RowSpan(ty);
+            EXPECT_TRUE(first >= s.rect_min_x && first <= last && last <= s.rect_max_x);
+            kept += last - first;
+            for (int tx = s.rect_min_x; tx < s.rect_max_x; ++tx) {
+                ++counts.rect_tiles;
+                if (tx >= first && tx < last) continue;
+                if (MaxAlphaInTile(s, tx, ty, width, height) >= kBlendThreshold) {
+                    ++counts.missed_tiles;
+                }
+            }
+        }
+        EXPECT_EQ(kept, s.NumEntries());
+        counts.kept_tiles += kept;
+    }
+    return counts;
+}
+
+// Needles, discs and blobs at every orientation and opacity, many of them crossing tile
+// borders at grazing angles; correlations |rho| up to 1 - 1e-6.
+std::vector<TestSplat> RandomSplats(int n, uint32_t seed) {
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    std::vector<TestSplat> splats(n);
+    for (TestSplat& s : splats) {
+        s.position = Eigen::Vector3d(u(rng) * 4 - 2, u(rng) * 4 - 2, 3 + u(rng) * 6);
+        for (int k = 0; k < 3; ++k) s.scale[k] = std::pow(10.0, -3.5 + 3.3 * u(rng));
+        s.rot = Eigen::Vector4d(u(rng) - 0.5, u(rng) - 0.5, u(rng) - 0.5, u(rng) - 0.5);
+        s.opacity = std::pow(10.0, -3.0 * u(rng));  // 0.001 .. 1
+    }
+    return splats;
+}
+
+TEST(CpuTileCulling, RandomSplatsLoseNoBlendingTile) {
+    const camera::PinholeCamera cam = MakeTestCamera(203, 157);
+    for (bool antialias : {false, true}) {
+        RenderConfig config;
+        config.antialias = antialias;
+        const auto splats = ProjectSplats(MakeCloud(RandomSplats(3000, 7)), cam, config);
+        const CullingCounts c = CheckCulling(splats, cam.width, cam.height);
+        EXPECT_EQ(c.missed_tiles, 0) << "antialias " << antialias;
+        EXPECT_GT(c.rect_tiles, 10000);
+        // Low-opacity and oblique splats fill little of their square.
+        EXPECT_LT(c.kept_tiles, c.rect_tiles * 9 / 10);
+        std::cout << "[tile culling] random, antialias " << antialias << ": kept " << c.kept_tiles
+                  << " of " << c.rect_tiles << " rectangle tiles\n";
+    }
+}
+
+TEST(CpuTileCulling, TransparentSplatEmitsNothing) {
+    // alpha <= o < 1/255 everywhere: no tile can blend, yet the splat stays visible
+    // (it is sorted like any other; it only emits no entries).
+    TestSplat faint;
+    faint.scale = {0.5, 0.5, 0.5};
+    faint.opacity = 0.003;
+    const auto splats = ProjectSplats(MakeCloud({faint}), MakeTestCamera(), RenderConfig{});
+    ASSERT_TRUE(splats[0].IsVisible());
+    EXPECT_EQ(splats[0].NumTiles(), 16);
+    EXPECT_EQ(splats[0].NumEntries(), 0);
+}
+
+TEST(CpuTileCulling, PlaybotLosesNoBlendingTile) {
+    OPEN3D_REQUIRE_DATA("playbot/playbot_31k.ply");
+    t::geometry::PointCloud cloud;
+    t::io::ReadPointCloud(DataPath("playbot/playbot_31k.ply"), cloud);
+    const auto views = camera::ReadCamerasJson(DataPath("playbot/cameras.json"));
+    const camera::PinholeCamera cam = views.at(0).camera;
+    const auto splats = ProjectSplats(cloud, cam, RenderConfig{});
+    const CullingCounts c = CheckCulling(splats, cam.width, cam.height);
+    EXPECT_EQ(c.missed_tiles, 0);
+    std::cout << "[tile culling] playbot_31k view 0 " << cam.width << "x" << cam.height << ": kept "
+              << c.kept_tiles << " of " << c.rect_tiles << " rectangle tiles\n";
+    EXPECT_LT(c.kept_tiles, c.rect_tiles);
+}
+
+}  // namespace
+}  // namespace tests
+}  // namespace open3d
