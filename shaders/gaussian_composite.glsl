@@ -81,7 +81,11 @@ void BlendSplat(uint j, inout PixelState p) {
     vec4 conic = s_conic[j];
     vec2 d = cdo.xy - p.position;
     float power = -0.5 * (conic.x * d.x * d.x + conic.z * d.y * d.y) - conic.y * d.x * d.y;
-    if (power > 0.0) return;
+    // conic.w = -t / 2 for the splat's widened tile-culling threshold t (TileCullThreshold):
+    // below it alpha < 1/255 is certain even after this float32 rounding of the power, so
+    // the pixel skips the splat without the exp, exactly as the alpha test below would.
+    // Most (pixel, splat) pairs of a tile lie outside the ellipse.
+    if (power > 0.0 || power < conic.w) return;
     float alpha = min(kCompositeMaxAlpha, cdo.w * exp(power));
     if (alpha < kCompositeMinAlpha) return;
     float next_transmittance = p.transmittance * (1.0 - alpha);
@@ -147,7 +151,7 @@ void main() {
             if (entry < end) {
                 GaussianProjectedSplat splat = projected[entry_values[entry]];
                 s_center_depth_opacity[local] = splat.center_depth_opacity;
-                s_conic[local] = splat.conic;
+                s_conic[local] = vec4(splat.conic.xyz, -0.5 * splat.conic.w);
                 s_color[local] = splat.color;
             }
             barrier();

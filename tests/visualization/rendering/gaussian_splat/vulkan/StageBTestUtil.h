@@ -33,8 +33,12 @@ inline gpu::StageBRunInputs ToStageBInputs(
         if (!s.IsVisible()) continue;
         rendering::shader::GaussianProjectedSplat& p = in.projected[i];
         p.center_depth_opacity = {float(s.x), float(s.y), float(s.depth), float(s.opacity)};
-        p.conic = {float(s.conic_a), float(s.conic_b), float(s.conic_c), 0.f};
-        p.color = {float(s.color[0]), float(s.color[1]), float(s.color[2]), 0.f};
+        // w: the culling threshold and det_q, as the projection stores them (the composite
+        // skips pixels past the threshold).
+        p.conic = {float(s.conic_a), float(s.conic_b), float(s.conic_c),
+                   rendering::shader::TileCullThreshold(float(s.opacity), float(s.conic_a),
+                                                        float(s.conic_c), float(s.det_q))};
+        p.color = {float(s.color[0]), float(s.color[1]), float(s.color[2]), float(s.det_q)};
         p.tiles = {uint32_t(s.rect_min_x) | uint32_t(s.rect_min_y) << 16,
                    uint32_t(s.rect_max_x) | uint32_t(s.rect_max_y) << 16, uint32_t(s.NumTiles()),
                    uint32_t(s.radius)};
@@ -60,6 +64,7 @@ inline rendering::cpu::ProjectedSplat MakeSplat(double x, double y, double depth
     s.depth = depth;
     s.cov_a = s.cov_c = sigma * sigma;
     s.conic_a = s.conic_c = 1.0 / (sigma * sigma);
+    s.det_q = s.conic_a * s.conic_c;  // b = 0
     s.radius = static_cast<int>(std::ceil(3.0 * sigma));
     s.opacity = opacity;
     s.color = color;
