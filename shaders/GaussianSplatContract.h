@@ -49,9 +49,10 @@ OPEN3D_SHADER_CONST uint kRadixSortWorkgroupSize = 256u;
 OPEN3D_SHADER_CONST uint kRadixSortItemsPerInvocation = 16u;  // chunks per block, at most
 OPEN3D_SHADER_CONST uint kRadixSortBlockSize = 4096u;         // elements per block, at most
 OPEN3D_SHADER_CONST uint kRadixSortTargetBlocks = 1024u;      // GPUs; CPU devices use fewer
-// Upper bound of gl_NumSubgroups, sizing the shared arrays of per-subgroup totals, so
-// RadixSort requires minSubgroupSize >= kRadixSortWorkgroupSize / kRadixSortMaxSubgroups = 4.
-OPEN3D_SHADER_CONST uint kRadixSortMaxSubgroups = 64u;
+// Upper bound of gl_NumSubgroups, sizing the shared arrays of per-subgroup counts (the
+// scatter's [32][128] words: 16 KiB of lavapipe's 32), so RadixSort requires
+// minSubgroupSize >= kRadixSortWorkgroupSize / kRadixSortMaxSubgroups = 8.
+OPEN3D_SHADER_CONST uint kRadixSortMaxSubgroups = 32u;
 
 // Descriptor set 0 of every radix-sort pipeline (one push-descriptor layout for all).
 OPEN3D_SHADER_CONST uint kRadixSortParamsBinding = 0u;     // RadixSortParams

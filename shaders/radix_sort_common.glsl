@@ -19,8 +19,6 @@ uint DigitOf(uint key) {
 
 // Per-subgroup partial sums, indexed by gl_SubgroupID.
 shared uint s_subgroup_sum[kRadixSortMaxSubgroups];
-shared uvec4 s_subgroup_sum_lo[kRadixSortMaxSubgroups];
-shared uvec4 s_subgroup_sum_hi[kRadixSortMaxSubgroups];
 
 // The position of this invocation in the workgroup's scan order: subgroups in
 // gl_SubgroupID order, lanes in gl_SubgroupInvocationID order (the order of the subgroup
@@ -55,33 +53,6 @@ uint WorkgroupExclusiveAdd(uint value, out uint total) {
     barrier();  // s_subgroup_sum is reused by the next scan
     total = sum;
     return prefix + inclusive_in_subgroup - value;
-}
-
-// The same for two uvec4 (sixteen 16-bit counters packed two per uint).
-void WorkgroupExclusiveAdd2(inout uvec4 lo, inout uvec4 hi, out uvec4 total_lo,
-                            out uvec4 total_hi) {
-    uvec4 inclusive_lo = subgroupInclusiveAdd(lo);
-    uvec4 inclusive_hi = subgroupInclusiveAdd(hi);
-    if (gl_SubgroupInvocationID == subgroupMax(gl_SubgroupInvocationID)) {
-        s_subgroup_sum_lo[gl_SubgroupID] = inclusive_lo;
-        s_subgroup_sum_hi[gl_SubgroupID] = inclusive_hi;
-    }
-    barrier();
-    uvec4 prefix_lo = uvec4(0u), prefix_hi = uvec4(0u);
-    uvec4 sum_lo = uvec4(0u), sum_hi = uvec4(0u);
-    for (uint s = 0u; s < gl_NumSubgroups; ++s) {
-        if (s == gl_SubgroupID) {
-            prefix_lo = sum_lo;
-            prefix_hi = sum_hi;
-        }
-        sum_lo += s_subgroup_sum_lo[s];
-        sum_hi += s_subgroup_sum_hi[s];
-    }
-    barrier();
-    total_lo = sum_lo;
-    total_hi = sum_hi;
-    lo = prefix_lo + inclusive_lo - lo;
-    hi = prefix_hi + inclusive_hi - hi;
 }
 
 #endif  // OPEN3D_RADIX_SORT_COMMON_GLSL
