@@ -43,12 +43,13 @@ OPEN3D_SHADER_CONST uint kRadixSortBins = 256u;  // 1 << kRadixSortDigitBits
 OPEN3D_SHADER_CONST uint kRadixSortWorkgroupSize = 256u;
 // A workgroup owns a block of 256 * chunks elements, chunks = 1..16 chosen per sort by
 // radix_sort_setup.comp from the GPU-side count: the fewest chunks that keep the block count
-// at or below kRadixSortTargetBlocks (about one wave of a large GPU), so a small sort still
-// spreads over the whole GPU instead of queueing 16 chunks in a handful of workgroups
-// (the H100 sorted 125k depth keys 5x slower with fixed 4096-element blocks).
+// at or below kRadixSortTargetBlocks, so a small sort still spreads over the whole GPU
+// instead of queueing 16 chunks in a handful of workgroups (the H100 sorted 125k depth keys
+// 3x slower with fixed 4096-element blocks). 256 measured best on the H100 (playbot_125k
+// 1080p sort 0.232 ms; 128: 0.249, 1024: 0.252, 2048: 0.263).
 OPEN3D_SHADER_CONST uint kRadixSortItemsPerInvocation = 16u;  // chunks per block, at most
 OPEN3D_SHADER_CONST uint kRadixSortBlockSize = 4096u;         // elements per block, at most
-OPEN3D_SHADER_CONST uint kRadixSortTargetBlocks = 1024u;      // GPUs; CPU devices use fewer
+OPEN3D_SHADER_CONST uint kRadixSortTargetBlocks = 256u;      // GPUs; CPU devices use fewer
 // Upper bound of gl_NumSubgroups, sizing the shared arrays of per-subgroup counts (the
 // scatter's [32][128] words: 16 KiB of lavapipe's 32), so RadixSort requires
 // minSubgroupSize >= kRadixSortWorkgroupSize / kRadixSortMaxSubgroups = 8.
@@ -163,6 +164,8 @@ OPEN3D_SHADER_CONST uint kMaxSplatRadius = 1073741824u;  // 2^30, exact in float
 // Workgroup sizes of the Stage A passes (one invocation per splat / per visible splat).
 OPEN3D_SHADER_CONST uint kProjectWorkgroupSize = 256u;
 OPEN3D_SHADER_CONST uint kEmitWorkgroupSize = 256u;
+// A splat with at least this many entries is emitted by its whole subgroup.
+OPEN3D_SHADER_CONST uint kEmitSubgroupEntries = 32u;
 // The tile-count scan: a workgroup scans a block of 256 * 4 = 1024 counts.
 OPEN3D_SHADER_CONST uint kScanWorkgroupSize = 256u;
 OPEN3D_SHADER_CONST uint kScanItemsPerInvocation = 4u;
