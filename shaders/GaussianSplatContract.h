@@ -164,8 +164,6 @@ OPEN3D_SHADER_CONST uint kMaxSplatRadius = 1073741824u;  // 2^30, exact in float
 // Workgroup sizes of the Stage A passes (one invocation per splat / per visible splat).
 OPEN3D_SHADER_CONST uint kProjectWorkgroupSize = 256u;
 OPEN3D_SHADER_CONST uint kEmitWorkgroupSize = 256u;
-// A splat with at least this many entries is emitted by its whole subgroup.
-OPEN3D_SHADER_CONST uint kEmitSubgroupEntries = 32u;
 // The tile-count scan: a workgroup scans a block of 256 * 4 = 1024 counts.
 OPEN3D_SHADER_CONST uint kScanWorkgroupSize = 256u;
 OPEN3D_SHADER_CONST uint kScanItemsPerInvocation = 4u;
