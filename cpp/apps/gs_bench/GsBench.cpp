@@ -115,12 +115,13 @@ double Median(std::vector<double> v) {
 // Times `frames` frames (Stage A + Stage B, no readback) after at least kWarmUpSeconds of
 // the same frames, and returns the median of each GPU pass and, in composite_ms, of the
 // CPU wall time per frame. Frames follow each other with only the submit/fence gap, so a
-// GPU that lowers its clocks when idle (every NVIDIA board does) is timed at full clock;
-// with a readback between frames the H100 ran the same depth sort 2.5-5x slower.
+// GPU that lowers its clocks when idle (every NVIDIA board does) is timed at full clock:
+// with a readback between frames the H100 ran the same depth sort 2.5-5x slower. (Run
+// loops time everything before the CPU references: see Run.)
 rendering::RenderStats RunTimedFrames(rendering::GaussianSplatBackend& backend,
                                       const camera::PinholeCamera& camera,
                                       const rendering::RenderConfig& config, int frames) {
-    constexpr double kWarmUpSeconds = 0.5;
+    constexpr double kWarmUpSeconds = 1.0;
     rendering::CompositeInputs no_readback;
     no_readback.read_back = false;
     rendering::RenderOutput out;
@@ -131,10 +132,25 @@ rendering::RenderStats RunTimedFrames(rendering::GaussianSplatBackend& backend,
         out.stats.composite_ms = core::MillisecondsSince(start);
         return out.stats;
     };
+    // Warm up until the GPU time stops falling: windows of 20 frames until a window's
+    // median is no longer 2% below the previous one (at least kWarmUpSeconds, at most 10 s).
+    // After seconds of CPU work the H100 needed more than 1 s of these frames (its duty
+    // cycle is only ~25%) to reach full clocks: a fixed 1 s warm-up left rows 1.6x slow.
     const auto warm_start = std::chrono::steady_clock::now();
-    do {
-        frame();
-    } while (core::MillisecondsSince(warm_start) < 1000.0 * kWarmUpSeconds);
+    double previous = INFINITY;
+    while (core::MillisecondsSince(warm_start) < 10000.0) {
+        std::vector<double> window;
+        for (int i = 0; i < 20; ++i) {
+            const rendering::RenderStats s = frame();
+            window.push_back(s.gpu_project_ms + s.gpu_sort_ms + s.gpu_composite_ms);
+        }
+        const double median = Median(window);
+        if (core::MillisecondsSince(warm_start) >= 1000.0 * kWarmUpSeconds &&
+            median > 0.98 * previous) {
+            break;
+        }
+        previous = std::min(previous, median);
+    }
     std::vector<double> project, sort, composite, depth_sort, scan_emit, tile_sort, wall;
     for (int i = 0; i < frames; ++i) {
         const rendering::RenderStats s = frame();
@@ -243,22 +259,23 @@ int Run(const Options& opt) {
         if (job_resolutions.empty()) job_resolutions.push_back(job.native);
         for (const auto& [w, h] : job_resolutions) {
             const auto cams = job.cameras(w, h);
-            // CPU references, keyed by what changes the reference image (SH cap, antialias).
-            std::map<std::pair<int, bool>, std::vector<t::geometry::Image>> refs;
-            for (const Knob& knob : knobs) {
+            // Phase 1, the GPU alone: every knob and view is timed before any CPU reference
+            // runs, because seconds of CPU work let the GPU's clocks fall and a short
+            // warm-up did not always bring them back (H100: up to 2.6x slower rows).
+            const size_t first_row = rows.size();
+            std::vector<std::vector<t::geometry::Image>> images(knobs.size());
+            for (size_t k = 0; k < knobs.size(); ++k) {
                 rendering::RenderConfig config;
                 config.reuse_geometry = false;
-                knob.apply(config);
+                knobs[k].apply(config);
                 Row row;
                 row.scene = job.name;
                 row.resolution = fmt::format("{}x{}", w, h);
-                row.knob = knob.name;
+                row.knob = knobs[k].name;
                 row.splats = job.cloud.NumPoints();
-                double worst_psnr = INFINITY;
                 for (size_t v = 0; v < cams.size(); ++v) {
                     // One full frame for the error columns, then timed frames without
-                    // readback: RunTimedFrames keeps the GPU busy (its clocks high) and
-                    // reports per-pass medians.
+                    // readback (per-pass medians).
                     rendering::RenderOutput out = backend->Render(cams[v], config);
                     const rendering::RenderStats med =
                         RunTimedFrames(*backend, cams[v], config, opt.repeat);
@@ -275,7 +292,21 @@ int Run(const Options& opt) {
                     row.error_flags |= out.stats.error_flags;
                     row.bytes_per_splat =
                         static_cast<double>(out.stats.gpu_scene_bytes) / row.splats;
-                    if (!reference) continue;
+                    if (reference) images[k].push_back(std::move(out.color));
+                }
+                row.gpu_total_ms = row.project_ms + row.sort_ms + row.composite_ms;
+                rows.push_back(row);
+            }
+            if (!reference) continue;
+            // Phase 2: the error columns against CPU references, keyed by what changes the
+            // reference image (SH cap, antialias).
+            std::map<std::pair<int, bool>, std::vector<t::geometry::Image>> refs;
+            for (size_t k = 0; k < knobs.size(); ++k) {
+                rendering::RenderConfig config;
+                knobs[k].apply(config);
+                Row& row = rows[first_row + k];
+                double worst_psnr = INFINITY;
+                for (size_t v = 0; v < cams.size(); ++v) {
                     auto& ref = refs[{config.sh_degree, config.antialias}];
                     if (ref.size() <= v) {
                         rendering::RenderConfig ref_config;
@@ -284,18 +315,17 @@ int Run(const Options& opt) {
                         ref.push_back(
                             rendering::cpu::RenderReference(job.cloud, cams[v], ref_config).color);
                     }
+                    const t::geometry::Image& gpu = images[k][v];
                     const auto m =
-                        t::geometry::ComputeImageErrorMetrics(out.color, ref[v], 1.0, 1.0 / 255.0);
+                        t::geometry::ComputeImageErrorMetrics(gpu, ref[v], 1.0, 1.0 / 255.0);
                     row.has_error = true;
                     worst_psnr = std::min(worst_psnr, m.psnr_db);
                     row.max_abs = std::max(row.max_abs, m.max_abs_error);
                     row.over_1_255 = std::max(row.over_1_255, m.fraction_over_threshold);
-                    row.p999 = std::max(
-                        row.p999, t::geometry::ComputeAbsErrorPercentile(out.color, ref[v], 0.999));
+                    row.p999 = std::max(row.p999,
+                                        t::geometry::ComputeAbsErrorPercentile(gpu, ref[v], 0.999));
                 }
                 row.psnr = worst_psnr;  // the worst view
-                row.gpu_total_ms = row.project_ms + row.sort_ms + row.composite_ms;
-                rows.push_back(row);
             }
         }
     }
@@ -359,7 +389,8 @@ int main(int argc, char** argv) {
         ->check(CLI::Range(1, 64));
     app.add_option("--json", opt.json, "Write machine-readable results here");
     app.add_option("--repeat", opt.repeat,
-                   "Timed frames per view and knob (medians; after 0.5 s of warm-up frames)")
+                   "Timed frames per view and knob (medians, after warm-up frames until the GPU "
+                   "time settles)")
         ->check(CLI::Range(1, 10000))
         ->capture_default_str();
     app.add_option("--knobs", opt.knobs, "Comma list of knobs or 'all'")->capture_default_str();
