@@ -49,7 +49,7 @@ OPEN3D_SHADER_CONST uint kRadixSortWorkgroupSize = 256u;
 // 1080p sort 0.232 ms; 128: 0.249, 1024: 0.252, 2048: 0.263).
 OPEN3D_SHADER_CONST uint kRadixSortItemsPerInvocation = 16u;  // chunks per block, at most
 OPEN3D_SHADER_CONST uint kRadixSortBlockSize = 4096u;         // elements per block, at most
-OPEN3D_SHADER_CONST uint kRadixSortTargetBlocks = 256u;      // GPUs; CPU devices use fewer
+OPEN3D_SHADER_CONST uint kRadixSortTargetBlocks = 256u;       // GPUs; CPU devices use fewer
 // Upper bound of gl_NumSubgroups, sizing the shared arrays of per-subgroup counts (the
 // scatter's [32][128] words: 16 KiB of lavapipe's 32), so RadixSort requires
 // minSubgroupSize >= kRadixSortWorkgroupSize / kRadixSortMaxSubgroups = 8.
