@@ -1,8 +1,15 @@
-// 200 resizes, then 1,800 offscreen renders with a moving camera, a second cloud added and
+// 200 to 800 resizes, then 1,800 offscreen renders with a moving camera, a second cloud added and
 // removed, and the sphere shown and hidden: no crash, no validation message, no GPU error
 // flag, and resident memory that stops growing (Filament, GL and Vulkan objects of old
 // sizes and scenes are freed; on lavapipe device memory is host memory, so RSS covers GPU
 // allocations too). OPEN3D_SOAK_FRAMES=N renders N frames instead of 1,800.
+//
+// Resizes carry a one-time memory cost that differs by machine: this one measures +1.3 MiB
+// over the first 200 resizes after warm-up and +0.5 MiB over the next 100, then nothing; CI
+// once measured +13.5 MiB over the first 200. A leak grows without end, a one-time cost
+// stops, so the test resizes in blocks of 100 until one block grows by less than 256 KiB
+// (a leak of 2.6 KiB per resize or more never gets there; one 16x12 RGBA16F target of the
+// smallest size is 1.5 KiB before driver overhead).
 #include <gtest/gtest.h>
 
 #include <cstdlib>
@@ -38,16 +45,28 @@ TEST_F(FilamentSoak, ResizesAndRendersWithoutGrowth) {
         ASSERT_TRUE(scene.GetLastFrame().splats_drawn);
     };
     // Warm up every size once, with and without the sphere (the composite pipeline without
-    // scene depth is compiled on first use): allocators and driver caches settle.
+    // scene depth is compiled on first use).
     for (int i = 0; i < 20; ++i) {
         scene.ShowGeometry("sphere", i % 2 == 0);
         render_at(16 + (i % 10) * 4, 12 + (i % 7) * 2);
     }
     scene.ShowGeometry("sphere", true);
     const int64_t before = ResidentKiB();
-    int64_t builds = scene.GetView().GetTargetBuilds();
-    for (int i = 0; i < 200; ++i) render_at(16 + (i % 10) * 4, 12 + (i % 7) * 2);
-    EXPECT_EQ(scene.GetView().GetTargetBuilds() - builds, 200);  // every resize rebuilt
+    const int64_t builds = scene.GetView().GetTargetBuilds();
+    constexpr int kBlock = 100, kMaxBlocks = 8;
+    constexpr int64_t kQuietBlockKiB = 256;
+    int blocks = 0;
+    int64_t block_growth = 0;
+    std::string growth_log;
+    do {
+        const int64_t block_start = ResidentKiB();
+        for (int i = 0; i < kBlock; ++i) render_at(16 + (i % 10) * 4, 12 + (i % 7) * 2);
+        block_growth = ResidentKiB() - block_start;
+        growth_log += " +" + std::to_string(block_growth);
+    } while (++blocks < kMaxBlocks && block_growth >= kQuietBlockKiB);
+    EXPECT_EQ(scene.GetView().GetTargetBuilds() - builds, blocks * kBlock);  // all rebuilt
+    EXPECT_LT(block_growth, kQuietBlockKiB)
+        << "KiB per block of " << kBlock << " resizes:" << growth_log;
     scene.SetupCamera(MakeFilamentTestCamera(32, 24));
     scene.RenderToImage();
     const int64_t after_resizes = ResidentKiB();
@@ -67,17 +86,16 @@ TEST_F(FilamentSoak, ResizesAndRendersWithoutGrowth) {
         ASSERT_EQ(scene.GetLastFrame().splat_stats.error_flags, 0u) << "frame " << i;
     }
     const int64_t after = ResidentKiB();
-    // Measured on llvmpipe + lavapipe: +1.3 MiB over the 200 resizes, then +1.9 MiB over
-    // 1,800 frames and +2.9 MiB over 5,000 (OPEN3D_SOAK_FRAMES): mostly a one-time cost,
-    // plus a drift of about 0.3 KiB per frame that we have not attributed (allocator
-    // fragmentation from the repeated add/remove is the suspect). The bound allows 3 MiB
-    // plus 0.5 KiB per frame; a leak of one 32x24 RGBA8 image per frame (3 KiB) fails it.
-    EXPECT_LT(after_resizes - before, 8 * 1024) << "RSS " << before << " -> " << after_resizes;
+    // Measured on llvmpipe + lavapipe: +1.9 MiB over 1,800 frames and +2.9 MiB over 5,000
+    // (OPEN3D_SOAK_FRAMES): mostly a one-time cost, plus a drift of about 0.3 KiB per frame that we
+    // have not attributed (allocator fragmentation from the repeated add/remove is the suspect).
+    // The bound allows 3 MiB plus 0.5 KiB per frame; a leak of one 32x24 RGBA8 image per frame (3
+    // KiB) fails it.
     EXPECT_LT(after - after_resizes, 3 * 1024 + frames / 2)
         << "RSS " << after_resizes << " -> " << after;
     EXPECT_EQ(scene.GetLastFrame().splat_stats.error_flags, 0u);
-    std::printf("RSS %lld -> %lld -> %lld KiB\n", (long long)before, (long long)after_resizes,
-                (long long)after);
+    std::printf("RSS %lld -> %lld (%d resizes; KiB per block:%s) -> %lld KiB\n", (long long)before,
+                (long long)after_resizes, blocks * kBlock, growth_log.c_str(), (long long)after);
 }
 
 }  // namespace
