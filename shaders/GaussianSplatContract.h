@@ -85,9 +85,13 @@ struct RadixSortPushConstants {
     uint count_index;    // uint index of the count within the count binding
     uint max_count;      // capacity of the key/value buffers
     uint target_blocks;  // 1..kRadixSortTargetBlocks: block count the setup aims at
-    uint reserved0;
-    uint reserved1;
-    uint reserved2;
+    // The histogram binding holds two areas of kRadixSortBins digit totals followed by
+    // [kRadixSortBins][blocks] block counts. A pass reads the area at `area`; its scatter
+    // adds the NEXT pass's block counts into the area at `next_area` (which the pass's scan
+    // zeroes first), so only the first pass runs radix_sort_histogram.comp.
+    uint area;        // uint offset of this pass's area
+    uint next_area;   // uint offset of the other area
+    uint next_digit;  // the next pass's shift | digit_bits << 8; 0: last pass, nothing to add
 };
 
 // ---- Sort-key layout of the seed's packed (tile, depth) key, a measured option ----
@@ -212,7 +216,8 @@ OPEN3D_SHADER_CONST uint kStageASplatIndexBinding = 8u;    // uint[N]: visible s
 OPEN3D_SHADER_CONST uint kStageAScanBinding = 9u;          // uint[scan words]: all levels
 OPEN3D_SHADER_CONST uint kStageAEntryKeysBinding = 10u;    // uint[capacity]: tile index
 OPEN3D_SHADER_CONST uint kStageAEntryValuesBinding = 11u;  // uint[capacity]: splat index
-OPEN3D_SHADER_CONST uint kStageANumBindings = 12u;
+OPEN3D_SHADER_CONST uint kStageASortParamsBinding = 12u;   // RadixSortParams of the next sort
+OPEN3D_SHADER_CONST uint kStageANumBindings = 13u;
 
 // uint indices into GaussianStageACounters, used as the radix sorter's count_index.
 OPEN3D_SHADER_CONST uint kCounterVisibleIndex = 0u;
@@ -280,8 +285,11 @@ OPEN3D_SHADER_CONST uint kDispatchArgsAfterScan = 1u;     // counts the entries 
 struct GaussianDispatchArgsPushConstants {
     uint mode;        // kDispatchArgsAfterProject / kDispatchArgsAfterScan
     uint num_levels;  // scan levels recorded (1..kScanMaxLevels)
-    uint reserved0;
-    uint reserved1;
+    // The next sort's parameters (RadixSortParamsFor) are written here, saving the sort its
+    // setup dispatch: after the projection the depth sort's (count N), after the scan the
+    // tile sort's (count = entries that fit).
+    uint sort_max_count;
+    uint sort_target_blocks;
 };
 
 // Push constants of gaussian_scan.comp.
@@ -416,6 +424,37 @@ OPEN3D_SHADER_FUNC uint TileRowSpan(float cx, float cy, float a, float b, float 
 
 // Tiles of a span from TileRowSpan.
 OPEN3D_SHADER_FUNC uint TileSpanCount(uint span) { return (span >> 16u) - (span & 0xFFFFu); }
+
+// ---- Radix sort parameters for an element count ----
+// Clamps the count to max_count (kErrorCountsClamped) and chooses the block size: the
+// fewest chunks of kRadixSortWorkgroupSize that keep the block count at or below
+// target_blocks (clamped to 1..kRadixSortTargetBlocks), 1..kRadixSortItemsPerInvocation
+// chunks. radix_sort_setup.comp calls it, and so does a producer that writes the sort's
+// parameters itself (gaussian_dispatch_args.comp), saving the sort its setup dispatch. No
+// overflow: the host keeps max_count far below 2^32 - kRadixSortBlockSize.
+OPEN3D_SHADER_FUNC RadixSortParams RadixSortParamsFor(uint count, uint max_count,
+                                                      uint target_blocks) {
+    RadixSortParams p;
+    p.flags = 0u;
+    if (count > max_count) {
+        count = max_count;
+        p.flags = kErrorCountsClamped;
+    }
+    uint target = target_blocks < 1u ? 1u : target_blocks;
+    target = target < kRadixSortTargetBlocks ? target : kRadixSortTargetBlocks;
+    uint wave = kRadixSortWorkgroupSize * target;
+    uint chunks = (count + wave - 1u) / wave;
+    chunks = chunks < 1u ? 1u : chunks;
+    chunks = chunks < kRadixSortItemsPerInvocation ? chunks : kRadixSortItemsPerInvocation;
+    p.block_size = kRadixSortWorkgroupSize * chunks;
+    p.num_blocks = (count + p.block_size - 1u) / p.block_size;
+    p.dispatch_x = p.num_blocks;
+    p.dispatch_y = 1u;
+    p.dispatch_z = 1u;
+    p.count = count;
+    p.reserved1 = 0u;
+    return p;
+}
 #undef OPEN3D_SHADER_FUNC
 #undef OPEN3D_SHADER_PRECISE
 

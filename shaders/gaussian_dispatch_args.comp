@@ -1,7 +1,8 @@
 #version 460
 // Stage A indirect sizes from GPU-side counts (no CPU readback between passes).
-// After the projection: the scan levels and the emit pass, from the visible count.
-// After the scan: how many entries fit. Splats emit whole or not at all, front to back, so
+// After the projection: the scan levels and the emit pass, from the visible count, and the
+// depth sort's parameters. After the scan: how many entries fit, and the tile sort's
+// parameters (RadixSortParamsFor, what the sort's setup dispatch would write). Splats emit whole or not at all, front to back, so
 // the emitting splats are a prefix of the depth order: the first splat whose inclusive
 // offset passes the capacity is found by binary search and everything from it is dropped.
 #extension GL_GOOGLE_include_directive : require
@@ -21,6 +22,9 @@ layout(std430, set = 0, binding = kStageACountersBinding) buffer CountersBlock {
 };
 layout(std430, set = 0, binding = kStageAScanBinding) readonly buffer ScanBlock {
     uint scan[];
+};
+layout(std430, set = 0, binding = kStageASortParamsBinding) writeonly buffer SortParamsBlock {
+    RadixSortParams sort_params;
 };
 
 uint DivCeil(uint a, uint b) {
@@ -42,6 +46,8 @@ void SizeScanAndEmit() {
         counters.scan_levels[level].count = recorded ? count : 0u;
         count = blocks;
     }
+    sort_params =
+            RadixSortParamsFor(counters.num_splats, pc.sort_max_count, pc.sort_target_blocks);
 }
 
 // Inclusive offset of sorted visible splat k: the next exclusive offset, or the total.
@@ -70,6 +76,7 @@ void CountFittingEntries() {
     // The allocation, not RenderConfig::max_tile_entries_total, was the binding limit.
     if (total > capacity && capacity < view.limits.z) flags |= kErrorCountsClamped;
     if (flags != 0u) atomicOr(counters.error_flags, flags);
+    sort_params = RadixSortParamsFor(entries, pc.sort_max_count, pc.sort_target_blocks);
 }
 
 void main() {

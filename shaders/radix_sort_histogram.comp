@@ -1,6 +1,7 @@
 #version 460
-// Pass 1 of a digit: per-block digit counts, stored digit-major so that one exclusive scan
-// per digit row (radix_sort_scan.comp) gives every block its output offset within a digit.
+// Block counts of the FIRST pass's digit, stored digit-major so that one exclusive scan per
+// digit row (radix_sort_scan.comp) gives every block its output offset within a digit. The
+// later passes' counts are added by the previous pass's scatter.
 #extension GL_GOOGLE_include_directive : require
 #include "radix_sort_common.glsl"
 
@@ -12,7 +13,7 @@ layout(std430, set = 0, binding = kRadixSortParamsBinding) readonly buffer Param
 layout(std430, set = 0, binding = kRadixSortKeysInBinding) readonly buffer KeysBlock {
     uint keys_in[];
 };
-// [kRadixSortBins] digit totals, then [kRadixSortBins][num_blocks] block counts.
+// Area pc.area: [kRadixSortBins] digit totals, then [kRadixSortBins][num_blocks] counts.
 layout(std430, set = 0, binding = kRadixSortHistogramBinding) writeonly buffer HistogramBlock {
     uint histogram[];
 };
@@ -31,5 +32,6 @@ void main() {
         if (index < count) atomicAdd(s_counts[DigitOf(keys_in[index])], 1u);
     }
     barrier();
-    histogram[kRadixSortBins + local * params.num_blocks + gl_WorkGroupID.x] = s_counts[local];
+    histogram[pc.area + kRadixSortBins + local * params.num_blocks + gl_WorkGroupID.x] =
+            s_counts[local];
 }

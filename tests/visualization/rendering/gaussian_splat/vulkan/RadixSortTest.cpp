@@ -106,7 +106,8 @@ protected:
     /// Sorts keys/values (the whole vectors are the buffers' contents, capacity =
     /// keys.size()) on the GPU with `gpu_count` written into the count buffer on the GPU.
     GpuSortResult Sort(const std::vector<uint32_t>& keys, const std::vector<uint32_t>& values,
-                       uint32_t gpu_count, uint32_t num_bits) {
+                       uint32_t gpu_count, uint32_t num_bits,
+                       RadixSort::Params source = RadixSort::Params::kSetupPass) {
         const auto capacity = static_cast<uint32_t>(keys.size());
         const VkDeviceSize bytes = std::max<VkDeviceSize>(capacity, 1) * 4;
         const VkBufferUsageFlags usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT |
@@ -122,8 +123,10 @@ protected:
         Buffer values_alt(Context(), need.values_alt_bytes, need.scratch_usage,
                           MemoryUsage::kDevice);
         Buffer histogram(Context(), need.histogram_bytes, need.scratch_usage, MemoryUsage::kDevice);
-        Buffer params(Context(), need.params_bytes,
-                      need.params_usage | VK_BUFFER_USAGE_TRANSFER_SRC_BIT, MemoryUsage::kDevice);
+        Buffer params(
+            Context(), need.params_bytes,
+            need.params_usage | VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+            MemoryUsage::kDevice);
         Buffer upload(Context(), 2 * bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
                       MemoryUsage::kHostUpload);
         Buffer readback(Context(), 2 * bytes + sizeof(shader::RadixSortParams),
@@ -143,15 +146,24 @@ protected:
             region.srcOffset = bytes;
             vkCmdCopyBuffer(c, upload.Get(), value_buffer.Get(), 1, &region);
         }
-        vkCmdFillBuffer(c, count_buffer.Get(), 20, 4, gpu_count);
+        const bool producer = source == RadixSort::Params::kWrittenByProducer;
+        // A producer writes the parameters itself (as a shader would); the sort must not
+        // read the count then, so the count binding holds garbage.
+        vkCmdFillBuffer(c, count_buffer.Get(), 20, 4, producer ? 0xFFFFFFFFu : gpu_count);
+        if (producer) {
+            const shader::RadixSortParams written = shader::RadixSortParamsFor(
+                gpu_count, std::max(capacity, 1u), sort_->GetTargetBlocks());
+            vkCmdUpdateBuffer(c, params.Get(), 0, sizeof(written), &written);
+        }
         RecordMemoryBarrier(
             c, VK_PIPELINE_STAGE_2_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
-            VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
-            VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
+            VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_DRAW_INDIRECT_BIT,
+            VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT |
+                VK_ACCESS_2_INDIRECT_COMMAND_READ_BIT);
         RadixSortScratch scratch{keys_alt.Range(), values_alt.Range(), histogram.Range(),
                                  params.Range()};
         sort_->Record(c, key_buffer.Range(), value_buffer.Range(), scratch,
-                      count_buffer.Range(20, 4), capacity, num_bits);
+                      count_buffer.Range(20, 4), capacity, num_bits, source);
         RecordMemoryBarrier(c, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
                             VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, VK_PIPELINE_STAGE_2_TRANSFER_BIT,
                             VK_ACCESS_2_TRANSFER_READ_BIT);
@@ -207,6 +219,17 @@ protected:
         if (c.num_bits > 0) {
             EXPECT_EQ(gpu.params.count, c.count);
             EXPECT_EQ(gpu.params.flags, 0u);
+            // The setup shader and the C++ compilation of RadixSortParamsFor agree (a
+            // producer that writes the parameters itself relies on it), and the blocks fit
+            // the histogram that GetStorageRequirements sized.
+            const shader::RadixSortParams want =
+                shader::RadixSortParamsFor(c.count, c.count + padding, sort_->GetTargetBlocks());
+            EXPECT_EQ(gpu.params.block_size, want.block_size);
+            EXPECT_EQ(gpu.params.num_blocks, want.num_blocks);
+            EXPECT_EQ(gpu.params.dispatch_x, want.num_blocks);
+            const uint64_t area_words =
+                RadixSort::GetStorageRequirements(c.count + padding).histogram_bytes / 8;
+            EXPECT_LE(256u + 256u * uint64_t(gpu.params.num_blocks), area_words);
         }
         ASSERT_EQ(gpu.keys.size(), want_keys.size());
         for (size_t i = 0; i < want_keys.size(); ++i) {
@@ -276,6 +299,21 @@ TEST_F(RadixSortTest, CountAboveCapacityIsClampedAndFlagged) {
     EXPECT_EQ(gpu.values, values);
 }
 
+TEST_F(RadixSortTest, ParamsWrittenByTheProducer) {
+    // No setup pass: the parameters come from the command buffer (as from a producer
+    // shader), and the count binding holds garbage that must not be read.
+    for (uint32_t count : {1u, 4097u, 70000u}) {
+        std::vector<uint32_t> keys = MakeKeys({"", count, Pattern::kRandom}, count);
+        std::vector<uint32_t> values(keys.size());
+        std::iota(values.begin(), values.end(), 0u);
+        GpuSortResult gpu = Sort(keys, values, count, 32, RadixSort::Params::kWrittenByProducer);
+        ReferenceSort(keys, values, 32);
+        EXPECT_EQ(gpu.params.count, count);
+        EXPECT_EQ(gpu.keys, keys) << count;
+        EXPECT_EQ(gpu.values, values) << count;
+    }
+}
+
 TEST_F(RadixSortTest, ReusesScratchAcrossSorts) {
     // The same sorter records many sorts; results must not depend on earlier ones.
     for (uint32_t seed = 10; seed < 13; ++seed) CheckSort({"", 9000, Pattern::kRandom}, 5, seed);
@@ -285,11 +323,12 @@ TEST_F(RadixSortTest, StorageRequirements) {
     const auto need = RadixSort::GetStorageRequirements(10000);
     EXPECT_EQ(need.keys_alt_bytes, 40000u);
     EXPECT_EQ(need.values_alt_bytes, 40000u);
-    // Up to kRadixSortTargetBlocks blocks of >= 256 elements: ceil(10000 / 256) = 40 blocks.
-    EXPECT_EQ(need.histogram_bytes, (256u + 256u * 40u) * 4u);
+    // Up to kRadixSortTargetBlocks blocks of >= 256 elements: ceil(10000 / 256) = 40 blocks;
+    // two areas (this pass's counts and the next pass's, added by the scatter).
+    EXPECT_EQ(need.histogram_bytes, 2u * (256u + 256u * 40u) * 4u);
     // Past 1024 * 4096 elements the blocks are 4096 long: 2^23 elements -> 2048 blocks.
     EXPECT_EQ(RadixSort::GetStorageRequirements(1u << 23).histogram_bytes,
-              (256u + 256u * 2048u) * 4u);
+              2u * (256u + 256u * 2048u) * 4u);
     EXPECT_EQ(need.params_bytes, sizeof(shader::RadixSortParams));
     EXPECT_TRUE(need.params_usage & VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT);
     EXPECT_GT(RadixSort::GetStorageRequirements(0).keys_alt_bytes, 0u);  // no empty buffers

@@ -120,15 +120,17 @@ VkPipeline GaussianStageA::GetProjectPipeline(uint32_t sh_degree, bool antialias
 void GaussianStageA::PushBindings(VkCommandBuffer cmd, const StageASceneBuffers& scene,
                                   const StageAViewBuffers& buffers) const {
     const std::array<const BufferRange*, kStageANumBindings> ranges{
-        &buffers.view_params,   &scene.positions,   &scene.shape,        &scene.sh,
-        &scene.visibility,      &buffers.projected, &buffers.counters,   &buffers.depth_keys,
-        &buffers.splat_indices, &buffers.scan,      &buffers.entry_keys, &buffers.entry_values};
+        &buffers.view_params,        &scene.positions,   &scene.shape,        &scene.sh,
+        &scene.visibility,           &buffers.projected, &buffers.counters,   &buffers.depth_keys,
+        &buffers.splat_indices,      &buffers.scan,      &buffers.entry_keys, &buffers.entry_values,
+        &buffers.sort_scratch.params};
     static_assert(kStageAViewBinding == 0 && kStageAPositionsBinding == 1 &&
                       kStageAShapeBinding == 2 && kStageAShBinding == 3 &&
                       kStageAVisibilityBinding == 4 && kStageAProjectedBinding == 5 &&
                       kStageACountersBinding == 6 && kStageADepthKeysBinding == 7 &&
                       kStageASplatIndexBinding == 8 && kStageAScanBinding == 9 &&
-                      kStageAEntryKeysBinding == 10 && kStageAEntryValuesBinding == 11,
+                      kStageAEntryKeysBinding == 10 && kStageAEntryValuesBinding == 11 &&
+                      kStageASortParamsBinding == 12,
                   "ranges above are listed in binding order");
     std::array<VkDescriptorBufferInfo, kStageANumBindings> infos{};
     std::array<VkWriteDescriptorSet, kStageANumBindings> writes{};
@@ -193,6 +195,8 @@ void GaussianStageA::Record(VkCommandBuffer cmd, const StageASceneBuffers& scene
     GaussianDispatchArgsPushConstants args{};
     args.mode = kDispatchArgsAfterProject;
     args.num_levels = need.num_scan_levels;
+    args.sort_max_count = std::max(n, 1u);
+    args.sort_target_blocks = sort_.GetTargetBlocks();
     vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, dispatch_args_.Get());
     vkCmdPushConstants(cmd, layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(args), &args);
     vkCmdDispatch(cmd, 1, 1, 1);
@@ -216,7 +220,8 @@ void GaussianStageA::Record(VkCommandBuffer cmd, const StageASceneBuffers& scene
     if (!packed_key) {
         begin(TimedPass::kDepthSort);
         sort_.Record(cmd, buffers.depth_keys, buffers.splat_indices, buffers.sort_scratch,
-                     counter_range(kCounterNumSplatsIndex), std::max(n, 1u), 32);
+                     counter_range(kCounterNumSplatsIndex), std::max(n, 1u), 32,
+                     RadixSort::Params::kWrittenByProducer);
         ComputeBarrier(cmd);
         end(TimedPass::kDepthSort);
     }
@@ -247,6 +252,7 @@ void GaussianStageA::Record(VkCommandBuffer cmd, const StageASceneBuffers& scene
 
     // 5. How many entries fit (whole splats, front to back) -> entry_count, error flags.
     args.mode = kDispatchArgsAfterScan;
+    args.sort_max_count = std::max(capacity, 1u);
     vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, dispatch_args_.Get());
     vkCmdPushConstants(cmd, layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(args), &args);
     vkCmdDispatch(cmd, 1, 1, 1);
@@ -268,7 +274,8 @@ void GaussianStageA::Record(VkCommandBuffer cmd, const StageASceneBuffers& scene
     begin(TimedPass::kTileSort);
     sort_.Record(cmd, buffers.entry_keys, buffers.entry_values, buffers.sort_scratch,
                  counter_range(kCounterEntriesIndex), std::max(capacity, 1u),
-                 packed_key ? kSortKeyBits : params.limits.w);
+                 packed_key ? kSortKeyBits : params.limits.w,
+                 RadixSort::Params::kWrittenByProducer);
     if (packed_key) {
         ComputeBarrier(cmd);
         PushBindings(cmd, scene, buffers);  // the sort bound its own layout

@@ -91,7 +91,8 @@ public:
                                                             uint32_t entry_capacity);
 
     /// Records Stage A for one view: writes `params` into buffers.view_params, zeroes the
-    /// counters, then project (slot i = splat i) -> dispatch args -> one stable sort of all
+    /// counters, then project (slot i = splat i) -> dispatch args (which also write the
+    /// sorts' parameters, so neither sort runs its setup pass) -> one stable sort of all
     /// N slots by depth (culled splats last, ties by index) -> scan tile counts -> dispatch args ->
     /// emit entries -> stable sort by tile (params.limits.w bits). Every size after the projection
     /// comes from GPU-side counts. `params` must come from PackGaussianViewParams for this scene
@@ -105,7 +106,7 @@ public:
     /// Synchronisation: the caller orders earlier uses of these buffers before Record (and
     /// makes scene uploads visible to compute reads); afterwards all results are
     /// COMPUTE_SHADER storage writes (the counters also) for the caller to barrier.
-    /// With  (reset by the caller in this command buffer), the projection and
+    /// With `timestamps` (reset by the caller in this command buffer), the projection and
     /// its dispatch arguments are timed as TimedPass::kProject and everything after as kSort.
     void Record(VkCommandBuffer cmd, const StageASceneBuffers& scene,
                 const StageAViewBuffers& buffers, const shader::GaussianViewParams& params,

@@ -40,6 +40,11 @@ uint32_t MaxBlocks(uint32_t max_count) {
         std::max<uint64_t>(std::min<uint64_t>(smallest, kRadixSortTargetBlocks), largest));
 }
 
+// uints of one histogram area: digit totals, then the block counts of every digit.
+uint64_t HistogramAreaWords(uint32_t max_count) {
+    return kRadixSortBins + uint64_t(kRadixSortBins) * MaxBlocks(max_count);
+}
+
 }  // namespace
 
 RadixSort::RadixSort(const VulkanContext& context) : context_(&context) {
@@ -71,8 +76,7 @@ RadixSortStorageRequirements RadixSort::GetStorageRequirements(uint32_t max_coun
     RadixSortStorageRequirements requirements;
     requirements.keys_alt_bytes = Words(max_count);
     requirements.values_alt_bytes = Words(max_count);
-    requirements.histogram_bytes =
-        Words(kRadixSortBins + uint64_t(kRadixSortBins) * MaxBlocks(max_count));
+    requirements.histogram_bytes = 2 * HistogramAreaWords(max_count) * 4;
     requirements.params_bytes = sizeof(RadixSortParams);
     return requirements;
 }
@@ -115,9 +119,16 @@ void RadixSort::CheckArguments(const BufferRange& keys, const BufferRange& value
     }
 }
 
+uint32_t RadixSort::GetTargetBlocks() const {
+    // GPUs want about one wave of blocks; a CPU device (lavapipe) runs workgroups on a few
+    // threads, where every block's fixed cost (digit offsets, slot scan) is pure overhead:
+    // 16 blocks keep it as fast as the fixed 4096-element blocks were.
+    return context_->GetDeviceInfo().type == "CPU" ? 16u : kRadixSortTargetBlocks;
+}
+
 void RadixSort::Record(VkCommandBuffer cmd, const BufferRange& keys, const BufferRange& values,
                        const RadixSortScratch& scratch, const BufferRange& count,
-                       uint32_t max_count, uint32_t num_bits) const {
+                       uint32_t max_count, uint32_t num_bits, Params params) const {
     CheckArguments(keys, values, scratch, count, max_count, num_bits);
     const uint32_t num_passes = GetNumPasses(num_bits);
     if (num_passes == 0) return;  // no key bits: every order is sorted
@@ -129,10 +140,7 @@ void RadixSort::Record(VkCommandBuffer cmd, const BufferRange& keys, const Buffe
     RadixSortPushConstants push{};
     push.count_index = static_cast<uint32_t>((count.offset - count_binding_offset) / 4);
     push.max_count = max_count;
-    // GPUs want about one wave of blocks; a CPU device (lavapipe) runs workgroups on a few
-    // threads, where every block's fixed cost (digit offsets, slot scan) is pure overhead:
-    // 16 blocks keep it as fast as the fixed 4096-element blocks were.
-    push.target_blocks = context_->GetDeviceInfo().type == "CPU" ? 16u : kRadixSortTargetBlocks;
+    push.target_blocks = GetTargetBlocks();
 
     const VkPipelineLayout layout = pipeline_layout_.Get();
     const auto bind = [&](const BufferRange& keys_in, const BufferRange& values_in,
@@ -170,14 +178,17 @@ void RadixSort::Record(VkCommandBuffer cmd, const BufferRange& keys, const Buffe
             VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT |
                 VK_ACCESS_2_INDIRECT_COMMAND_READ_BIT);
     };
+    const uint64_t area_words = HistogramAreaWords(max_count);
     const VkBuffer params_buffer = scratch.params.buffer;
     const VkDeviceSize params_offset = scratch.params.offset;
 
-    bind(keys, values, scratch.keys_alt, scratch.values_alt);
-    push_constants();
-    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, setup_.Get());
-    vkCmdDispatch(cmd, 1, 1, 1);
-    barrier();
+    if (params == Params::kSetupPass) {
+        bind(keys, values, scratch.keys_alt, scratch.values_alt);
+        push_constants();
+        vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, setup_.Get());
+        vkCmdDispatch(cmd, 1, 1, 1);
+        barrier();
+    }
 
     if (max_count == 0) return;  // params now say count 0; nothing to move
 
@@ -190,10 +201,21 @@ void RadixSort::Record(VkCommandBuffer cmd, const BufferRange& keys, const Buffe
         }
         push.shift = pass * kRadixSortDigitBits;
         push.digit_bits = std::min(kRadixSortDigitBits, num_bits - push.shift);
+        // Areas alternate; this pass's scatter counts the next pass's digits.
+        push.area = static_cast<uint32_t>(pass % 2 == 0 ? 0 : area_words);
+        push.next_area = static_cast<uint32_t>(pass % 2 == 0 ? area_words : 0);
+        push.next_digit = 0;
+        if (pass + 1 < num_passes) {
+            const uint32_t next_shift = push.shift + kRadixSortDigitBits;
+            push.next_digit = next_shift | std::min(kRadixSortDigitBits, num_bits - next_shift)
+                                               << 8;
+        }
         push_constants();
-        vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, histogram_.Get());
-        vkCmdDispatchIndirect(cmd, params_buffer, params_offset);
-        barrier();
+        if (pass == 0) {
+            vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, histogram_.Get());
+            vkCmdDispatchIndirect(cmd, params_buffer, params_offset);
+            barrier();
+        }
         // One workgroup per digit; rows of digits above digit_bits are all zero.
         vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, scan_.Get());
         vkCmdDispatch(cmd, kRadixSortBins, 1, 1);

@@ -2,9 +2,10 @@
 // caller allocates the scratch buffers from GetStorageRequirements and Record() only
 // records commands. The element count is read on the GPU from the producer's buffer.
 //
-// Algorithm (docs/vulkan.md): LSD, 8-bit digits, ceil(num_bits / 8) passes. Per pass:
-// histogram (per-block digit counts) -> scan (one workgroup per digit) -> scatter (stable
-// in-workgroup ranking from subgroup scans), each per-block pass dispatched indirectly
+// Algorithm (docs/vulkan.md): LSD, 8-bit digits, ceil(num_bits / 8) passes. A histogram
+// pass counts the first digit per block; per pass: scan (one workgroup per digit) ->
+// scatter (stable in-workgroup ranking from subgroup ballots, which also counts the next
+// pass's digits per destination block), each per-block pass dispatched indirectly
 // with the block count a setup shader writes: blocks of 256..4096 elements, at most
 // kRadixSortTargetBlocks of them while 4096-element blocks are not needed. Stable for any subgroup
 // size; keys bits at and above num_bits are carried but do not affect the order.
@@ -28,7 +29,7 @@ class VulkanContext;
 struct RadixSortStorageRequirements {
     VkDeviceSize keys_alt_bytes = 0;    ///< uint32 [max_count]
     VkDeviceSize values_alt_bytes = 0;  ///< uint32 [max_count]
-    VkDeviceSize histogram_bytes = 0;   ///< uint32 [256 + 256 * max blocks]
+    VkDeviceSize histogram_bytes = 0;   ///< uint32 [2][256 + 256 * max blocks]
     VkDeviceSize params_bytes = 0;      ///< shader::RadixSortParams
     /// Usage of keys_alt, values_alt and histogram.
     VkBufferUsageFlags scratch_usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
@@ -62,6 +63,17 @@ public:
     static RadixSortStorageRequirements GetStorageRequirements(uint32_t max_count);
     /// Passes for `num_bits` key bits: ceil(num_bits / 8).
     static uint32_t GetNumPasses(uint32_t num_bits) { return (num_bits + 7u) / 8u; }
+    /// The block count the sort aims at on this device (RadixSortParamsFor's target_blocks).
+    uint32_t GetTargetBlocks() const;
+
+    /// Who writes `scratch.params` before the passes.
+    enum class Params {
+        kSetupPass,  ///< the sort's own setup dispatch, from the GPU count at `count`
+        /// The producer already wrote RadixSortParamsFor(count, max_count, GetTargetBlocks())
+        /// in a shader and made it visible to COMPUTE_SHADER and DRAW_INDIRECT reads: one
+        /// dispatch fewer. `count` is then not read.
+        kWrittenByProducer,
+    };
 
     /// Records a stable sort of the first `count` pairs of (keys, values) by the low
     /// `num_bits` (0..32) bits of the keys, count = min(the uint at `count`, max_count).
@@ -77,7 +89,7 @@ public:
                 const BufferRange& values,  // uint32 [max_count], permuted with keys
                 const RadixSortScratch& scratch,
                 const BufferRange& count,  // uint32 written on the GPU by the producer
-                uint32_t max_count, uint32_t num_bits) const;
+                uint32_t max_count, uint32_t num_bits, Params params = Params::kSetupPass) const;
 
 private:
     void CheckArguments(const BufferRange& keys, const BufferRange& values,
