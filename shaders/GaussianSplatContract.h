@@ -85,13 +85,9 @@ struct RadixSortPushConstants {
     uint count_index;    // uint index of the count within the count binding
     uint max_count;      // capacity of the key/value buffers
     uint target_blocks;  // 1..kRadixSortTargetBlocks: block count the setup aims at
-    // The histogram binding holds two areas of kRadixSortBins digit totals followed by
-    // [kRadixSortBins][blocks] block counts. A pass reads the area at `area`; its scatter
-    // adds the NEXT pass's block counts into the area at `next_area` (which the pass's scan
-    // zeroes first), so only the first pass runs radix_sort_histogram.comp.
-    uint area;        // uint offset of this pass's area
-    uint next_area;   // uint offset of the other area
-    uint next_digit;  // the next pass's shift | digit_bits << 8; 0: last pass, nothing to add
+    uint reserved0;
+    uint reserved1;
+    uint reserved2;
 };
 
 // ---- Sort-key layout of the seed's packed (tile, depth) key, a measured option ----

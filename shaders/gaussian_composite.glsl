@@ -78,15 +78,19 @@ void BlendSplat(uint j, inout PixelState p) {
     vec4 cdo = s_center_depth_opacity[j];
     // Scene-depth test: a splat behind the opaque geometry is skipped.
     if (kSceneDepth != 0u && cdo.z > p.scene_z) return;
+    // The 3DGS power -(a dx^2 + c dy^2) / 2 - b dx dy in base-2 units (s_conic holds the
+    // conic times -log2(e) / 2, -log2(e), -log2(e) / 2): exp(power) = exp2(power2), and the
+    // multiplications by -1/2 and log2(e) are done once per splat, not per pixel.
     vec4 conic = s_conic[j];
     vec2 d = cdo.xy - p.position;
-    float power = -0.5 * (conic.x * d.x * d.x + conic.z * d.y * d.y) - conic.y * d.x * d.y;
-    // conic.w = -t / 2 for the splat's widened tile-culling threshold t (TileCullThreshold):
-    // below it alpha < 1/255 is certain even after this float32 rounding of the power, so
-    // the pixel skips the splat without the exp, exactly as the alpha test below would.
-    // Most (pixel, splat) pairs of a tile lie outside the ellipse.
-    if (power > 0.0 || power < conic.w) return;
-    float alpha = min(kCompositeMaxAlpha, cdo.w * exp(power));
+    float power2 = d.x * (conic.x * d.x + conic.y * d.y) + conic.z * d.y * d.y;
+    // conic.w = -t log2(e) / 2 for the splat's widened tile-culling threshold t
+    // (TileCullThreshold): below it alpha < 1/255 is certain even after this float32
+    // rounding of the power (its margin covers the base change's ulp), so the pixel skips the
+    // splat without the exp, exactly as the alpha test below would. Most (pixel, splat)
+    // pairs of a tile lie outside the ellipse.
+    if (power2 > 0.0 || power2 < conic.w) return;
+    float alpha = min(kCompositeMaxAlpha, cdo.w * exp2(power2));
     if (alpha < kCompositeMinAlpha) return;
     float next_transmittance = p.transmittance * (1.0 - alpha);
     // Stop BEFORE blending: this splat would make the pixel (almost) opaque.
@@ -104,6 +108,8 @@ void BlendSplat(uint j, inout PixelState p) {
         p.median_found = true;
     }
 }
+
+const float kLog2E = 1.4426950408889634;
 
 // Splats blended per iteration of the batch loop. Unrolled by hand because llvmpipe
 // (lavapipe) ends every loop of an invocation once 65535 back-edges have been taken in
@@ -151,7 +157,8 @@ void main() {
             if (entry < end) {
                 GaussianProjectedSplat splat = projected[entry_values[entry]];
                 s_center_depth_opacity[local] = splat.center_depth_opacity;
-                s_conic[local] = vec4(splat.conic.xyz, -0.5 * splat.conic.w);
+                s_conic[local] = splat.conic * vec4(-0.5 * kLog2E, -kLog2E, -0.5 * kLog2E,
+                                                    -0.5 * kLog2E);
                 s_color[local] = splat.color;
             }
             barrier();

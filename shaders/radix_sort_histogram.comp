@@ -1,7 +1,6 @@
 #version 460
-// Block counts of the FIRST pass's digit, stored digit-major so that one exclusive scan per
-// digit row (radix_sort_scan.comp) gives every block its output offset within a digit. The
-// later passes' counts are added by the previous pass's scatter.
+// Pass 1 of a digit: per-block digit counts, stored digit-major so that one exclusive scan
+// per digit row (radix_sort_scan.comp) gives every block its output offset within a digit.
 #extension GL_GOOGLE_include_directive : require
 #include "radix_sort_common.glsl"
 
@@ -13,7 +12,7 @@ layout(std430, set = 0, binding = kRadixSortParamsBinding) readonly buffer Param
 layout(std430, set = 0, binding = kRadixSortKeysInBinding) readonly buffer KeysBlock {
     uint keys_in[];
 };
-// Area pc.area: [kRadixSortBins] digit totals, then [kRadixSortBins][num_blocks] counts.
+// [kRadixSortBins] digit totals, then [kRadixSortBins][num_blocks] block counts.
 layout(std430, set = 0, binding = kRadixSortHistogramBinding) writeonly buffer HistogramBlock {
     uint histogram[];
 };
@@ -32,6 +31,5 @@ void main() {
         if (index < count) atomicAdd(s_counts[DigitOf(keys_in[index])], 1u);
     }
     barrier();
-    histogram[pc.area + kRadixSortBins + local * params.num_blocks + gl_WorkGroupID.x] =
-            s_counts[local];
+    histogram[kRadixSortBins + local * params.num_blocks + gl_WorkGroupID.x] = s_counts[local];
 }

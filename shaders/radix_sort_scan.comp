@@ -1,8 +1,6 @@
 #version 460
-// Step 1 of a pass: one workgroup per digit turns its row of block counts into exclusive
-// offsets (in block order, which keeps the sort stable) and stores the digit's total. Unless
-// this is the last pass, it also zeroes its row of the other area, where this pass's
-// scatter counts the next pass's digits (the previous pass read that area; it is done).
+// Pass 2 of a digit: one workgroup per digit turns its row of block counts into exclusive
+// offsets (in block order, which keeps the sort stable) and stores the digit's total.
 #extension GL_GOOGLE_include_directive : require
 #include "radix_sort_common.glsl"
 
@@ -19,13 +17,7 @@ void main() {
     InitScanSlot();
     uint digit = gl_WorkGroupID.x;
     uint num_blocks = params.num_blocks;
-    uint row = pc.area + kRadixSortBins + digit * num_blocks;
-    if (pc.next_digit != 0u) {
-        uint next_row = pc.next_area + kRadixSortBins + digit * num_blocks;
-        for (uint block = g_slot; block < num_blocks; block += kRadixSortWorkgroupSize) {
-            histogram[next_row + block] = 0u;
-        }
-    }
+    uint row = kRadixSortBins + digit * num_blocks;
     uint running = 0u;
     // num_blocks is uniform, so every invocation takes the barriers inside the scan.
     for (uint begin = 0u; begin < num_blocks; begin += kRadixSortWorkgroupSize) {
@@ -36,5 +28,5 @@ void main() {
         if (block < num_blocks) histogram[row + block] = running + prefix;
         running += total;
     }
-    if (g_slot == 0u) histogram[pc.area + digit] = running;
+    if (g_slot == 0u) histogram[digit] = running;
 }

@@ -1,14 +1,12 @@
 #version 460
-// Step 2 of a pass: moves every pair of a block to its sorted position. The block is
+// Pass 3 of a digit: moves every pair of a block to its sorted position. The block is
 // processed in chunks of kRadixSortWorkgroupSize pairs, one per invocation in scan-slot
 // order. Each subgroup ranks its pairs by digit with ballots (the lanes holding the same
 // digit are the intersection of one ballot per digit bit), the per-subgroup digit counts
 // are scanned across subgroups in shared memory, and every pair is written straight to
 // digit offset + earlier subgroups' count + rank among its subgroup's equal digits.
 // Three barriers per chunk; the earlier two-round 4-bit split needed ten and ran the H100's
-// 6M-key depth sort at a third of this speed. Unless this is the last pass, every pair also
-// counts its next digit for the block it lands in (a global atomic), which saves each later
-// pass a histogram dispatch and a read of the keys.
+// 6M-key depth sort at a third of this speed.
 // Stability: pairs are loaded in scan-slot order (subgroups by gl_SubgroupID, lanes by
 // gl_SubgroupInvocationID, the order of ballot bits), earlier subgroups take lower
 // positions, chunks run in index order and blocks take their offsets in block order, so
@@ -35,7 +33,7 @@ layout(std430, set = 0, binding = kRadixSortKeysOutBinding) writeonly buffer Key
 layout(std430, set = 0, binding = kRadixSortValuesOutBinding) writeonly buffer ValuesOutBlock {
     uint values_out[];
 };
-layout(std430, set = 0, binding = kRadixSortHistogramBinding) buffer HistogramBlock {
+layout(std430, set = 0, binding = kRadixSortHistogramBinding) readonly buffer HistogramBlock {
     uint histogram[];
 };
 
@@ -62,9 +60,9 @@ void main() {
     // Output offset of this block per digit = all smaller digits + earlier blocks' digit.
     {
         uint total;
-        uint digit_base = WorkgroupExclusiveAdd(histogram[pc.area + g_slot], total);
-        s_digit_offset[g_slot] = digit_base + histogram[pc.area + kRadixSortBins +
-                                                        g_slot * num_blocks + block];
+        uint digit_base = WorkgroupExclusiveAdd(histogram[g_slot], total);
+        s_digit_offset[g_slot] =
+                digit_base + histogram[kRadixSortBins + g_slot * num_blocks + block];
     }
     uint words = gl_NumSubgroups * kPairWords;
     for (uint w = local; w < words; w += kRadixSortWorkgroupSize) s_counts[w] = 0u;
@@ -73,9 +71,6 @@ void main() {
 
     uint block_size = params.block_size;
     uint block_begin = block * block_size;
-    uint next_shift = pc.next_digit & 0xFFu;
-    uint next_mask = (1u << (pc.next_digit >> 8u)) - 1u;
-    uint next_rows = pc.next_area + kRadixSortBins;
     for (uint chunk_begin = block_begin; chunk_begin < block_begin + block_size;
          chunk_begin += kRadixSortWorkgroupSize) {
         if (chunk_begin >= count) break;  // uniform over the workgroup
@@ -115,10 +110,6 @@ void main() {
                     s_digit_offset[digit] + HalfOf(s_counts[row + (digit >> 1u)], digit) + rank;
             keys_out[out_index] = key;
             values_out[out_index] = value;
-            if (pc.next_digit != 0u) {
-                uint next = (key >> next_shift) & next_mask;
-                atomicAdd(histogram[next_rows + next * num_blocks + out_index / block_size], 1u);
-            }
         }
         barrier();  // every offset and count was read before they change
         s_digit_offset[local] += HalfOf(s_totals[local >> 1u], local);

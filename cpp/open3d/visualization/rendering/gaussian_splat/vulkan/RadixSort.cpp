@@ -40,11 +40,6 @@ uint32_t MaxBlocks(uint32_t max_count) {
         std::max<uint64_t>(std::min<uint64_t>(smallest, kRadixSortTargetBlocks), largest));
 }
 
-// uints of one histogram area: digit totals, then the block counts of every digit.
-uint64_t HistogramAreaWords(uint32_t max_count) {
-    return kRadixSortBins + uint64_t(kRadixSortBins) * MaxBlocks(max_count);
-}
-
 }  // namespace
 
 RadixSort::RadixSort(const VulkanContext& context) : context_(&context) {
@@ -76,7 +71,8 @@ RadixSortStorageRequirements RadixSort::GetStorageRequirements(uint32_t max_coun
     RadixSortStorageRequirements requirements;
     requirements.keys_alt_bytes = Words(max_count);
     requirements.values_alt_bytes = Words(max_count);
-    requirements.histogram_bytes = 2 * HistogramAreaWords(max_count) * 4;
+    requirements.histogram_bytes =
+        Words(kRadixSortBins + uint64_t(kRadixSortBins) * MaxBlocks(max_count));
     requirements.params_bytes = sizeof(RadixSortParams);
     return requirements;
 }
@@ -178,7 +174,6 @@ void RadixSort::Record(VkCommandBuffer cmd, const BufferRange& keys, const Buffe
             VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT |
                 VK_ACCESS_2_INDIRECT_COMMAND_READ_BIT);
     };
-    const uint64_t area_words = HistogramAreaWords(max_count);
     const VkBuffer params_buffer = scratch.params.buffer;
     const VkDeviceSize params_offset = scratch.params.offset;
 
@@ -201,21 +196,10 @@ void RadixSort::Record(VkCommandBuffer cmd, const BufferRange& keys, const Buffe
         }
         push.shift = pass * kRadixSortDigitBits;
         push.digit_bits = std::min(kRadixSortDigitBits, num_bits - push.shift);
-        // Areas alternate; this pass's scatter counts the next pass's digits.
-        push.area = static_cast<uint32_t>(pass % 2 == 0 ? 0 : area_words);
-        push.next_area = static_cast<uint32_t>(pass % 2 == 0 ? area_words : 0);
-        push.next_digit = 0;
-        if (pass + 1 < num_passes) {
-            const uint32_t next_shift = push.shift + kRadixSortDigitBits;
-            push.next_digit = next_shift | std::min(kRadixSortDigitBits, num_bits - next_shift)
-                                               << 8;
-        }
         push_constants();
-        if (pass == 0) {
-            vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, histogram_.Get());
-            vkCmdDispatchIndirect(cmd, params_buffer, params_offset);
-            barrier();
-        }
+        vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, histogram_.Get());
+        vkCmdDispatchIndirect(cmd, params_buffer, params_offset);
+        barrier();
         // One workgroup per digit; rows of digits above digit_bits are all zero.
         vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, scan_.Get());
         vkCmdDispatch(cmd, kRadixSortBins, 1, 1);

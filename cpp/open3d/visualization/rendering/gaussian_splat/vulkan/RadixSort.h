@@ -2,10 +2,9 @@
 // caller allocates the scratch buffers from GetStorageRequirements and Record() only
 // records commands. The element count is read on the GPU from the producer's buffer.
 //
-// Algorithm (docs/vulkan.md): LSD, 8-bit digits, ceil(num_bits / 8) passes. A histogram
-// pass counts the first digit per block; per pass: scan (one workgroup per digit) ->
-// scatter (stable in-workgroup ranking from subgroup ballots, which also counts the next
-// pass's digits per destination block), each per-block pass dispatched indirectly
+// Algorithm (docs/vulkan.md): LSD, 8-bit digits, ceil(num_bits / 8) passes. Per pass:
+// histogram (per-block digit counts) -> scan (one workgroup per digit) -> scatter (stable
+// in-workgroup ranking from subgroup ballots), each per-block pass dispatched indirectly
 // with the block count a setup shader writes: blocks of 256..4096 elements, at most
 // kRadixSortTargetBlocks of them while 4096-element blocks are not needed. Stable for any subgroup
 // size; keys bits at and above num_bits are carried but do not affect the order.
@@ -29,7 +28,7 @@ class VulkanContext;
 struct RadixSortStorageRequirements {
     VkDeviceSize keys_alt_bytes = 0;    ///< uint32 [max_count]
     VkDeviceSize values_alt_bytes = 0;  ///< uint32 [max_count]
-    VkDeviceSize histogram_bytes = 0;   ///< uint32 [2][256 + 256 * max blocks]
+    VkDeviceSize histogram_bytes = 0;   ///< uint32 [256 + 256 * max blocks]
     VkDeviceSize params_bytes = 0;      ///< shader::RadixSortParams
     /// Usage of keys_alt, values_alt and histogram.
     VkBufferUsageFlags scratch_usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
