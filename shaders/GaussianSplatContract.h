@@ -281,9 +281,8 @@ OPEN3D_SHADER_CONST uint kDispatchArgsAfterScan = 1u;     // counts the entries 
 struct GaussianDispatchArgsPushConstants {
     uint mode;        // kDispatchArgsAfterProject / kDispatchArgsAfterScan
     uint num_levels;  // scan levels recorded (1..kScanMaxLevels)
-    // The next sort's parameters (RadixSortParamsFor) are written here, saving the sort its
-    // setup dispatch: after the projection the depth sort's (count N), after the scan the
-    // tile sort's (count = entries that fit).
+    // After the scan, the tile sort's parameters (RadixSortParamsFor, count = entries that
+    // fit) are written here, saving the sort its setup dispatch.
     uint sort_max_count;
     uint sort_target_blocks;
 };

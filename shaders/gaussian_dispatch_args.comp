@@ -1,8 +1,9 @@
 #version 460
 // Stage A indirect sizes from GPU-side counts (no CPU readback between passes).
-// After the projection: the scan levels and the emit pass, from the visible count, and the
-// depth sort's parameters. After the scan: how many entries fit, and the tile sort's
-// parameters (RadixSortParamsFor, what the sort's setup dispatch would write). Splats emit whole or not at all, front to back, so
+// After the projection (packed key only; the exact order's sizes depend on N alone and the
+// host writes them): the scan levels and the emit pass, from the visible count. After the
+// scan: how many entries fit, and the tile sort's parameters (RadixSortParamsFor, what the
+// sort's setup dispatch would write). Splats emit whole or not at all, front to back, so
 // the emitting splats are a prefix of the depth order: the first splat whose inclusive
 // offset passes the capacity is found by binary search and everything from it is dropped.
 #extension GL_GOOGLE_include_directive : require
@@ -46,8 +47,6 @@ void SizeScanAndEmit() {
         counters.scan_levels[level].count = recorded ? count : 0u;
         count = blocks;
     }
-    sort_params =
-            RadixSortParamsFor(counters.num_splats, pc.sort_max_count, pc.sort_target_blocks);
 }
 
 // Inclusive offset of sorted visible splat k: the next exclusive offset, or the total.

@@ -5,7 +5,8 @@
 // totals back down. Additions saturate at kScanSaturation (the total of a frame can pass
 // 2^32), and the workgroup scan runs in shared memory by local index, so the result does
 // not depend on the subgroup size or shape. Level 0 with kScanGather reads its counts
-// from the depth-sorted visible list (splats over max_tiles_per_splat count 0 and flag).
+// from the depth-sorted visible list (splats over max_tiles_per_splat count 0 and flag;
+// slots past visible_count, which the exact order also scans, count 0).
 #extension GL_GOOGLE_include_directive : require
 #include "GaussianSplatContract.h"
 
@@ -41,6 +42,9 @@ uint SatAdd(uint a, uint b) {
 
 uint LoadCount(uint index) {
     if (kGather == 0u) return scan[pc.base + index];
+    // The exact order scans all N slots; past the visible ones (culled splats, sorted last)
+    // the records are stale and count nothing.
+    if (index >= counters.visible_count) return 0u;
     uint count = projected[splat_indices[index]].tiles.z;
     if (count > view.limits.y) {  // over max_tiles_per_splat: the splat emits nothing
         atomicOr(counters.error_flags, kErrorEntriesDropped);

@@ -175,13 +175,35 @@ void GaussianStageA::Record(VkCommandBuffer cmd, const StageASceneBuffers& scene
     vkCmdUpdateBuffer(cmd, buffers.view_params.buffer, buffers.view_params.offset, sizeof(params),
                       &params);
     // Counters start at zero but for N, the element count of the exact mode's depth sort
-    // (the sorter reads counts from GPU memory).
+    // (the sorter reads counts from GPU memory). In the exact order the scan and the emit
+    // run over all N slots of the depth-sorted list (culled splats sort last and count no
+    // tiles), so their sizes and the depth sort's parameters are known here: no
+    // dispatch-args pass between the projection and the sort.
     GaussianStageACounters initial_counters{};
     initial_counters.num_splats = n;
+    if (!packed_key) {
+        initial_counters.emit_dispatch_x = DivCeil(n, kEmitWorkgroupSize);
+        initial_counters.emit_dispatch_y = 1;
+        initial_counters.emit_dispatch_z = 1;
+        uint32_t count = n;
+        for (uint32_t level = 0; level < kScanMaxLevels; ++level) {
+            const uint32_t blocks = DivCeil(count, kScanBlockSize);
+            const bool recorded = level < need.num_scan_levels;
+            initial_counters.scan_levels[level] = {recorded ? blocks : 0u, 1u, 1u,
+                                                   recorded ? count : 0u};
+            count = blocks;
+        }
+        const RadixSortParams depth_sort =
+            RadixSortParamsFor(n, std::max(n, 1u), sort_.GetTargetBlocks());
+        vkCmdUpdateBuffer(cmd, buffers.sort_scratch.params.buffer,
+                          buffers.sort_scratch.params.offset, sizeof(depth_sort), &depth_sort);
+    }
     vkCmdUpdateBuffer(cmd, counters, counters_offset, sizeof(initial_counters), &initial_counters);
-    RecordMemoryBarrier(cmd, VK_PIPELINE_STAGE_2_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
-                        VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
-                        VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
+    RecordMemoryBarrier(
+        cmd, VK_PIPELINE_STAGE_2_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
+        VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_DRAW_INDIRECT_BIT,
+        VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT |
+            VK_ACCESS_2_INDIRECT_COMMAND_READ_BIT);
 
     // 1. Project: visible splats -> (depth key, splat index) list, visible_count.
     PushBindings(cmd, scene, buffers);
@@ -191,16 +213,18 @@ void GaussianStageA::Record(VkCommandBuffer cmd, const StageASceneBuffers& scene
     if (n > 0) vkCmdDispatch(cmd, DivCeil(n, kProjectWorkgroupSize), 1, 1);
     ComputeBarrier(cmd);
 
-    // 2. Dispatch sizes of the scan levels and the emit pass from visible_count.
+    // 2. Packed key: the scan and the emit follow the append order of the visible splats,
+    // sized on the GPU from visible_count.
     GaussianDispatchArgsPushConstants args{};
-    args.mode = kDispatchArgsAfterProject;
     args.num_levels = need.num_scan_levels;
-    args.sort_max_count = std::max(n, 1u);
     args.sort_target_blocks = sort_.GetTargetBlocks();
-    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, dispatch_args_.Get());
-    vkCmdPushConstants(cmd, layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(args), &args);
-    vkCmdDispatch(cmd, 1, 1, 1);
-    ComputeBarrier(cmd);
+    if (packed_key) {
+        args.mode = kDispatchArgsAfterProject;
+        vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, dispatch_args_.Get());
+        vkCmdPushConstants(cmd, layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(args), &args);
+        vkCmdDispatch(cmd, 1, 1, 1);
+        ComputeBarrier(cmd);
+    }
     if (timestamps) {
         timestamps->RecordEnd(cmd, TimedPass::kProject);
         timestamps->RecordBegin(cmd, TimedPass::kSort);

@@ -91,17 +91,18 @@ public:
                                                             uint32_t entry_capacity);
 
     /// Records Stage A for one view: writes `params` into buffers.view_params, zeroes the
-    /// counters, then project (slot i = splat i) -> dispatch args (which also write the
-    /// sorts' parameters, so neither sort runs its setup pass) -> one stable sort of all
-    /// N slots by depth (culled splats last, ties by index) -> scan tile counts -> dispatch args ->
-    /// emit entries -> stable sort by tile (params.limits.w bits). Every size after the projection
-    /// comes from GPU-side counts. `params` must come from PackGaussianViewParams for this scene
-    /// and a capacity <= the one the buffers were sized for.
+    /// counters (and, from N, the scan and emit sizes and the depth sort's parameters), then
+    /// project (slot i = splat i) -> one stable sort of all
+    /// N slots by depth (culled splats last, ties by index) -> scan tile counts of the N slots
+    /// -> dispatch args (entries that fit; the tile sort's parameters, so no sort runs its setup
+    /// pass) -> emit entries -> stable sort by tile (params.limits.w bits). Every size after the
+    /// projection comes from GPU-side counts. `params` must come from PackGaussianViewParams for
+    /// this scene and a capacity <= the one the buffers were sized for.
     ///
     /// With the packed key (UsesPackedSortKey(params)): no sort of the visible list (scan
-    /// and emit follow the append order), entries keyed by shader::PackedSortKey, one
-    /// stable 32-bit sort, then the keys are shifted back to tile indices. The outputs have
-    /// the same layout in both modes.
+    /// and emit follow the append order, sized by a dispatch-args pass), entries keyed by
+    /// shader::PackedSortKey, one stable 32-bit sort, then the keys are shifted back to tile
+    /// indices. The outputs have the same layout in both modes.
     ///
     /// Synchronisation: the caller orders earlier uses of these buffers before Record (and
     /// makes scene uploads visible to compute reads); afterwards all results are
