@@ -87,10 +87,12 @@ void BlendSplat(uint j, inout PixelState p) {
     // conic.w = -t log2(e) / 2 for the splat's widened tile-culling threshold t
     // (TileCullThreshold): below it alpha < 1/255 is certain even after this float32
     // rounding of the power (its margin covers the base change's ulp), so the pixel skips the
-    // splat without the exp, exactly as the alpha test below would. Most (pixel, splat)
-    // pairs of a tile lie outside the ellipse.
-    if (power2 > 0.0 || power2 < conic.w) return;
-    float alpha = min(kCompositeMaxAlpha, cdo.w * exp2(power2));
+    // splat as the alpha test would. Most (pixel, splat) pairs of a tile lie outside the
+    // ellipse. Folding this test into the alpha test (one branch instead of two, the exp2
+    // result selected away) measured 0.604 -> 0.588 ms at 4K on the H100 (1080p 0.246 ->
+    // 0.243, the grid 2.70 -> 2.73).
+    bool outside = power2 > 0.0 || power2 < conic.w;
+    float alpha = outside ? 0.0 : min(kCompositeMaxAlpha, cdo.w * exp2(power2));
     if (alpha < kCompositeMinAlpha) return;
     float next_transmittance = p.transmittance * (1.0 - alpha);
     // Stop BEFORE blending: this splat would make the pixel (almost) opaque.
@@ -114,6 +116,7 @@ const float kLog2E = 1.4426950408889634;
 // Splats blended per iteration of the batch loop. Unrolled by hand because llvmpipe
 // (lavapipe) ends every loop of an invocation once 65535 back-edges have been taken in
 // total (gallivm's loop limiter): at 8 splats per back-edge a tile may hold ~500k entries.
+// It pays on the H100 too: a plain loop measured 0.303 vs 0.243 ms (playbot 1080p).
 const uint kUnroll = 8u;
 
 void main() {
