@@ -425,7 +425,8 @@ OPEN3D_SHADER_FUNC uint TileSpanCount(uint span) { return (span >> 16u) - (span 
 // fewest chunks of kRadixSortWorkgroupSize that keep the block count at or below
 // target_blocks (clamped to 1..kRadixSortTargetBlocks), 1..kRadixSortItemsPerInvocation
 // chunks. radix_sort_setup.comp calls it, and so does a producer that writes the sort's
-// parameters itself (gaussian_dispatch_args.comp), saving the sort its setup dispatch. No
+// parameters itself (gaussian_dispatch_args.comp, and GaussianStageA on the host for the
+// depth sort, whose count is N), saving the sort its setup dispatch. No
 // overflow: the host keeps max_count far below 2^32 - kRadixSortBlockSize.
 OPEN3D_SHADER_FUNC RadixSortParams RadixSortParamsFor(uint count, uint max_count,
                                                       uint target_blocks) {

@@ -69,8 +69,8 @@ public:
     enum class Params {
         kSetupPass,  ///< the sort's own setup dispatch, from the GPU count at `count`
         /// The producer already wrote RadixSortParamsFor(count, max_count, GetTargetBlocks())
-        /// in a shader and made it visible to COMPUTE_SHADER and DRAW_INDIRECT reads: one
-        /// dispatch fewer. `count` is then not read.
+        /// (from a shader, or from the host with vkCmdUpdateBuffer) and made it visible to
+        /// COMPUTE_SHADER and DRAW_INDIRECT reads: one dispatch fewer. `count` is not read.
         kWrittenByProducer,
     };
 
