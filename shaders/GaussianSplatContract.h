@@ -420,6 +420,22 @@ OPEN3D_SHADER_FUNC uint TileRowSpan(float cx, float cy, float a, float b, float 
 // Tiles of a span from TileRowSpan.
 OPEN3D_SHADER_FUNC uint TileSpanCount(uint span) { return (span >> 16u) - (span & 0xFFFFu); }
 
+// ---- Scan level sizes ----
+// Indirect size of scan level `level` of a scan over `count` elements (level l + 1 scans
+// the block sums of level l, ceil(count / kScanBlockSize^l) of them); levels at and past
+// `num_levels` are not recorded and get zero groups. gaussian_dispatch_args.comp sizes the
+// packed key's scan from visible_count with it, GaussianStageA the exact order's from N.
+OPEN3D_SHADER_FUNC GaussianScanLevel ScanLevelFor(uint count, uint level, uint num_levels) {
+    for (uint l = 0u; l < level; ++l) count = (count + kScanBlockSize - 1u) / kScanBlockSize;
+    bool recorded = level < num_levels;
+    GaussianScanLevel size;
+    size.dispatch_x = recorded ? (count + kScanBlockSize - 1u) / kScanBlockSize : 0u;
+    size.dispatch_y = 1u;
+    size.dispatch_z = 1u;
+    size.count = recorded ? count : 0u;
+    return size;
+}
+
 // ---- Radix sort parameters for an element count ----
 // Clamps the count to max_count (kErrorCountsClamped) and chooses the block size: the
 // fewest chunks of kRadixSortWorkgroupSize that keep the block count at or below

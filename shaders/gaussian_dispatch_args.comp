@@ -37,15 +37,8 @@ void SizeScanAndEmit() {
     counters.emit_dispatch_x = DivCeil(visible, kEmitWorkgroupSize);
     counters.emit_dispatch_y = 1u;
     counters.emit_dispatch_z = 1u;
-    uint count = visible;
     for (uint level = 0u; level < kScanMaxLevels; ++level) {
-        uint blocks = DivCeil(count, kScanBlockSize);
-        bool recorded = level < pc.num_levels;
-        counters.scan_levels[level].dispatch_x = recorded ? blocks : 0u;
-        counters.scan_levels[level].dispatch_y = 1u;
-        counters.scan_levels[level].dispatch_z = 1u;
-        counters.scan_levels[level].count = recorded ? count : 0u;
-        count = blocks;
+        counters.scan_levels[level] = ScanLevelFor(visible, level, pc.num_levels);
     }
 }
 

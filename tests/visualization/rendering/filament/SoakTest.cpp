@@ -4,12 +4,12 @@
 // sizes and scenes are freed; on lavapipe device memory is host memory, so RSS covers GPU
 // allocations too). OPEN3D_SOAK_FRAMES=N renders N frames instead of 1,800.
 //
-// Resizes carry a one-time memory cost that differs by machine: this one measures +1.3 MiB
-// over the first 200 resizes after warm-up and +0.5 MiB over the next 100, then nothing; CI
-// once measured +13.5 MiB over the first 200. A leak grows without end, a one-time cost
-// stops, so the test resizes in blocks of 100 until one block grows by less than 256 KiB
-// (a leak of 2.6 KiB per resize or more never gets there; one 16x12 RGBA16F target of the
-// smallest size is 1.5 KiB before driver overhead).
+// Resizes carry a one-time memory cost that differs by machine: this one measures about
+// +0.7, +0.6, +0.6, +0.6, +0.4 MiB over the first five blocks of 100 resizes after warm-up,
+// then nothing; CI once measured +13.5 MiB over the first 200. A leak grows without end, a one-time
+// cost stops, so the test resizes in blocks of 100 until one block grows by less than 256 KiB (a
+// leak of 2.6 KiB per resize or more never gets there; one 16x12 RGBA16F target of the smallest
+// size is 1.5 KiB before driver overhead).
 #include <gtest/gtest.h>
 
 #include <cstdlib>

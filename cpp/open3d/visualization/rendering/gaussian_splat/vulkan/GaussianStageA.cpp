@@ -185,13 +185,8 @@ void GaussianStageA::Record(VkCommandBuffer cmd, const StageASceneBuffers& scene
         initial_counters.emit_dispatch_x = DivCeil(n, kEmitWorkgroupSize);
         initial_counters.emit_dispatch_y = 1;
         initial_counters.emit_dispatch_z = 1;
-        uint32_t count = n;
         for (uint32_t level = 0; level < kScanMaxLevels; ++level) {
-            const uint32_t blocks = DivCeil(count, kScanBlockSize);
-            const bool recorded = level < need.num_scan_levels;
-            initial_counters.scan_levels[level] = {recorded ? blocks : 0u, 1u, 1u,
-                                                   recorded ? count : 0u};
-            count = blocks;
+            initial_counters.scan_levels[level] = ScanLevelFor(n, level, need.num_scan_levels);
         }
         const RadixSortParams depth_sort =
             RadixSortParamsFor(n, std::max(n, 1u), sort_.GetTargetBlocks());
