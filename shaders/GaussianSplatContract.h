@@ -538,6 +538,9 @@ namespace shader {
 OPEN3D_SHADER_CONST uint kCompositeTileSize = 16u;  // == kGaussianTileSize (asserted in C++)
 OPEN3D_SHADER_CONST uint kCompositeWorkgroupSize = 256u;
 OPEN3D_SHADER_CONST uint kCompositeBatchSize = 256u;
+// Each 32 invocations blend an 8x4 pixel block of the tile (gaussian_composite.glsl).
+OPEN3D_SHADER_CONST uint kCompositeBlockWidth = 8u;
+OPEN3D_SHADER_CONST uint kCompositeBlockHeight = 4u;
 // The depth merge runs 16x16 pixels per workgroup.
 OPEN3D_SHADER_CONST uint kDepthMergeWorkgroupSize = 16u;
 
@@ -598,6 +601,8 @@ struct GaussianDepthMergePushConstants {
 
 #ifdef __cplusplus
 static_assert(kCompositeTileSize == kGaussianTileSize);
+static_assert(kCompositeTileSize == 2u * kCompositeBlockWidth, "two blocks side by side");
+static_assert(kCompositeWorkgroupSize % (kCompositeBlockWidth * kCompositeBlockHeight) == 0u);
 static_assert(kCompositeWorkgroupSize == kCompositeTileSize * kCompositeTileSize);
 static_assert(kCompositeBatchSize == kCompositeWorkgroupSize, "one splat load per invocation");
 
