@@ -601,8 +601,8 @@ struct GaussianDepthMergePushConstants {
 
 #ifdef __cplusplus
 static_assert(kCompositeTileSize == kGaussianTileSize);
-static_assert(kCompositeTileSize == 2u * kCompositeBlockWidth, "two blocks side by side");
-static_assert(kCompositeWorkgroupSize % (kCompositeBlockWidth * kCompositeBlockHeight) == 0u);
+static_assert(kCompositeTileSize % kCompositeBlockWidth == 0u);
+static_assert(kCompositeTileSize % kCompositeBlockHeight == 0u);
 static_assert(kCompositeWorkgroupSize == kCompositeTileSize * kCompositeTileSize);
 static_assert(kCompositeBatchSize == kCompositeWorkgroupSize, "one splat load per invocation");
 

@@ -137,8 +137,10 @@ void main() {
         // of 32 pays for: 0.244 -> 0.237 ms composite (playbot 1080p), 0.467 -> 0.449 (biker
         // 4K), the grid 2.73 -> 2.63 on the H100.
         uint block = local / (kCompositeBlockWidth * kCompositeBlockHeight);
-        uvec2 in_tile = uvec2((block % 2u) * kCompositeBlockWidth + local % kCompositeBlockWidth,
-                              (block / 2u) * kCompositeBlockHeight +
+        uint blocks_x = kCompositeTileSize / kCompositeBlockWidth;
+        uvec2 in_tile = uvec2((block % blocks_x) * kCompositeBlockWidth +
+                                      local % kCompositeBlockWidth,
+                              (block / blocks_x) * kCompositeBlockHeight +
                                       (local / kCompositeBlockWidth) % kCompositeBlockHeight);
         ivec2 pixel = ivec2(uvec2(tile % tiles_x, tile / tiles_x) * kCompositeTileSize + in_tile);
         bool inside = pixel.x < int(size.x) && pixel.y < int(size.y);
