@@ -3,8 +3,9 @@
 // must be declared in GLSL (no shaderStorageImageWriteWithoutFormat), so each colour format
 // is its own SPIR-V module that defines OPEN3D_COMPOSITE_COLOR_FORMAT and includes this.
 //
-// One workgroup per 16x16 tile, one invocation per pixel, each 32 invocations an 8x4 block. A fixed grid of workgroups steals
-// tiles from a global atomic counter until none is left. A tile's entries are its range of
+// One workgroup per 16x16 tile, one invocation per pixel, each 32 invocations an 8x4 pixel
+// block. A fixed grid of workgroups steals tiles from a global atomic counter until none is
+// left. A tile's entries are its range of
 // the tile-sorted entries, found beforehand by gaussian_tile_ranges.comp (depth order
 // preserved inside a tile);
 // its splats are loaded cooperatively into shared memory in batches of 256 and blended front
