@@ -5,11 +5,10 @@
 //
 // One workgroup per 16x16 tile, one invocation per pixel, each 32 invocations an 8x4 pixel
 // block. A fixed grid of workgroups steals tiles from a global atomic counter until none is
-// left. A tile's entries are its range of
-// the tile-sorted entries, found beforehand by gaussian_tile_ranges.comp (depth order
-// preserved inside a tile);
-// its splats are loaded cooperatively into shared memory in batches of 256 and blended front
-// to back with exactly the 3DGS rules (docs/DESIGN.md section 3, cpu/Composite.cpp).
+// left. A tile's entries are its range of the tile-sorted entries, found beforehand by
+// gaussian_tile_ranges.comp (depth order preserved inside a tile); its splats are loaded
+// cooperatively into shared memory in batches of 256 and blended front to back with exactly
+// the 3DGS rules (docs/DESIGN.md section 3, cpu/Composite.cpp).
 #ifndef OPEN3D_GAUSSIAN_COMPOSITE_GLSL
 #define OPEN3D_GAUSSIAN_COMPOSITE_GLSL
 
