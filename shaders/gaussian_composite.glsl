@@ -127,21 +127,21 @@ void main() {
     // Workgroup i starts with tile i, then steals tiles num_workgroups, num_workgroups + 1...
     // from the counter: with as many workgroups as tiles (CPU devices) each does one tile.
     uint tile = gl_WorkGroupID.x;
+    // This invocation's pixel within every tile it takes. Invocations 32 k .. 32 k + 31
+    // cover block k of the tile: 8 columns by 4 rows, two blocks side by side. A compact block
+    // meets fewer splats than a 16x2 row pair and its pixels agree more often on whether they
+    // blend a splat, which is what a subgroup of 32 pays for: 0.244 -> 0.237 ms composite
+    // (playbot 1080p), 0.467 -> 0.449 (biker 4K), the grid 2.73 -> 2.63 on the H100.
+    uint block = local / (kCompositeBlockWidth * kCompositeBlockHeight);
+    uint blocks_x = kCompositeTileSize / kCompositeBlockWidth;
+    uvec2 in_tile = uvec2(
+            (block % blocks_x) * kCompositeBlockWidth + local % kCompositeBlockWidth,
+            (block / blocks_x) * kCompositeBlockHeight +
+                    (local / kCompositeBlockWidth) % kCompositeBlockHeight);
 
     while (tile < num_tiles) {  // uniform: tile comes from shared memory after a barrier
         if (local == 0u) s_done = 0u;
 
-        // Invocations 32 k .. 32 k + 31 cover block k of the tile: 8 columns by 4 rows, two
-        // blocks side by side. A compact block meets fewer splats than a 16x2 row pair and
-        // its pixels agree more often on whether they blend a splat, which is what a subgroup
-        // of 32 pays for: 0.244 -> 0.237 ms composite (playbot 1080p), 0.467 -> 0.449 (biker
-        // 4K), the grid 2.73 -> 2.63 on the H100.
-        uint block = local / (kCompositeBlockWidth * kCompositeBlockHeight);
-        uint blocks_x = kCompositeTileSize / kCompositeBlockWidth;
-        uvec2 in_tile = uvec2((block % blocks_x) * kCompositeBlockWidth +
-                                      local % kCompositeBlockWidth,
-                              (block / blocks_x) * kCompositeBlockHeight +
-                                      (local / kCompositeBlockWidth) % kCompositeBlockHeight);
         ivec2 pixel = ivec2(uvec2(tile % tiles_x, tile / tiles_x) * kCompositeTileSize + in_tile);
         bool inside = pixel.x < int(size.x) && pixel.y < int(size.y);
         PixelState p;
