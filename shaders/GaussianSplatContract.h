@@ -41,19 +41,26 @@ OPEN3D_SHADER_CONST uint kRadixSortDigitBits = 8u;
 OPEN3D_SHADER_CONST uint kRadixSortBins = 256u;  // 1 << kRadixSortDigitBits
 // One invocation per bin in the histogram, scan and scatter shaders (asserted below).
 OPEN3D_SHADER_CONST uint kRadixSortWorkgroupSize = 256u;
-// A workgroup owns a block of 256 * chunks elements, chunks = 1..16 chosen per sort by
+// A workgroup owns a block of 256 * chunks elements, chunks = 1..8 chosen per sort by
 // radix_sort_setup.comp from the GPU-side count: the fewest chunks that keep the block count
 // at or below kRadixSortTargetBlocks, so a small sort still spreads over the whole GPU
 // instead of queueing 16 chunks in a handful of workgroups (the H100 sorted 125k depth keys
 // 3x slower with fixed 4096-element blocks). 256 measured best on the H100 (playbot_125k
-// 1080p sort 0.232 ms; 128: 0.249, 1024: 0.252, 2048: 0.263).
-OPEN3D_SHADER_CONST uint kRadixSortItemsPerInvocation = 16u;  // chunks per block, at most
-OPEN3D_SHADER_CONST uint kRadixSortBlockSize = 4096u;         // elements per block, at most
-OPEN3D_SHADER_CONST uint kRadixSortTargetBlocks = 256u;       // GPUs; CPU devices use fewer
-// Upper bound of gl_NumSubgroups, sizing the shared arrays of per-subgroup counts (the
-// scatter's [32][128] words: 16 KiB of lavapipe's 32), so RadixSort requires
-// minSubgroupSize >= kRadixSortWorkgroupSize / kRadixSortMaxSubgroups = 8.
+// 1080p sort 0.232 ms; 128: 0.249, 1024: 0.252, 2048: 0.263). At most 2048 elements, so
+// that a block fits the scatter's shared memory for its local reorder (radix_sort_scatter).
+OPEN3D_SHADER_CONST uint kRadixSortItemsPerInvocation = 8u;  // chunks per block, at most
+OPEN3D_SHADER_CONST uint kRadixSortBlockSize = 2048u;        // elements per block, at most
+OPEN3D_SHADER_CONST uint kRadixSortTargetBlocks = 256u;      // GPUs; CPU devices use fewer
+// Upper bound of gl_NumSubgroups on any device (the scatter's per-subgroup counts are then
+// [32][128] words, 16 KiB of lavapipe's 32), so RadixSort requires minSubgroupSize >=
+// kRadixSortWorkgroupSize / kRadixSortMaxSubgroups = 8.
 OPEN3D_SHADER_CONST uint kRadixSortMaxSubgroups = 32u;
+// Specialisation constants of the radix-sort shaders, set by RadixSort.cpp per device:
+// the bound of gl_NumSubgroups there (kRadixSortWorkgroupSize / minSubgroupSize; 8 on
+// NVIDIA, whose scatter counts then take 4 KiB), and the scatter's local reorder capacity
+// (kRadixSortBlockSize where its shared arrays fit maxComputeSharedMemorySize, else 1).
+OPEN3D_SHADER_CONST uint kSpecRadixSortSubgroups = 0u;
+OPEN3D_SHADER_CONST uint kSpecRadixSortLocalCapacity = 1u;
 
 // Descriptor set 0 of every radix-sort pipeline (one push-descriptor layout for all).
 OPEN3D_SHADER_CONST uint kRadixSortParamsBinding = 0u;     // RadixSortParams

@@ -17,8 +17,10 @@ uint DigitOf(uint key) {
     return (key >> pc.shift) & ((1u << pc.digit_bits) - 1u);
 }
 
+layout(constant_id = kSpecRadixSortSubgroups) const uint kMaxSubgroups = kRadixSortMaxSubgroups;
+
 // Per-subgroup partial sums, indexed by gl_SubgroupID.
-shared uint s_subgroup_sum[kRadixSortMaxSubgroups];
+shared uint s_subgroup_sum[kMaxSubgroups];
 
 // The position of this invocation in the workgroup's scan order: subgroups in
 // gl_SubgroupID order, lanes in gl_SubgroupInvocationID order (the order of the subgroup

@@ -31,13 +31,23 @@ static_assert(offsetof(RadixSortParams, dispatch_x) == offsetof(VkDispatchIndire
 VkDeviceSize Words(uint64_t n) { return VkDeviceSize(std::max<uint64_t>(n, 1)) * 4; }
 
 // Most blocks radix_sort_setup.comp can choose for any count <= max_count: up to
-// kRadixSortTargetBlocks blocks of 256..4096 elements, beyond that 4096-element blocks.
+// kRadixSortTargetBlocks blocks of 256..kRadixSortBlockSize elements, beyond that blocks of
+// kRadixSortBlockSize.
 uint32_t MaxBlocks(uint32_t max_count) {
     const uint64_t smallest =
         (uint64_t(max_count) + kRadixSortWorkgroupSize - 1) / kRadixSortWorkgroupSize;
     const uint64_t largest = (uint64_t(max_count) + kRadixSortBlockSize - 1) / kRadixSortBlockSize;
     return static_cast<uint32_t>(
         std::max<uint64_t>(std::min<uint64_t>(smallest, kRadixSortTargetBlocks), largest));
+}
+
+// Shared memory of radix_sort_scatter.comp: per-digit next position and output shift,
+// per-subgroup counts (two digits per word), chunk totals, the scan's subgroup sums, and the
+// reordered keys and values.
+uint64_t ScatterSharedBytes(uint32_t max_subgroups, uint32_t local_capacity) {
+    const uint64_t words = 2 * kRadixSortBins + uint64_t(max_subgroups) * (kRadixSortBins / 2) +
+                           kRadixSortBins / 2 + max_subgroups + 2 * uint64_t(local_capacity);
+    return 4 * words;
 }
 
 }  // namespace
@@ -55,13 +65,30 @@ RadixSort::RadixSort(const VulkanContext& context) : context_(&context) {
     pipeline_layout_ =
         CreatePipelineLayout(context, set_layout_.Get(), sizeof(RadixSortPushConstants));
     VkPipelineLayout layout = pipeline_layout_.Get();
-    setup_ = CreateComputePipeline(context, layout, spirv::kRadixSortSetup, "radix_sort_setup");
-    histogram_ =
-        CreateComputePipeline(context, layout, spirv::kRadixSortHistogram, "radix_sort_histogram");
-    scan_ = CreateComputePipeline(context, layout, spirv::kRadixSortScan, "radix_sort_scan");
-    scatter_ =
-        CreateComputePipeline(context, layout, spirv::kRadixSortScatter, "radix_sort_scatter");
-    copy_ = CreateComputePipeline(context, layout, spirv::kRadixSortCopy, "radix_sort_copy");
+    // Shared arrays sized for the most subgroups a workgroup can have on this device; the
+    // scatter reorders each block in shared memory where its arrays fit.
+    struct {
+        uint32_t max_subgroups;
+        uint32_t local_capacity;
+    } constants{kRadixSortWorkgroupSize / info.min_subgroup_size, 1u};
+    constants.local_capacity = ScatterSharedBytes(constants.max_subgroups, kRadixSortBlockSize) <=
+                                       info.max_compute_shared_memory
+                                   ? kRadixSortBlockSize
+                                   : 1u;
+    local_reorder_ = constants.local_capacity > 1u;
+    const std::array<VkSpecializationMapEntry, 2> entries{
+        {{kSpecRadixSortSubgroups, 0, sizeof(uint32_t)},
+         {kSpecRadixSortLocalCapacity, sizeof(uint32_t), sizeof(uint32_t)}}};
+    const VkSpecializationInfo specialization{static_cast<uint32_t>(entries.size()), entries.data(),
+                                              sizeof(constants), &constants};
+    const auto create = [&](std::span<const uint32_t> spirv, const char* name) {
+        return CreateComputePipeline(context, layout, spirv, name, &specialization);
+    };
+    setup_ = create(spirv::kRadixSortSetup, "radix_sort_setup");
+    histogram_ = create(spirv::kRadixSortHistogram, "radix_sort_histogram");
+    scan_ = create(spirv::kRadixSortScan, "radix_sort_scan");
+    scatter_ = create(spirv::kRadixSortScatter, "radix_sort_scatter");
+    copy_ = create(spirv::kRadixSortCopy, "radix_sort_copy");
 }
 
 RadixSortStorageRequirements RadixSort::GetStorageRequirements(uint32_t max_count) {

@@ -51,8 +51,9 @@ struct RadixSortScratch {
 
 class RadixSort {
 public:
-    /// Largest max_count: ceil(max_count / 4096) workgroups must fit one dispatch.
-    static constexpr uint32_t kMaxCount = 65535u * 4096u;
+    /// Largest max_count: ceil(max_count / kRadixSortBlockSize) workgroups must fit one
+    /// dispatch (maxComputeWorkGroupCount >= 65535).
+    static constexpr uint32_t kMaxCount = 65535u * 2048u;
 
     /// Creates the pipelines. Throws core::Open3DError when the device's subgroups can be
     /// smaller than 4 invocations (the shaders size shared arrays by subgroup count).
@@ -64,6 +65,9 @@ public:
     static uint32_t GetNumPasses(uint32_t num_bits) { return (num_bits + 7u) / 8u; }
     /// The block count the sort aims at on this device (RadixSortParamsFor's target_blocks).
     uint32_t GetTargetBlocks() const;
+    /// Whether the scatter reorders each block in shared memory before writing it (where
+    /// the device's shared memory holds a block; lavapipe's 32 KiB does not).
+    bool UsesLocalReorder() const { return local_reorder_; }
 
     /// Who writes `scratch.params` before the passes.
     enum class Params {
@@ -103,6 +107,7 @@ private:
     UniquePipeline scan_;
     UniquePipeline scatter_;
     UniquePipeline copy_;
+    bool local_reorder_ = false;
 };
 
 }  // namespace vulkan
