@@ -41,12 +41,12 @@ uint32_t MaxBlocks(uint32_t max_count) {
         std::max<uint64_t>(std::min<uint64_t>(smallest, kRadixSortTargetBlocks), largest));
 }
 
-// Shared memory of radix_sort_scatter.comp: per-digit next position and output shift,
-// per-subgroup counts (two digits per word), chunk totals, the scan's subgroup sums, and the
-// reordered keys and values.
+// Shared memory of radix_sort_scatter.comp: per-digit first position and output shift,
+// per-subgroup counts (two digits per word), the scan's subgroup sums, and the reordered
+// keys and values.
 uint64_t ScatterSharedBytes(uint32_t max_subgroups, uint32_t local_capacity) {
     const uint64_t words = 2 * kRadixSortBins + uint64_t(max_subgroups) * (kRadixSortBins / 2) +
-                           kRadixSortBins / 2 + max_subgroups + 2 * uint64_t(local_capacity);
+                           max_subgroups + 2 * uint64_t(local_capacity);
     return 4 * words;
 }
 
