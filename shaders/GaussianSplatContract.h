@@ -220,7 +220,8 @@ OPEN3D_SHADER_CONST uint kStageAScanBinding = 9u;          // uint[scan words]: 
 OPEN3D_SHADER_CONST uint kStageAEntryKeysBinding = 10u;    // uint[capacity]: tile index
 OPEN3D_SHADER_CONST uint kStageAEntryValuesBinding = 11u;  // uint[capacity]: splat index
 OPEN3D_SHADER_CONST uint kStageASortParamsBinding = 12u;   // RadixSortParams of the next sort
-OPEN3D_SHADER_CONST uint kStageANumBindings = 13u;
+OPEN3D_SHADER_CONST uint kStageATileCountsBinding = 13u;   // uint[N]: tiles of splat i
+OPEN3D_SHADER_CONST uint kStageANumBindings = 14u;
 
 // uint indices into GaussianStageACounters, used as the radix sorter's count_index.
 OPEN3D_SHADER_CONST uint kCounterVisibleIndex = 0u;
@@ -559,6 +560,11 @@ OPEN3D_SHADER_CONST float kCompositeMinTransmittance = 0.0001f;
 // Specialisation constant of gaussian_composite*.comp and gaussian_depth_merge.comp:
 // 1 = a scene depth texture is bound and tested; 0 = it is never read.
 OPEN3D_SHADER_CONST uint kSpecSceneDepth = 0u;
+// Specialisation constant of gaussian_composite*.comp: which depth images it writes, a sum
+// of the bits below (0 = colour only). Each bit drops per-blend arithmetic when clear.
+OPEN3D_SHADER_CONST uint kSpecCompositeDepth = 1u;
+OPEN3D_SHADER_CONST uint kCompositeExpectedDepthBit = 1u;  // expected depth and alpha images
+OPEN3D_SHADER_CONST uint kCompositeMedianDepthBit = 2u;    // median depth image
 
 // Descriptor set 0 of the composite (push descriptors).
 OPEN3D_SHADER_CONST uint kCompositeProjectedBinding = 0u;    // GaussianProjectedSplat[N]

@@ -20,6 +20,13 @@ layout(local_size_x = kCompositeWorkgroupSize) in;
 
 // 0: no scene depth; the texture binding is never read (the recorder binds a placeholder).
 layout(constant_id = kSpecSceneDepth) const uint kSceneDepth = 0u;
+// kCompositeExpectedDepthBit | kCompositeMedianDepthBit: the depth images to write. A clear
+// bit drops that image's accumulation from every blend: colour alone measured 2.61 -> 2.43 ms
+// (grid 1080p) and 0.567 -> 0.509 ms (playbot 4K) on the H100.
+layout(constant_id = kSpecCompositeDepth) const uint kDepthOutputs =
+        kCompositeExpectedDepthBit | kCompositeMedianDepthBit;
+const bool kExpectedDepth = (kDepthOutputs & kCompositeExpectedDepthBit) != 0u;
+const bool kMedianDepth = (kDepthOutputs & kCompositeMedianDepthBit) != 0u;
 
 layout(push_constant, std430) uniform PushConstantsBlock {
     GaussianCompositePushConstants pc;
@@ -102,10 +109,12 @@ void BlendSplat(uint j, inout PixelState p) {
     }
     float weight = alpha * p.transmittance;
     p.color += s_color[j].rgb * weight;
-    p.weighted_depth += cdo.z * weight;
-    p.weight += weight;
+    if (kExpectedDepth) {
+        p.weighted_depth += cdo.z * weight;
+        p.weight += weight;
+    }
     p.transmittance = next_transmittance;
-    if (!p.median_found && 1.0 - p.transmittance >= 0.5) {
+    if (kMedianDepth && !p.median_found && 1.0 - p.transmittance >= 0.5) {
         p.median_depth = cdo.z;
         p.median_found = true;
     }
@@ -196,10 +205,12 @@ void main() {
             float accumulated = 1.0 - p.transmittance;
             imageStore(out_color, pixel,
                        vec4(p.color + p.transmittance * pc.background.rgb, accumulated));
-            imageStore(out_depth, pixel,
-                       vec4(p.weight > 0.0 ? p.weighted_depth / p.weight : 0.0));
-            imageStore(out_alpha, pixel, vec4(accumulated));
-            imageStore(out_median_depth, pixel, vec4(p.median_depth));
+            if (kExpectedDepth) {
+                imageStore(out_depth, pixel,
+                           vec4(p.weight > 0.0 ? p.weighted_depth / p.weight : 0.0));
+                imageStore(out_alpha, pixel, vec4(accumulated));
+            }
+            if (kMedianDepth) imageStore(out_median_depth, pixel, vec4(p.median_depth));
         }
         // Claim the next tile. The barrier also makes sure every invocation has read
         // s_done before it is reset for that tile.

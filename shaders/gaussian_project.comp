@@ -47,6 +47,11 @@ layout(std430, set = 0, binding = kStageADepthKeysBinding) writeonly buffer Dept
 layout(std430, set = 0, binding = kStageASplatIndexBinding) writeonly buffer SplatIndexBlock {
     uint splat_indices[];
 };
+// The scan gathers these 4 bytes per visible splat in depth order: a dense array stays in
+// the GPU's L2 cache where a field of the 64-byte projected records did not.
+layout(std430, set = 0, binding = kStageATileCountsBinding) writeonly buffer TileCountsBlock {
+    uint tile_counts[];
+};
 
 const float kSH_C0 = 0.28209479177387814;
 const float kSH_C1 = 0.4886025119029199;
@@ -222,6 +227,7 @@ bool Project(uint i, out float depth) {
     out_splat.tiles = uvec4(rect_min.x | (rect_min.y << 16u), rect_max.x | (rect_max.y << 16u),
                             num_tiles, radius);
     projected[i] = out_splat;
+    tile_counts[i] = num_tiles;
     depth = sort_depth;
     return true;
 }

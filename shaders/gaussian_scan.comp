@@ -21,8 +21,8 @@ layout(push_constant, std430) uniform PushConstantsBlock {
 layout(std430, set = 0, binding = kStageAViewBinding) readonly buffer ViewBlock {
     GaussianViewParams view;
 };
-layout(std430, set = 0, binding = kStageAProjectedBinding) readonly buffer ProjectedBlock {
-    GaussianProjectedSplat projected[];
+layout(std430, set = 0, binding = kStageATileCountsBinding) readonly buffer TileCountsBlock {
+    uint tile_counts[];  // by splat index, written by the projection for visible splats
 };
 layout(std430, set = 0, binding = kStageACountersBinding) buffer CountersBlock {
     GaussianStageACounters counters;
@@ -45,7 +45,7 @@ uint LoadCount(uint index) {
     // The exact order scans all N slots; past the visible ones (culled splats, sorted last)
     // the records are stale and count nothing.
     if (index >= counters.visible_count) return 0u;
-    uint count = projected[splat_indices[index]].tiles.z;
+    uint count = tile_counts[splat_indices[index]];
     if (count > view.limits.y) {  // over max_tiles_per_splat: the splat emits nothing
         atomicOr(counters.error_flags, kErrorEntriesDropped);
         return 0u;

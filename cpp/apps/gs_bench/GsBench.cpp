@@ -40,6 +40,7 @@ struct Options {
     int repeat = 10;
     std::string knobs = "all";
     int64_t reference_max_splats = 2000000;
+    std::string depth = "none";
 };
 
 struct Knob {
@@ -120,10 +121,13 @@ double Median(std::vector<double> v) {
 // loops time everything before the CPU references: see Run.)
 rendering::RenderStats RunTimedFrames(rendering::GaussianSplatBackend& backend,
                                       const camera::PinholeCamera& camera,
-                                      const rendering::RenderConfig& config, int frames) {
+                                      const rendering::RenderConfig& config, int frames,
+                                      const std::string& depth) {
     constexpr double kWarmUpSeconds = 1.0;
     rendering::CompositeInputs no_readback;
     no_readback.read_back = false;
+    no_readback.expected_depth = depth == "expected" || depth == "both";
+    no_readback.median_depth = depth == "median" || depth == "both";
     rendering::RenderOutput out;
     const auto frame = [&]() {
         const auto start = std::chrono::steady_clock::now();
@@ -278,7 +282,7 @@ int Run(const Options& opt) {
                     // readback (per-pass medians).
                     rendering::RenderOutput out = backend->Render(cams[v], config);
                     const rendering::RenderStats med =
-                        RunTimedFrames(*backend, cams[v], config, opt.repeat);
+                        RunTimedFrames(*backend, cams[v], config, opt.repeat, opt.depth);
                     const double n = static_cast<double>(cams.size());  // mean over views
                     row.project_ms += med.gpu_project_ms / n;
                     row.sort_ms += med.gpu_sort_ms / n;
@@ -372,7 +376,7 @@ int main(int argc, char** argv) {
         "(fx = fy = fx_json * H / H_json, principal point at the centre). --grid K builds\n"
         "K x K copies of the first --input with the camera defined in docs/benchmark.md.\n"
         "Knobs: default, packed-key, compact, sh<=1, antialias. The error columns compare\n"
-        "with the CPU reference rendered in the same run (worst view).",
+        "the colour with the CPU reference rendered in the same run (worst view).",
         "gs-bench"};
     app.add_option("-i,--input", opt.inputs, "Scene file(s): .ply or .splat")
         ->check(CLI::ExistingFile)
@@ -394,6 +398,11 @@ int main(int argc, char** argv) {
         ->check(CLI::Range(1, 10000))
         ->capture_default_str();
     app.add_option("--knobs", opt.knobs, "Comma list of knobs or 'all'")->capture_default_str();
+    app.add_option("--depth", opt.depth,
+                   "Depth images the timed frames also compute (none: colour only, as the "
+                   "original 3DGS forward pass)")
+        ->check(CLI::IsMember({"none", "expected", "median", "both"}))
+        ->capture_default_str();
     app.add_option("--reference-max-splats", opt.reference_max_splats,
                    "Skip the CPU reference for scenes larger than this (0: never compare)")
         ->capture_default_str();

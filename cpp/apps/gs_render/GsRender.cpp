@@ -171,7 +171,10 @@ int Run(const Options& opt) {
     const auto render_start = std::chrono::steady_clock::now();
     backend->RenderGeometryStage(cam, config);
     rendering::RenderOutput out;
-    backend->RenderCompositeStage(out);
+    rendering::CompositeInputs inputs;  // the depth image to write, if any
+    inputs.expected_depth = !opt.depth_output.empty() && opt.depth_kind != "median";
+    inputs.median_depth = !opt.depth_output.empty() && opt.depth_kind == "median";
+    backend->RenderCompositeStage(out, inputs);
     const double render_ms = core::MillisecondsSince(render_start);
     const auto& s = out.stats;
     // Threads matter to the CPU reference only; the GPU reports its own pass times.

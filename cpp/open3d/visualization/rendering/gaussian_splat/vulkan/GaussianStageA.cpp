@@ -79,6 +79,7 @@ StageAStorageRequirements GaussianStageA::GetStorageRequirements(uint32_t num_sp
     r.counters_bytes = sizeof(GaussianStageACounters);
     r.depth_keys_bytes = Words(num_splats);
     r.splat_indices_bytes = Words(num_splats);
+    r.tile_counts_bytes = Words(num_splats);
     // Level l holds the counts (then offsets) of level l - 1's blocks; the top level is a
     // single block. Its data follows the previous level's in one buffer.
     uint64_t count = std::max(num_splats, 1u);
@@ -119,18 +120,27 @@ VkPipeline GaussianStageA::GetProjectPipeline(uint32_t sh_degree, bool antialias
 
 void GaussianStageA::PushBindings(VkCommandBuffer cmd, const StageASceneBuffers& scene,
                                   const StageAViewBuffers& buffers) const {
-    const std::array<const BufferRange*, kStageANumBindings> ranges{
-        &buffers.view_params,        &scene.positions,   &scene.shape,        &scene.sh,
-        &scene.visibility,           &buffers.projected, &buffers.counters,   &buffers.depth_keys,
-        &buffers.splat_indices,      &buffers.scan,      &buffers.entry_keys, &buffers.entry_values,
-        &buffers.sort_scratch.params};
+    const std::array<const BufferRange*, kStageANumBindings> ranges{&buffers.view_params,
+                                                                    &scene.positions,
+                                                                    &scene.shape,
+                                                                    &scene.sh,
+                                                                    &scene.visibility,
+                                                                    &buffers.projected,
+                                                                    &buffers.counters,
+                                                                    &buffers.depth_keys,
+                                                                    &buffers.splat_indices,
+                                                                    &buffers.scan,
+                                                                    &buffers.entry_keys,
+                                                                    &buffers.entry_values,
+                                                                    &buffers.sort_scratch.params,
+                                                                    &buffers.tile_counts};
     static_assert(kStageAViewBinding == 0 && kStageAPositionsBinding == 1 &&
                       kStageAShapeBinding == 2 && kStageAShBinding == 3 &&
                       kStageAVisibilityBinding == 4 && kStageAProjectedBinding == 5 &&
                       kStageACountersBinding == 6 && kStageADepthKeysBinding == 7 &&
                       kStageASplatIndexBinding == 8 && kStageAScanBinding == 9 &&
                       kStageAEntryKeysBinding == 10 && kStageAEntryValuesBinding == 11 &&
-                      kStageASortParamsBinding == 12,
+                      kStageASortParamsBinding == 12 && kStageATileCountsBinding == 13,
                   "ranges above are listed in binding order");
     std::array<VkDescriptorBufferInfo, kStageANumBindings> infos{};
     std::array<VkWriteDescriptorSet, kStageANumBindings> writes{};

@@ -36,6 +36,7 @@ struct StageAStorageRequirements {
     VkDeviceSize counters_bytes = 0;       ///< shader::GaussianStageACounters
     VkDeviceSize depth_keys_bytes = 0;     ///< uint32 [N]
     VkDeviceSize splat_indices_bytes = 0;  ///< uint32 [N]
+    VkDeviceSize tile_counts_bytes = 0;    ///< uint32 [N]
     VkDeviceSize scan_bytes = 0;           ///< uint32 [N + block sums of every level]
     VkDeviceSize entry_keys_bytes = 0;     ///< uint32 [entry_capacity]
     VkDeviceSize entry_values_bytes = 0;   ///< uint32 [entry_capacity]
@@ -77,6 +78,7 @@ struct StageAViewBuffers {
     BufferRange entry_keys;     ///< after Record: tile index per entry, ascending
     BufferRange entry_values;   ///< after Record: splat index per entry, front to back
     RadixSortScratch sort_scratch;
+    BufferRange tile_counts;  ///< scratch: each visible splat's tile count, by splat index
 };
 
 class GaussianStageA {

@@ -79,6 +79,7 @@ void StageAResources::AllocateView(const VulkanContext& context, uint32_t entry_
     counters = make(need.counters_bytes, need.counters_usage);
     depth_keys = make(need.depth_keys_bytes, need.usage);
     splat_indices = make(need.splat_indices_bytes, need.usage);
+    tile_counts = make(need.tile_counts_bytes, need.usage);
     scan = make(need.scan_bytes, need.usage);
     entry_keys = make(need.entry_keys_bytes, need.usage);
     entry_values = make(need.entry_values_bytes, need.usage);
@@ -109,6 +110,7 @@ StageAViewBuffers StageAResources::View() const {
     view.counters = counters.Range();
     view.depth_keys = depth_keys.Range();
     view.splat_indices = splat_indices.Range();
+    view.tile_counts = tile_counts.Range();
     view.scan = scan.Range();
     view.entry_keys = entry_keys.Range();
     view.entry_values = entry_values.Range();

@@ -52,7 +52,7 @@ public:
     // Scene.
     Buffer positions, shape, sh, visibility;
     // View: Stage A's outputs (projected splats, counters, sorted entries) and scratch.
-    Buffer view_params, projected, counters, depth_keys, splat_indices, scan;
+    Buffer view_params, projected, counters, depth_keys, splat_indices, tile_counts, scan;
     Buffer entry_keys, entry_values, keys_alt, values_alt, histogram, sort_params;
 
 private:

@@ -1,6 +1,7 @@
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/GaussianStageB.h"
 
 #include <algorithm>
+#include <optional>
 #include <vector>
 
 #include "open3d/core/Exception.h"
@@ -72,12 +73,16 @@ VkDescriptorImageInfo StorageImage(VkImageView view) {
     return {VK_NULL_HANDLE, view, VK_IMAGE_LAYOUT_GENERAL};
 }
 
+// Specialised on kSpecSceneDepth and, when `depth_outputs` is given, kSpecCompositeDepth.
 UniquePipeline CreateSpecialised(const VulkanContext& context, VkPipelineLayout layout,
                                  std::span<const uint32_t> spirv, const char* name,
-                                 bool scene_depth) {
-    const uint32_t value = scene_depth ? 1u : 0u;
-    const VkSpecializationMapEntry entry{kSpecSceneDepth, 0, sizeof(uint32_t)};
-    VkSpecializationInfo specialization{1, &entry, sizeof(value), &value};
+                                 bool scene_depth, std::optional<uint32_t> depth_outputs = {}) {
+    const std::array<uint32_t, 2> values{scene_depth ? 1u : 0u, depth_outputs.value_or(0u)};
+    const std::array<VkSpecializationMapEntry, 2> entries{
+        {{kSpecSceneDepth, 0, sizeof(uint32_t)},
+         {kSpecCompositeDepth, sizeof(uint32_t), sizeof(uint32_t)}}};
+    const VkSpecializationInfo specialization{depth_outputs ? 2u : 1u, entries.data(),
+                                              sizeof(values), values.data()};
     return CreateComputePipeline(context, layout, spirv, name, &specialization);
 }
 
@@ -126,14 +131,20 @@ VkDeviceSize GaussianStageB::StateBytes(uint32_t width, uint32_t height) {
     return sizeof(GaussianCompositeState) + sizeof(uint32_t) * 2 * tiles_x * tiles_y;
 }
 
-VkPipeline GaussianStageB::GetCompositePipeline(CompositeColorFormat format, bool scene_depth) {
+VkPipeline GaussianStageB::GetCompositePipeline(CompositeColorFormat format,
+                                                const CompositeParams& params) {
     const bool half = format == CompositeColorFormat::kRgba16f;
-    UniquePipeline& pipeline = composite_[(half ? 2 : 0) + (scene_depth ? 1 : 0)];
+    const bool scene_depth = params.scene_depth != nullptr;
+    const uint32_t depth_outputs = (params.expected_depth ? kCompositeExpectedDepthBit : 0u) |
+                                   (params.median_depth ? kCompositeMedianDepthBit : 0u);
+    static_assert(kCompositeExpectedDepthBit == 1u && kCompositeMedianDepthBit == 2u);
+    UniquePipeline& pipeline =
+        composite_[(half ? 8u : 0u) + (scene_depth ? 4u : 0u) + depth_outputs];
     if (!pipeline) {
         pipeline = CreateSpecialised(
             context_, composite_layout_.Get(),
             half ? spirv::kGaussianCompositeRgba16f : spirv::kGaussianComposite,
-            half ? "gaussian_composite_rgba16f" : "gaussian_composite", scene_depth);
+            half ? "gaussian_composite_rgba16f" : "gaussian_composite", scene_depth, depth_outputs);
     }
     return pipeline.Get();
 }
@@ -266,7 +277,7 @@ void GaussianStageB::RecordComposite(VkCommandBuffer cmd, const StageBInputs& in
                         VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
                         VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
     vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE,
-                      GetCompositePipeline(targets.color_format, params.scene_depth != nullptr));
+                      GetCompositePipeline(targets.color_format, params));
     vkCmdDispatch(cmd, workgroups, 1, 1);
 }
 

@@ -65,10 +65,12 @@ struct StageBTargets {
     /// rgb = C + T * background (premultiplied when the background is black), a = 1 - T.
     VkImageView color = VK_NULL_HANDLE;
     /// R32F sum(alpha_i T_i z_i) / (1 - T), view-space z; 0 where no splat contributes.
+    /// Written only with CompositeParams::expected_depth (the view must be valid anyway).
     VkImageView depth = VK_NULL_HANDLE;
-    /// R32F accumulated alpha 1 - T.
+    /// R32F accumulated alpha 1 - T (what the depth merge reads), written like `depth`.
     VkImageView alpha = VK_NULL_HANDLE;
     /// R32F view z of the splat that brings 1 - T to >= 0.5; 0 where it never gets there.
+    /// Written only with CompositeParams::median_depth.
     VkImageView median_depth = VK_NULL_HANDLE;
 };
 
@@ -88,6 +90,10 @@ struct CompositeParams {
     /// Scene depth to test each splat against (a splat farther than the scene at a pixel is
     /// skipped), or nullptr: then the pipeline specialised without it runs and reads no depth.
     const SceneDepthTexture* scene_depth = nullptr;
+    /// The depth images to write (StageBTargets); each is a pipeline specialisation, and one
+    /// not asked for costs nothing per blended splat (the images it leaves keep old values).
+    bool expected_depth = true;  ///< expected depth and alpha
+    bool median_depth = true;
     /// Workgroups of the grid (workgroup i does tile i, then steals tiles from a counter):
     /// 0 = min(tiles, kDefaultMaxWorkgroups) on GPUs, one per tile on CPU devices.
     uint32_t max_workgroups = 0;
@@ -147,7 +153,7 @@ public:
                           const DepthMergeParams& params);
 
 private:
-    VkPipeline GetCompositePipeline(CompositeColorFormat format, bool scene_depth);
+    VkPipeline GetCompositePipeline(CompositeColorFormat format, const CompositeParams& params);
     VkPipeline GetDepthMergePipeline(bool scene_depth);
     // The view and layout to bind for `scene_depth`; records the placeholder's transition
     // when it stands in.
@@ -160,8 +166,9 @@ private:
     UniqueDescriptorSetLayout merge_set_layout_;
     UniquePipelineLayout merge_layout_;
     UniquePipeline tile_ranges_;
-    std::array<UniquePipeline, 4> composite_;  // [format * 2 + scene depth]
-    std::array<UniquePipeline, 2> merge_;      // [scene depth]
+    // [format][scene depth][expected depth][median depth]
+    std::array<UniquePipeline, 16> composite_;
+    std::array<UniquePipeline, 2> merge_;  // [scene depth]
     Image placeholder_depth_;
 };
 
