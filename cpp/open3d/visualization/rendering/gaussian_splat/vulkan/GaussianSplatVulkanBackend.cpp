@@ -18,6 +18,13 @@ namespace vulkan {
 
 namespace {
 
+// The most tile entries a frame of this config may allocate: what it allows, within what the
+// scan (saturating at kScanSaturation) and the sorts (RadixSort::kMaxCount) address.
+uint64_t MaxEntryCapacity(const RenderConfig& config) {
+    return std::min<uint64_t>(
+        {config.max_tile_entries_total, shader::kScanSaturation - 1, RadixSort::kMaxCount});
+}
+
 bool SameCamera(const camera::PinholeCamera& a, const camera::PinholeCamera& b) {
     return a.width == b.width && a.height == b.height && a.fx == b.fx && a.fy == b.fy &&
            a.cx == b.cx && a.cy == b.cy && a.world_to_camera == b.world_to_camera;
@@ -165,10 +172,8 @@ void GaussianSplatVulkanBackend::RenderGeometryStage(const camera::PinholeCamera
     }
     if (geometry_.in_flight) Wait(*context_, stage_a_fence_.Get());
 
-    // The largest capacity this config allows, within what the sorts address.
-    const uint64_t wanted =
-        std::min<uint64_t>(config.max_tile_entries_total, shader::kScanSaturation);
-    EnsureViewBuffers(static_cast<uint32_t>(std::min<uint64_t>(wanted, initial_entry_capacity_)));
+    EnsureViewBuffers(static_cast<uint32_t>(
+        std::min<uint64_t>(MaxEntryCapacity(config), initial_entry_capacity_)));
 
     const shader::GaussianViewParams params = stage_a_resources_.ViewParams(camera, config);
 
@@ -415,8 +420,7 @@ RenderStats GaussianSplatVulkanBackend::RenderComposite(CompositeSink& sink) {
     // The allocation, not the config, cut this frame short: grow the entry buffers to what
     // it asked for (plus a quarter, so a moving camera does not regrow every frame) and
     // render it again. Stage A reported the full request, so one retry suffices.
-    const uint64_t limit =
-        std::min<uint64_t>(geometry_.config.max_tile_entries_total, shader::kScanSaturation - 1);
+    const uint64_t limit = MaxEntryCapacity(geometry_.config);
     if ((gpu_counters.error_flags & kCountsClamped) && stage_a_resources_.EntryCapacity() < limit &&
         !growing_) {
         const uint64_t asked = gpu_counters.requested_entries;
