@@ -28,14 +28,17 @@ shared uint s_subgroup_sum[kMaxSubgroups];
 // is what makes the sort stable; gl_LocalInvocationIndex need not follow that order and
 // subgroups may be partial, so the slot is counted, not computed.
 uint g_slot;
+// This invocation's subgroup: its active lanes and the slot of its first one.
+uint g_subgroup_lanes;
+uint g_subgroup_first_slot;
 
 void InitScanSlot() {
-    uint lanes = subgroupAdd(1u);
-    if (subgroupElect()) s_subgroup_sum[gl_SubgroupID] = lanes;
+    g_subgroup_lanes = subgroupAdd(1u);
+    if (subgroupElect()) s_subgroup_sum[gl_SubgroupID] = g_subgroup_lanes;
     barrier();
-    uint base = 0u;
-    for (uint s = 0u; s < gl_SubgroupID; ++s) base += s_subgroup_sum[s];
-    g_slot = base + subgroupExclusiveAdd(1u);
+    g_subgroup_first_slot = 0u;
+    for (uint s = 0u; s < gl_SubgroupID; ++s) g_subgroup_first_slot += s_subgroup_sum[s];
+    g_slot = g_subgroup_first_slot + subgroupExclusiveAdd(1u);
     barrier();
 }
 

@@ -94,9 +94,8 @@ void main() {
     uint chunks = params.block_size / kRadixSortWorkgroupSize;  // uniform, 1..8
     uint block_begin = block * params.block_size;
     uint block_end = min(block_begin + params.block_size, count);
-    uint lane = subgroupExclusiveAdd(1u);
-    uint lanes = subgroupAdd(1u);
-    uint first = block_begin + (g_slot - lane) * chunks + lane;
+    uint lanes = g_subgroup_lanes;
+    uint first = block_begin + g_subgroup_first_slot * chunks + (g_slot - g_subgroup_first_slot);
     // All loads first, so that they are in flight together.
     uint keys[kRadixSortItemsPerInvocation];
     uint values[kRadixSortItemsPerInvocation];

@@ -274,18 +274,15 @@ public:
         const int64_t h = backend_.height_, w = backend_.width_;
         output_.color = t::geometry::Image(h, w, 4, core::Dtype::Float32);
         std::memcpy(output_.color.Data<float>(), backend_.color_readback_.GetMapped(), pixels * 16);
-        output_.depth_expected = t::geometry::Image();
-        output_.depth_median = t::geometry::Image();
-        if (expected_depth_) {
-            output_.depth_expected = t::geometry::Image(h, w, 1, core::Dtype::Float32);
-            std::memcpy(output_.depth_expected.Data<float>(), backend_.depth_readback_.GetMapped(),
-                        pixels * 4);
-        }
-        if (median_depth_) {
-            output_.depth_median = t::geometry::Image(h, w, 1, core::Dtype::Float32);
-            std::memcpy(output_.depth_median.Data<float>(), backend_.median_readback_.GetMapped(),
-                        pixels * 4);
-        }
+        // An R32F image that was asked for, else empty.
+        const auto scalar = [&](bool wanted, const Buffer& readback) {
+            if (!wanted) return t::geometry::Image();
+            t::geometry::Image image(h, w, 1, core::Dtype::Float32);
+            std::memcpy(image.Data<float>(), readback.GetMapped(), pixels * 4);
+            return image;
+        };
+        output_.depth_expected = scalar(expected_depth_, backend_.depth_readback_);
+        output_.depth_median = scalar(median_depth_, backend_.median_readback_);
     }
 
 private:

@@ -1,7 +1,6 @@
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/GaussianStageB.h"
 
 #include <algorithm>
-#include <optional>
 #include <vector>
 
 #include "open3d/core/Exception.h"
@@ -73,15 +72,16 @@ VkDescriptorImageInfo StorageImage(VkImageView view) {
     return {VK_NULL_HANDLE, view, VK_IMAGE_LAYOUT_GENERAL};
 }
 
-// Specialised on kSpecSceneDepth and, when `depth_outputs` is given, kSpecCompositeDepth.
+// Specialised on kSpecSceneDepth and kSpecCompositeDepth. The depth merge declares no
+// kSpecCompositeDepth: Vulkan ignores a map entry whose ID the shader does not use.
 UniquePipeline CreateSpecialised(const VulkanContext& context, VkPipelineLayout layout,
                                  std::span<const uint32_t> spirv, const char* name,
-                                 bool scene_depth, std::optional<uint32_t> depth_outputs = {}) {
-    const std::array<uint32_t, 2> values{scene_depth ? 1u : 0u, depth_outputs.value_or(0u)};
+                                 bool scene_depth, uint32_t depth_outputs = 0u) {
+    const std::array<uint32_t, 2> values{scene_depth ? 1u : 0u, depth_outputs};
     const std::array<VkSpecializationMapEntry, 2> entries{
         {{kSpecSceneDepth, 0, sizeof(uint32_t)},
          {kSpecCompositeDepth, sizeof(uint32_t), sizeof(uint32_t)}}};
-    const VkSpecializationInfo specialization{depth_outputs ? 2u : 1u, entries.data(),
+    const VkSpecializationInfo specialization{static_cast<uint32_t>(entries.size()), entries.data(),
                                               sizeof(values), values.data()};
     return CreateComputePipeline(context, layout, spirv, name, &specialization);
 }
