@@ -549,6 +549,15 @@ OPEN3D_SHADER_CONST uint kCompositeBatchSize = 256u;
 // Each 32 invocations blend an 8x4 pixel block of the tile (gaussian_composite.glsl).
 OPEN3D_SHADER_CONST uint kCompositeBlockWidth = 8u;
 OPEN3D_SHADER_CONST uint kCompositeBlockHeight = 4u;
+// Pixel blocks of a tile, numbered row-major: block k covers columns
+// (k % kCompositeBlocksX) * kCompositeBlockWidth.. and rows (k / kCompositeBlocksX) *
+// kCompositeBlockHeight.. of the tile (one bit each in CompositeBlockMask).
+OPEN3D_SHADER_CONST uint kCompositeBlocksX = kCompositeTileSize / kCompositeBlockWidth;
+OPEN3D_SHADER_CONST uint kCompositeBlocksY = kCompositeTileSize / kCompositeBlockHeight;
+OPEN3D_SHADER_CONST uint kCompositeBlocks = kCompositeBlocksX * kCompositeBlocksY;
+// Bound of gl_NumSubgroups in a composite workgroup: subgroups of at least 8 invocations,
+// which RadixSort already requires of the device.
+OPEN3D_SHADER_CONST uint kCompositeMaxSubgroups = kCompositeWorkgroupSize / 8u;
 // The depth merge runs 16x16 pixels per workgroup.
 OPEN3D_SHADER_CONST uint kDepthMergeWorkgroupSize = 16u;
 
@@ -565,6 +574,53 @@ OPEN3D_SHADER_CONST uint kSpecSceneDepth = 0u;
 OPEN3D_SHADER_CONST uint kSpecCompositeDepth = 1u;
 OPEN3D_SHADER_CONST uint kCompositeExpectedDepthBit = 1u;  // expected depth and alpha images
 OPEN3D_SHADER_CONST uint kCompositeMedianDepthBit = 2u;    // median depth image
+
+// Which pixel blocks of a tile a splat can change: bit k is set unless no pixel of block k
+// lies in the axis-aligned box of the splat's culling ellipse q <= t (TileCullThreshold,
+// stored in conic.w). The box is the ellipse's extents sqrt(c t / det_q) and sqrt(a t /
+// det_q) widened as in TileRowSpan (1/256 of the extent + 0.5 px, for this function's own
+// rounding), so a block outside it receives only skips, exactly as a culled tile. (x0, y0)
+// is the tile's first pixel, (cx, cy) the splat centre; pixel (x, y) is evaluated at (x, y).
+// Nothing finite to bound by (t not finite, a degenerate conic, NaN): every block.
+#ifdef __cplusplus
+#define OPEN3D_SHADER_FUNC inline
+#define OPEN3D_SHADER_PRECISE
+#else
+#define OPEN3D_SHADER_FUNC
+#define OPEN3D_SHADER_PRECISE precise
+#endif
+OPEN3D_SHADER_FUNC uint CompositeBlockMask(float cx, float cy, float a, float c, float det_q,
+                                           float t, float x0, float y0) {
+    uint all = (1u << kCompositeBlocks) - 1u;
+    if (!(t > 0.0f)) return 0u;
+    OPEN3D_SHADER_PRECISE float x_ext = sqrt(c * t / det_q);
+    OPEN3D_SHADER_PRECISE float y_ext = sqrt(a * t / det_q);
+    if (!(x_ext < 1e30f && y_ext < 1e30f && a > 0.0f && c > 0.0f)) return all;
+    OPEN3D_SHADER_PRECISE float x_reach = x_ext * (1.0f + 1.0f / 256.0f) + 0.5f;
+    OPEN3D_SHADER_PRECISE float y_reach = y_ext * (1.0f + 1.0f / 256.0f) + 0.5f;
+    OPEN3D_SHADER_PRECISE float lo_x = cx - x0 - x_reach;
+    OPEN3D_SHADER_PRECISE float hi_x = cx - x0 + x_reach;
+    OPEN3D_SHADER_PRECISE float lo_y = cy - y0 - y_reach;
+    OPEN3D_SHADER_PRECISE float hi_y = cy - y0 + y_reach;
+    if (!(lo_x <= hi_x && lo_y <= hi_y)) return all;
+    uint columns = 0u;
+    for (uint bx = 0u; bx < kCompositeBlocksX; ++bx) {
+        float first = float(bx * kCompositeBlockWidth);
+        if (hi_x >= first && lo_x <= first + float(kCompositeBlockWidth - 1u)) {
+            columns |= 1u << bx;
+        }
+    }
+    uint mask = 0u;
+    for (uint by = 0u; by < kCompositeBlocksY; ++by) {
+        float first = float(by * kCompositeBlockHeight);
+        if (hi_y >= first && lo_y <= first + float(kCompositeBlockHeight - 1u)) {
+            mask |= columns << (by * kCompositeBlocksX);
+        }
+    }
+    return mask;
+}
+#undef OPEN3D_SHADER_FUNC
+#undef OPEN3D_SHADER_PRECISE
 
 // Descriptor set 0 of the composite (push descriptors).
 OPEN3D_SHADER_CONST uint kCompositeProjectedBinding = 0u;    // GaussianProjectedSplat[N]
@@ -618,6 +674,9 @@ static_assert(kCompositeTileSize % kCompositeBlockWidth == 0u);
 static_assert(kCompositeTileSize % kCompositeBlockHeight == 0u);
 static_assert(kCompositeWorkgroupSize == kCompositeTileSize * kCompositeTileSize);
 static_assert(kCompositeBatchSize == kCompositeWorkgroupSize, "one splat load per invocation");
+static_assert(kCompositeBlocks <= 8u, "CompositeBlockMask's bits are counted in 16-bit fields");
+static_assert(kCompositeBlocks * kCompositeBlockWidth * kCompositeBlockHeight ==
+              kCompositeWorkgroupSize);
 
 static_assert(sizeof(GaussianCompositeState) == 16);
 static_assert(offsetof(GaussianCompositeState, next_tile) == 0);

@@ -2,7 +2,7 @@
 // when no pixel of it can blend the splat. Checked by brute force in double precision: at
 // every pixel of every dropped tile, alpha = o exp(-q / 2) stays below the composite's 1/255
 // with a 0.1% allowance for float32 rounding (the culling's own margin is about 0.5% in
-// alpha, so a missing margin fails here).
+// alpha, so a missing margin fails here). The composite's per-block skip is checked the same way.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -17,6 +17,7 @@
 #include "open3d/visualization/rendering/gaussian_splat/cpu/Composite.h"
 #include "open3d/visualization/rendering/gaussian_splat/cpu/Projection.h"
 #include "open3d/visualization/rendering/gaussian_splat/cpu/TileLists.h"
+#include "shaders/GaussianSplatContract.h"
 
 namespace open3d {
 namespace tests {
@@ -31,12 +32,12 @@ struct CullingCounts {
     int64_t missed_tiles = 0;  // dropped although a pixel blends: must stay 0
 };
 
-// Largest alpha the composite could give the splat over the tile's pixels (integer pixel
-// positions inside the image), in double.
-double MaxAlphaInTile(const ProjectedSplat& s, int tx, int ty, int width, int height) {
+// Largest alpha the composite could give the splat over the pixels [x0, x1) x [y0, y1)
+// (integer pixel positions), in double.
+double MaxAlphaInRect(const ProjectedSplat& s, int x0, int y0, int x1, int y1) {
     double best = 0.0;
-    for (int y = ty * kTileSize; y < std::min((ty + 1) * kTileSize, height); ++y) {
-        for (int x = tx * kTileSize; x < std::min((tx + 1) * kTileSize, width); ++x) {
+    for (int y = y0; y < y1; ++y) {
+        for (int x = x0; x < x1; ++x) {
             const double dx = s.x - x, dy = s.y - y;
             const double q = s.conic_a * dx * dx + 2.0 * s.conic_b * dx * dy + s.conic_c * dy * dy;
             best = std::max(best, s.opacity * std::exp(-0.5 * q));
@@ -45,8 +46,15 @@ double MaxAlphaInTile(const ProjectedSplat& s, int tx, int ty, int width, int he
     return best;
 }
 
+// The same over the tile's pixels inside the image.
+double MaxAlphaInTile(const ProjectedSplat& s, int tx, int ty, int width, int height) {
+    return MaxAlphaInRect(s, tx * kTileSize, ty * kTileSize, std::min((tx + 1) * kTileSize, width),
+                          std::min((ty + 1) * kTileSize, height));
+}
+
+constexpr double kBlendThreshold = (1.0 / 255.0) * (1.0 - 1e-3);
+
 CullingCounts CheckCulling(const std::vector<ProjectedSplat>& splats, int width, int height) {
-    constexpr double kBlendThreshold = (1.0 / 255.0) * (1.0 - 1e-3);
     CullingCounts counts;
     for (const ProjectedSplat& s : splats) {
         if (!s.IsVisible()) continue;
@@ -145,6 +153,68 @@ TileLists RectangleLists(const std::vector<ProjectedSplat>& splats, const TileGr
         lists.offsets.push_back(lists.splat_indices.size());
     }
     return lists;
+}
+
+// The composite's per-block skip (shader::CompositeBlockMask): in every kept tile, a pixel
+// block whose bit is clear must not hold a pixel that blends the splat, on the same brute
+// force as the tiles. Counts (rect_tiles, kept_tiles, missed_tiles) are blocks here.
+CullingCounts CheckBlockMasks(const std::vector<ProjectedSplat>& splats) {
+    using namespace shader;
+    CullingCounts counts;
+    for (const ProjectedSplat& s : splats) {
+        if (!s.IsVisible()) continue;
+        const float t =
+            TileCullThreshold(float(s.opacity), float(s.conic_a), float(s.conic_c), float(s.det_q));
+        for (int ty = s.rect_min_y; ty < s.rect_max_y; ++ty) {
+            const auto [first, last] = s.RowSpan(ty);
+            for (int tx = first; tx < last; ++tx) {
+                const int x0 = tx * kTileSize, y0 = ty * kTileSize;
+                const uint32_t mask =
+                    CompositeBlockMask(float(s.x), float(s.y), float(s.conic_a), float(s.conic_c),
+                                       float(s.det_q), t, float(x0), float(y0));
+                EXPECT_EQ(mask >> kCompositeBlocks, 0u);
+                for (uint32_t k = 0; k < kCompositeBlocks; ++k) {
+                    ++counts.rect_tiles;
+                    if ((mask >> k) & 1u) {
+                        ++counts.kept_tiles;
+                        continue;
+                    }
+                    const int bx = x0 + int(k % kCompositeBlocksX * kCompositeBlockWidth);
+                    const int by = y0 + int(k / kCompositeBlocksX * kCompositeBlockHeight);
+                    if (MaxAlphaInRect(s, bx, by, bx + int(kCompositeBlockWidth),
+                                       by + int(kCompositeBlockHeight)) >= kBlendThreshold) {
+                        ++counts.missed_tiles;
+                    }
+                }
+            }
+        }
+    }
+    return counts;
+}
+
+TEST(CpuTileCulling, BlockMasksLoseNoBlendingBlock) {
+    const camera::PinholeCamera cam = MakeTestCamera(203, 157);
+    for (bool antialias : {false, true}) {
+        RenderConfig config;
+        config.antialias = antialias;
+        const auto splats = ProjectSplats(MakeCloud(RandomSplats(3000, 11)), cam, config);
+        const CullingCounts c = CheckBlockMasks(splats);
+        EXPECT_EQ(c.missed_tiles, 0) << "antialias " << antialias;
+        EXPECT_GT(c.rect_tiles, 10000);
+        EXPECT_LT(c.kept_tiles, c.rect_tiles * 3 / 4);
+        std::cout << "[block masks] random, antialias " << antialias << ": kept " << c.kept_tiles
+                  << " of " << c.rect_tiles << " blocks of kept tiles\n";
+    }
+    OPEN3D_REQUIRE_DATA("playbot/playbot_31k.ply");
+    t::geometry::PointCloud cloud;
+    t::io::ReadPointCloud(DataPath("playbot/playbot_31k.ply"), cloud);
+    const camera::PinholeCamera view =
+        camera::ReadCamerasJson(DataPath("playbot/cameras.json")).at(0).camera;
+    const CullingCounts c = CheckBlockMasks(ProjectSplats(cloud, view, RenderConfig{}));
+    EXPECT_EQ(c.missed_tiles, 0);
+    EXPECT_LT(c.kept_tiles, c.rect_tiles * 3 / 4);
+    std::cout << "[block masks] playbot_31k view 0: kept " << c.kept_tiles << " of " << c.rect_tiles
+              << " blocks of kept tiles\n";
 }
 
 // End to end: compositing only the kept tiles gives bit for bit the image (colour, expected
