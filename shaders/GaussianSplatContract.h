@@ -384,29 +384,25 @@ OPEN3D_SHADER_FUNC float TileCullThreshold(float opacity, float a, float c, floa
     return widened;
 }
 
-// Tile columns [first, last) of tile row `ty` that the ellipse q <= t of a splat centred at
-// (cx, cy) touches, within the rectangle's columns [rect_x0, rect_x1), packed as
-// first | last << 16 (empty: first == last == rect_x0). Pixel (x, y) is evaluated at (x, y), so row
-// ty covers pixel rows 16 ty .. 16 ty + 15 and column tx pixel columns 16 tx .. 16 tx + 15. For a
-// band of rows the ellipse's right edge x_r(dy) = (-b dy + sqrt(a t - det_q dy^2)) / a is concave
-// in dy with its peak at dy* = -b sqrt(t / (det_q c)), so its maximum over the band is at dy*
-// clamped to the band (the left edge mirrors it). The reach is widened by 0.5 px + 1/256 of the
-// extent for this function's own rounding; anything not finite falls back to the whole rectangle
-// row.
-OPEN3D_SHADER_FUNC uint TileRowSpan(float cx, float cy, float a, float b, float c, float det_q,
-                                    float t, uint ty, uint rect_x0, uint rect_x1) {
-    uint whole = rect_x0 | (rect_x1 << 16u);
-    uint none = rect_x0 | (rect_x0 << 16u);
-    if (!(t > 0.0f)) return none;
-    OPEN3D_SHADER_PRECISE float y_ext = sqrt(a * t / det_q);
-    OPEN3D_SHADER_PRECISE float x_ext = sqrt(c * t / det_q);
-    if (!(y_ext < 1e30f && x_ext < 1e30f && a > 0.0f && c > 0.0f)) return whole;
+// Where the ellipse q <= t reaches within the band of row offsets [lo, hi] (pixel y minus the
+// centre's y): x offsets x_l .. x_r (pixel x minus the centre's x) to widen by `margin` on
+// either side, as (x_l, x_r, margin, 1); w = 0 when the band misses the ellipse. x_ext,
+// y_ext = sqrt(c t / det_q), sqrt(a t / det_q), the ellipse's half extents, finite. For a
+// band of rows the right edge x_r(dy) = (-b dy + sqrt(a t - det_q dy^2)) / a is concave in dy
+// with its peak at dy* = -b sqrt(t / (det_q c)), so its maximum over the band is at dy*
+// clamped to the band (the left edge mirrors it). The reach is widened by 0.5 px + 1/256 of
+// the extent for this function's own rounding.
+OPEN3D_SHADER_FUNC vec4 EllipseBandReach(float a, float b, float c, float det_q, float t,
+                                         float x_ext, float y_ext, float lo, float hi) {
+    vec4 band;
+    band.x = 0.0f;
+    band.y = 0.0f;
+    band.z = 0.0f;
+    band.w = 0.0f;
     OPEN3D_SHADER_PRECISE float reach = y_ext * (1.0f + 1.0f / 256.0f) + 0.5f;
-    OPEN3D_SHADER_PRECISE float lo = float(ty * kGaussianTileSize) - cy;
-    OPEN3D_SHADER_PRECISE float hi = lo + float(kGaussianTileSize - 1u);
     lo = lo > -reach ? lo : -reach;
     hi = hi < reach ? hi : reach;
-    if (!(lo <= hi)) return none;
+    if (!(lo <= hi)) return band;
     OPEN3D_SHADER_PRECISE float peak = -b * (x_ext / c);
     OPEN3D_SHADER_PRECISE float dy_r = peak < lo ? lo : (peak > hi ? hi : peak);
     OPEN3D_SHADER_PRECISE float dy_l = -peak < lo ? lo : (-peak > hi ? hi : -peak);
@@ -415,8 +411,33 @@ OPEN3D_SHADER_FUNC uint TileRowSpan(float cx, float cy, float a, float b, float 
     OPEN3D_SHADER_PRECISE float x_r = (sqrt(s_r > 0.0f ? s_r : 0.0f) - b * dy_r) / a;
     OPEN3D_SHADER_PRECISE float x_l = (-sqrt(s_l > 0.0f ? s_l : 0.0f) - b * dy_l) / a;
     OPEN3D_SHADER_PRECISE float margin = 0.5f + x_ext * (1.0f / 256.0f);
-    OPEN3D_SHADER_PRECISE float first = ceil((cx + x_l - margin - 15.0f) / 16.0f);
-    OPEN3D_SHADER_PRECISE float last = floor((cx + x_r + margin) / 16.0f) + 1.0f;
+    band.x = x_l;
+    band.y = x_r;
+    band.z = margin;
+    band.w = 1.0f;
+    return band;
+}
+
+// Tile columns [first, last) of tile row `ty` that the ellipse q <= t of a splat centred at
+// (cx, cy) touches, within the rectangle's columns [rect_x0, rect_x1), packed as
+// first | last << 16 (empty: first == last == rect_x0). Pixel (x, y) is evaluated at (x, y), so row
+// ty covers pixel rows 16 ty .. 16 ty + 15 and column tx pixel columns 16 tx .. 16 tx + 15
+// (EllipseBandReach over the row's band); anything not finite falls back to the whole
+// rectangle row.
+OPEN3D_SHADER_FUNC uint TileRowSpan(float cx, float cy, float a, float b, float c, float det_q,
+                                    float t, uint ty, uint rect_x0, uint rect_x1) {
+    uint whole = rect_x0 | (rect_x1 << 16u);
+    uint none = rect_x0 | (rect_x0 << 16u);
+    if (!(t > 0.0f)) return none;
+    OPEN3D_SHADER_PRECISE float y_ext = sqrt(a * t / det_q);
+    OPEN3D_SHADER_PRECISE float x_ext = sqrt(c * t / det_q);
+    if (!(y_ext < 1e30f && x_ext < 1e30f && a > 0.0f && c > 0.0f)) return whole;
+    OPEN3D_SHADER_PRECISE float lo = float(ty * kGaussianTileSize) - cy;
+    OPEN3D_SHADER_PRECISE float hi = lo + float(kGaussianTileSize - 1u);
+    vec4 band = EllipseBandReach(a, b, c, det_q, t, x_ext, y_ext, lo, hi);
+    if (band.w == 0.0f) return none;
+    OPEN3D_SHADER_PRECISE float first = ceil((cx + band.x - band.z - 15.0f) / 16.0f);
+    OPEN3D_SHADER_PRECISE float last = floor((cx + band.y + band.z) / 16.0f) + 1.0f;
     if (!(first <= last || first > last)) return whole;  // NaN
     first = first > float(rect_x0) ? first : float(rect_x0);
     first = first < float(rect_x1) ? first : float(rect_x1);
@@ -576,12 +597,11 @@ OPEN3D_SHADER_CONST uint kCompositeExpectedDepthBit = 1u;  // expected depth and
 OPEN3D_SHADER_CONST uint kCompositeMedianDepthBit = 2u;    // median depth image
 
 // Which pixel blocks of a tile a splat can change: bit k is set unless no pixel of block k
-// lies in the axis-aligned box of the splat's culling ellipse q <= t (TileCullThreshold,
-// stored in conic.w). The box is the ellipse's extents sqrt(c t / det_q) and sqrt(a t /
-// det_q) widened as in TileRowSpan (1/256 of the extent + 0.5 px, for this function's own
-// rounding), so a block outside it receives only skips, exactly as a culled tile. (x0, y0)
-// is the tile's first pixel, (cx, cy) the splat centre; pixel (x, y) is evaluated at (x, y).
-// Nothing finite to bound by (t not finite, a degenerate conic, NaN): every block.
+// lies in the splat's culling ellipse q <= t (TileCullThreshold, stored in conic.w), found
+// per row of blocks with EllipseBandReach as TileRowSpan finds tiles, so a block with a clear
+// bit receives only skips, exactly as a culled tile. (x0, y0) is the tile's first pixel,
+// (cx, cy) the splat centre; pixel (x, y) is evaluated at (x, y). Nothing finite to bound by
+// (a degenerate conic, NaN): every block.
 #ifdef __cplusplus
 #define OPEN3D_SHADER_FUNC inline
 #define OPEN3D_SHADER_PRECISE
@@ -589,33 +609,31 @@ OPEN3D_SHADER_CONST uint kCompositeMedianDepthBit = 2u;    // median depth image
 #define OPEN3D_SHADER_FUNC
 #define OPEN3D_SHADER_PRECISE precise
 #endif
-OPEN3D_SHADER_FUNC uint CompositeBlockMask(float cx, float cy, float a, float c, float det_q,
-                                           float t, float x0, float y0) {
+OPEN3D_SHADER_FUNC uint CompositeBlockMask(float cx, float cy, float a, float b, float c,
+                                           float det_q, float t, float x0, float y0) {
     uint all = (1u << kCompositeBlocks) - 1u;
+    uint row = (1u << kCompositeBlocksX) - 1u;
     if (!(t > 0.0f)) return 0u;
     OPEN3D_SHADER_PRECISE float x_ext = sqrt(c * t / det_q);
     OPEN3D_SHADER_PRECISE float y_ext = sqrt(a * t / det_q);
     if (!(x_ext < 1e30f && y_ext < 1e30f && a > 0.0f && c > 0.0f)) return all;
-    OPEN3D_SHADER_PRECISE float x_reach = x_ext * (1.0f + 1.0f / 256.0f) + 0.5f;
-    OPEN3D_SHADER_PRECISE float y_reach = y_ext * (1.0f + 1.0f / 256.0f) + 0.5f;
-    OPEN3D_SHADER_PRECISE float lo_x = cx - x0 - x_reach;
-    OPEN3D_SHADER_PRECISE float hi_x = cx - x0 + x_reach;
-    OPEN3D_SHADER_PRECISE float lo_y = cy - y0 - y_reach;
-    OPEN3D_SHADER_PRECISE float hi_y = cy - y0 + y_reach;
-    if (!(lo_x <= hi_x && lo_y <= hi_y)) return all;
-    uint columns = 0u;
-    for (uint bx = 0u; bx < kCompositeBlocksX; ++bx) {
-        float first = float(bx * kCompositeBlockWidth);
-        if (hi_x >= first && lo_x <= first + float(kCompositeBlockWidth - 1u)) {
-            columns |= 1u << bx;
-        }
-    }
     uint mask = 0u;
     for (uint by = 0u; by < kCompositeBlocksY; ++by) {
-        float first = float(by * kCompositeBlockHeight);
-        if (hi_y >= first && lo_y <= first + float(kCompositeBlockHeight - 1u)) {
-            mask |= columns << (by * kCompositeBlocksX);
+        OPEN3D_SHADER_PRECISE float lo = y0 + float(by * kCompositeBlockHeight) - cy;
+        OPEN3D_SHADER_PRECISE float hi = lo + float(kCompositeBlockHeight - 1u);
+        vec4 band = EllipseBandReach(a, b, c, det_q, t, x_ext, y_ext, lo, hi);
+        if (band.w == 0.0f) continue;
+        OPEN3D_SHADER_PRECISE float left = cx + band.x - band.z - x0;
+        OPEN3D_SHADER_PRECISE float right = cx + band.y + band.z - x0;
+        uint columns = 0u;
+        for (uint bx = 0u; bx < kCompositeBlocksX; ++bx) {
+            float first = float(bx * kCompositeBlockWidth);
+            if (right >= first && left <= first + float(kCompositeBlockWidth - 1u)) {
+                columns |= 1u << bx;
+            }
         }
+        if (!(left <= right)) columns = row;  // NaN
+        mask |= columns << (by * kCompositeBlocksX);
     }
     return mask;
 }

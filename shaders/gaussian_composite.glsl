@@ -9,7 +9,7 @@
 // gaussian_tile_ranges.comp (depth order preserved inside a tile); its splats are loaded
 // cooperatively into shared memory in batches of 256 and blended front to back with exactly
 // the 3DGS rules (docs/DESIGN.md section 3, cpu/Composite.cpp). Each pixel block visits only
-// the batch splats whose culling ellipse's bounding box meets it (CompositeBlockMask), a
+// the batch splats whose culling ellipse meets it (CompositeBlockMask), a
 // list built per batch by one workgroup scan, and takes them eight at a time: the eight
 // alphas first (independent loads and arithmetic), then the serial transmittance chain.
 // On the H100 the two together took the grid's composite from 2.42 to 1.58 ms (1080p) and
@@ -234,7 +234,8 @@ void main() {
                 s_color[slot] = splat.color;
                 mask = CompositeBlockMask(splat.center_depth_opacity.x,
                                           splat.center_depth_opacity.y, splat.conic.x,
-                                          splat.conic.z, splat.color.w, splat.conic.w,
+                                          splat.conic.y, splat.conic.z, splat.color.w,
+                                          splat.conic.w,
                                           float(tile_origin.x), float(tile_origin.y));
             }
             // Each block's list of the slots whose bit is set, in slot (depth) order: a

@@ -170,8 +170,8 @@ CullingCounts CheckBlockMasks(const std::vector<ProjectedSplat>& splats) {
             for (int tx = first; tx < last; ++tx) {
                 const int x0 = tx * kTileSize, y0 = ty * kTileSize;
                 const uint32_t mask =
-                    CompositeBlockMask(float(s.x), float(s.y), float(s.conic_a), float(s.conic_c),
-                                       float(s.det_q), t, float(x0), float(y0));
+                    CompositeBlockMask(float(s.x), float(s.y), float(s.conic_a), float(s.conic_b),
+                                       float(s.conic_c), float(s.det_q), t, float(x0), float(y0));
                 EXPECT_EQ(mask >> kCompositeBlocks, 0u);
                 for (uint32_t k = 0; k < kCompositeBlocks; ++k) {
                     ++counts.rect_tiles;
