@@ -219,6 +219,11 @@ void main() {
         uint begin = range.x;
         uint end = range.y;
 
+        // The splat index of this invocation's next batch entry is read one batch ahead, so a
+        // batch load waits on one gather instead of two dependent ones: grid composite 1.583
+        // -> 1.566 ms (H100, 1080p). Reading the whole next record ahead held 12 more
+        // registers across the blend loop and measured slower (1.611 ms).
+        uint next_index = begin + slot < end ? entry_values[begin + slot] : 0u;
         for (uint batch = begin; batch < end; batch += kCompositeBatchSize) {
             barrier();  // the previous batch is consumed and its s_done increments made
             // Early exit when every pixel of the tile is done. Uniform: s_done is read
@@ -227,7 +232,10 @@ void main() {
             uint entry = batch + slot;
             uint mask = 0u;
             if (entry < end) {
-                GaussianProjectedSplat splat = projected[entry_values[entry]];
+                GaussianProjectedSplat splat = projected[next_index];
+                if (entry + kCompositeBatchSize < end) {
+                    next_index = entry_values[entry + kCompositeBatchSize];
+                }
                 s_center_depth_opacity[slot] = splat.center_depth_opacity;
                 s_conic[slot] = splat.conic * vec4(-0.5 * kLog2E, -kLog2E, -0.5 * kLog2E,
                                                    -0.5 * kLog2E);
