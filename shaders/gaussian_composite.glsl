@@ -159,12 +159,29 @@ uint BlockCounter(uvec4 counters, uint k) {
     return (counters[k >> 1u] >> (16u * (k & 1u))) & 0xFFFFu;
 }
 
-// Splats blended per iteration of the batch loop. Unrolled because llvmpipe (lavapipe) ends
+// Splats blended per step of the batch loop. Unrolled because llvmpipe (lavapipe) ends
 // every loop of an invocation once 65535 back-edges have been taken in total (gallivm's loop
-// limiter): at 8 splats per back-edge a tile may hold ~500k entries. On the H100 four
-// measured slower than eight (grid composite 1.71 vs 1.59 ms), and padding the lists to
-// whole steps with a null splat instead of the one-by-one tail changed nothing (1.60 ms).
-const uint kUnroll = 8u;
+// limiter): with steps of 16 (at most 24 back-edges per batch of 256) a tile may hold ~700k
+// entries. On the H100 (grid composite, 1080p) steps of 4 took 1.71 ms, of 8 1.58 ms, of 16
+// followed by singles 1.57 ms, of 16 followed by one of 8 1.54 ms; padding the lists to whole
+// steps with a null splat changed nothing. Registers (VK_KHR_pipeline_executable_properties,
+// H100): 91 at 8, 122 at 16, so two workgroups share an SM either way, and the unrolled loads
+// are what hides the shared-memory and exp2 latency.
+const uint kUnroll = 16u;
+
+// One step of N splats from position j of the block's list: N alphas, then N blends in order.
+#define BLEND_STEP(N)                                                         \
+    {                                                                         \
+        uint slots[N];                                                        \
+        float alphas[N];                                                      \
+        [[unroll]] for (uint k = 0u; k < N; ++k) {                            \
+            slots[k] = s_block_slots[list + j + k];                           \
+            alphas[k] = SplatAlpha(slots[k], p);                              \
+        }                                                                     \
+        [[unroll]] for (uint k = 0u; k < N; ++k) {                            \
+            if (!p.done && alphas[k] > 0.0) BlendAlpha(slots[k], alphas[k], p); \
+        }                                                                     \
+    }
 
 void main() {
     uint local = gl_LocalInvocationIndex;
@@ -271,18 +288,12 @@ void main() {
             uint count = BlockCounter(total, block);
             uint list = block * kCompositeBatchSize;
             uint j = 0u;
-            // An alpha does not depend on the transmittance: the eight loads and exp2s overlap,
-            // and only the blending below is a serial chain.
-            for (; j + kUnroll <= count && !p.done; j += kUnroll) {
-                uint slots[kUnroll];
-                float alphas[kUnroll];
-                [[unroll]] for (uint k = 0u; k < kUnroll; ++k) {
-                    slots[k] = s_block_slots[list + j + k];
-                    alphas[k] = SplatAlpha(slots[k], p);
-                }
-                [[unroll]] for (uint k = 0u; k < kUnroll; ++k) {
-                    if (!p.done && alphas[k] > 0.0) BlendAlpha(slots[k], alphas[k], p);
-                }
+            // An alpha does not depend on the transmittance: a step's loads and exp2s overlap,
+            // and only its blending is a serial chain. Steps of 16, one of 8, then one by one.
+            for (; j + kUnroll <= count && !p.done; j += kUnroll) BLEND_STEP(kUnroll);
+            if (j + kUnroll / 2u <= count && !p.done) {
+                BLEND_STEP(kUnroll / 2u);
+                j += kUnroll / 2u;
             }
             for (; j < count && !p.done; ++j) BlendSplat(s_block_slots[list + j], p);
             if (p.done) atomicAdd(s_done, 1u);  // once: done pixels skip later batches

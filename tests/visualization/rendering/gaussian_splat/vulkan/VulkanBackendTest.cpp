@@ -9,11 +9,14 @@
 
 #include "TestUtility.h"
 #include "open3d/camera/CamerasJson.h"
+#include "open3d/core/Exception.h"
 #include "open3d/t/geometry/ImageMetrics.h"
 #include "open3d/t/io/PointCloudIO.h"
 #include "open3d/visualization/rendering/gaussian_splat/DefaultScene.h"
 #include "open3d/visualization/rendering/gaussian_splat/cpu/CpuBackend.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/GaussianSplatVulkanBackend.h"
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/GaussianStageA.h"
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/RadixSort.h"
 #include "visualization/rendering/gaussian_splat/vulkan/VulkanTestFixture.h"
 
 namespace open3d {
@@ -169,6 +172,28 @@ TEST_F(VulkanBackend, EntryBuffersGrowInsteadOfDroppingEntries) {
     limited.max_tile_entries_total = 500;
     EXPECT_NE(small->Render(cam, limited).stats.error_flags & kEntriesDropped, 0u);
     EXPECT_EQ(small->GetCounters().capacity_growths, 1);
+}
+
+TEST_F(VulkanBackend, EntryCapacityStopsAtTheSortLimit) {
+    // The config's limit binds below the sort's; above it, RadixSort::kMaxCount does (the scan
+    // saturates later), and Stage A accepts exactly that capacity.
+    RenderConfig config;
+    config.max_tile_entries_total = 1000;
+    EXPECT_EQ(GaussianSplatVulkanBackend::MaxEntryCapacity(config), 1000u);
+    static_assert(vulkan::RadixSort::kMaxCount < shader::kScanSaturation - 1);
+    for (uint64_t total : {uint64_t(vulkan::RadixSort::kMaxCount),
+                           uint64_t(vulkan::RadixSort::kMaxCount) + 1, uint64_t(1) << 40}) {
+        config.max_tile_entries_total = total;
+        EXPECT_EQ(GaussianSplatVulkanBackend::MaxEntryCapacity(config),
+                  vulkan::RadixSort::kMaxCount);
+    }
+    const uint32_t bound = GaussianSplatVulkanBackend::MaxEntryCapacity(config);
+    EXPECT_NO_THROW(vulkan::GaussianStageA::GetStorageRequirements(1000, bound));
+    EXPECT_NO_THROW(vulkan::RadixSort::GetStorageRequirements(bound));
+    EXPECT_THROW(vulkan::GaussianStageA::GetStorageRequirements(1000, bound + 1),
+                 core::Open3DError);
+    EXPECT_THROW(vulkan::GaussianStageA::GetStorageRequirements(bound + 1, 1000),
+                 core::Open3DError);
 }
 
 TEST_F(VulkanBackend, EmptyViewIsBackgroundOnly) {

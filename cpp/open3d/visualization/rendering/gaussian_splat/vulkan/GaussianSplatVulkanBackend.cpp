@@ -18,13 +18,6 @@ namespace vulkan {
 
 namespace {
 
-// The most tile entries a frame of this config may allocate: what it allows, within what the
-// scan (saturating at kScanSaturation) and the sorts (RadixSort::kMaxCount) address.
-uint64_t MaxEntryCapacity(const RenderConfig& config) {
-    return std::min<uint64_t>(
-        {config.max_tile_entries_total, shader::kScanSaturation - 1, RadixSort::kMaxCount});
-}
-
 bool SameCamera(const camera::PinholeCamera& a, const camera::PinholeCamera& b) {
     return a.width == b.width && a.height == b.height && a.fx == b.fx && a.fy == b.fy &&
            a.cx == b.cx && a.cy == b.cy && a.world_to_camera == b.world_to_camera;
@@ -58,6 +51,11 @@ const char* FlagMessage(uint32_t bit) {
 }
 
 }  // namespace
+
+uint32_t GaussianSplatVulkanBackend::MaxEntryCapacity(const RenderConfig& config) {
+    return static_cast<uint32_t>(std::min<uint64_t>(
+        {config.max_tile_entries_total, shader::kScanSaturation - 1, RadixSort::kMaxCount}));
+}
 
 GaussianSplatVulkanBackend::GaussianSplatVulkanBackend(std::unique_ptr<VulkanContext> context,
                                                        uint32_t initial_entry_capacity)

@@ -91,6 +91,11 @@ public:
         return true;
     }
 
+    /// The most tile entries a frame of `config` may allocate: what the config allows, within
+    /// what the scan (saturating at shader::kScanSaturation) and the sorts
+    /// (RadixSort::kMaxCount) address. Entry buffers never grow past it.
+    static uint32_t MaxEntryCapacity(const RenderConfig& config);
+
     /// Counters that make the skips visible to tests and benchmarks.
     struct Counters {
         int64_t scene_uploads = 0;       ///< packs + uploads of the scene
