@@ -113,27 +113,34 @@ double Median(std::vector<double> v) {
     return v.empty() ? 0.0 : v[v.size() / 2];
 }
 
+// Medians over the timed frames of RunTimedFrames.
+struct TimedFrames {
+    rendering::RenderStats gpu;  // every gpu_*_ms field is the median of that pass
+    double cpu_frame_ms = 0.0;   // CPU wall time per frame, submit to fence
+};
+
 // Times `frames` frames (Stage A + Stage B, no readback) after at least kWarmUpSeconds of
-// the same frames, and returns the median of each GPU pass and, in composite_ms, of the
-// CPU wall time per frame. Frames follow each other with only the submit/fence gap, so a
+// the same frames, and returns the median of each GPU pass and of the CPU wall time per
+// frame. Frames follow each other with only the submit/fence gap, so a
 // GPU that lowers its clocks when idle (every NVIDIA board does) is timed at full clock:
 // with a readback between frames the H100 ran the same depth sort 2.5-5x slower. (Run
 // loops time everything before the CPU references: see Run.)
-rendering::RenderStats RunTimedFrames(rendering::GaussianSplatBackend& backend,
-                                      const camera::PinholeCamera& camera,
-                                      const rendering::RenderConfig& config, int frames,
-                                      const std::string& depth) {
+TimedFrames RunTimedFrames(rendering::GaussianSplatBackend& backend,
+                           const camera::PinholeCamera& camera,
+                           const rendering::RenderConfig& config, int frames,
+                           const std::string& depth) {
     constexpr double kWarmUpSeconds = 1.0;
     rendering::CompositeInputs no_readback;
     no_readback.read_back = false;
     no_readback.expected_depth = depth == "expected" || depth == "both";
     no_readback.median_depth = depth == "median" || depth == "both";
     rendering::RenderOutput out;
+    double wall_ms = 0.0;  // of the last frame
     const auto frame = [&]() {
         const auto start = std::chrono::steady_clock::now();
         backend.RenderGeometryStage(camera, config);
         backend.RenderCompositeStage(out, no_readback);
-        out.stats.composite_ms = core::MillisecondsSince(start);
+        wall_ms = core::MillisecondsSince(start);
         return out.stats;
     };
     // Warm up until the GPU time stops falling: windows of 20 frames until a window's
@@ -164,16 +171,17 @@ rendering::RenderStats RunTimedFrames(rendering::GaussianSplatBackend& backend,
         depth_sort.push_back(s.gpu_depth_sort_ms);
         scan_emit.push_back(s.gpu_scan_emit_ms);
         tile_sort.push_back(s.gpu_tile_sort_ms);
-        wall.push_back(s.composite_ms);
+        wall.push_back(wall_ms);
     }
-    rendering::RenderStats m = out.stats;
-    m.gpu_project_ms = Median(project);
-    m.gpu_sort_ms = Median(sort);
-    m.gpu_composite_ms = Median(composite);
-    m.gpu_depth_sort_ms = Median(depth_sort);
-    m.gpu_scan_emit_ms = Median(scan_emit);
-    m.gpu_tile_sort_ms = Median(tile_sort);
-    m.composite_ms = Median(wall);
+    TimedFrames m;
+    m.gpu = out.stats;
+    m.gpu.gpu_project_ms = Median(project);
+    m.gpu.gpu_sort_ms = Median(sort);
+    m.gpu.gpu_composite_ms = Median(composite);
+    m.gpu.gpu_depth_sort_ms = Median(depth_sort);
+    m.gpu.gpu_scan_emit_ms = Median(scan_emit);
+    m.gpu.gpu_tile_sort_ms = Median(tile_sort);
+    m.cpu_frame_ms = Median(wall);
     return m;
 }
 
@@ -281,8 +289,9 @@ int Run(const Options& opt) {
                     // One full frame for the error columns, then timed frames without
                     // readback (per-pass medians).
                     rendering::RenderOutput out = backend->Render(cams[v], config);
-                    const rendering::RenderStats med =
+                    const TimedFrames timed =
                         RunTimedFrames(*backend, cams[v], config, opt.repeat, opt.depth);
+                    const rendering::RenderStats& med = timed.gpu;
                     const double n = static_cast<double>(cams.size());  // mean over views
                     row.project_ms += med.gpu_project_ms / n;
                     row.sort_ms += med.gpu_sort_ms / n;
@@ -290,7 +299,7 @@ int Run(const Options& opt) {
                     row.depth_sort_ms += med.gpu_depth_sort_ms / n;
                     row.scan_emit_ms += med.gpu_scan_emit_ms / n;
                     row.tile_sort_ms += med.gpu_tile_sort_ms / n;
-                    row.cpu_frame_ms += med.composite_ms / n;
+                    row.cpu_frame_ms += timed.cpu_frame_ms / n;
                     row.visible += out.stats.num_visible / static_cast<int64_t>(cams.size());
                     row.entries += out.stats.num_tile_entries / static_cast<int64_t>(cams.size());
                     row.error_flags |= out.stats.error_flags;
