@@ -39,6 +39,8 @@ OPEN3D_SHADER_CONST uint kErrorCountsClamped = 2u;
 // ---- Radix sort of (uint32 key, uint32 value) pairs: LSD, 8-bit digits ----
 OPEN3D_SHADER_CONST uint kRadixSortDigitBits = 8u;
 OPEN3D_SHADER_CONST uint kRadixSortBins = 256u;  // 1 << kRadixSortDigitBits
+// The key a first pass with drop_max_keys leaves out (RadixSort::DropMaxKeys).
+OPEN3D_SHADER_CONST uint kRadixSortDroppedKey = 0xFFFFFFFFu;
 // One invocation per bin in the histogram, scan and scatter shaders (asserted below).
 OPEN3D_SHADER_CONST uint kRadixSortWorkgroupSize = 256u;
 // A workgroup owns a block of 256 * chunks elements, chunks = 1..8 chosen per sort by
@@ -92,7 +94,7 @@ struct RadixSortPushConstants {
     uint count_index;    // uint index of the count within the count binding
     uint max_count;      // capacity of the key/value buffers
     uint target_blocks;  // 1..kRadixSortTargetBlocks: block count the setup aims at
-    uint reserved0;
+    uint drop_max_keys;  // 1: this pass leaves out pairs with key kRadixSortDroppedKey
     uint reserved1;
     uint reserved2;
 };

@@ -42,8 +42,8 @@ uint SatAdd(uint a, uint b) {
 
 uint LoadCount(uint index) {
     if (kGather == 0u) return scan[pc.base + index];
-    // The exact order scans all N slots; past the visible ones (culled splats, sorted last)
-    // the records are stale and count nothing.
+    // The exact order scans all N slots; past the visible ones the list holds stale slots
+    // (the depth sort dropped the culled splats), which count nothing.
     if (index >= counters.visible_count) return 0u;
     uint count = tile_counts[splat_indices[index]];
     if (count > view.limits.y) {  // over max_tiles_per_splat: the splat emits nothing

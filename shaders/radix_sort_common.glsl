@@ -17,6 +17,12 @@ uint DigitOf(uint key) {
     return (key >> pc.shift) & ((1u << pc.digit_bits) - 1u);
 }
 
+// Whether a pair in the input takes part in this pass: all of them but the dropped keys of
+// a first pass with drop_max_keys (RadixSort::DropMaxKeys).
+bool IsKept(uint key) {
+    return pc.drop_max_keys == 0u || key != kRadixSortDroppedKey;
+}
+
 layout(constant_id = kSpecRadixSortSubgroups) const uint kMaxSubgroups = kRadixSortMaxSubgroups;
 
 // Per-subgroup partial sums, indexed by gl_SubgroupID.

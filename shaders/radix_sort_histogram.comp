@@ -28,7 +28,9 @@ void main() {
     uint block_begin = gl_WorkGroupID.x * block_size;
     for (uint i = local; i < block_size; i += kRadixSortWorkgroupSize) {
         uint index = block_begin + i;
-        if (index < count) atomicAdd(s_counts[DigitOf(keys_in[index])], 1u);
+        if (index >= count) continue;
+        uint key = keys_in[index];
+        if (IsKept(key)) atomicAdd(s_counts[DigitOf(key)], 1u);
     }
     barrier();
     histogram[kRadixSortBins + local * params.num_blocks + gl_WorkGroupID.x] = s_counts[local];

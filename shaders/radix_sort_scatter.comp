@@ -16,6 +16,8 @@
 // pair is written straight from its register, about one pair per digit and memory segment:
 // on the H100 that took 250 us per pass of the grid's depth sort, against 130 with the
 // local reorder.
+// Dropping (a first pass with drop_max_keys): pairs with key kRadixSortDroppedKey take no
+// rank and are not written, so the block's kept pairs are packed from its output offsets.
 // Stability: subgroups own runs in scan-slot order (gl_SubgroupID), a subgroup ranks its
 // run in element order (steps in order, lanes by gl_SubgroupInvocationID, the order of
 // ballot bits), earlier subgroups take lower positions and blocks take their offsets in
@@ -71,6 +73,7 @@ void main() {
     uint count = params.count;
     uint num_blocks = params.num_blocks;
     uint block = gl_WorkGroupID.x;
+    uint block_kept;  // pairs of this block the histogram counted (all but dropped keys)
 
     // The scan left the block's first output index within each digit; the block's count of
     // a digit is the next block's index minus its own (the digit's total after the last
@@ -79,8 +82,8 @@ void main() {
         uint row = kRadixSortBins + g_slot * num_blocks;
         uint first = histogram[row + block];
         uint next = block + 1u < num_blocks ? histogram[row + block + 1u] : histogram[g_slot];
+        uint local_first = WorkgroupExclusiveAdd(next - first, block_kept);
         uint total;
-        uint local_first = WorkgroupExclusiveAdd(next - first, total);
         uint digit_base = WorkgroupExclusiveAdd(histogram[g_slot], total);
         s_first[g_slot] = local_first;
         s_out_shift[g_slot] = digit_base + first - local_first;
@@ -100,6 +103,7 @@ void main() {
     uint keys[kRadixSortItemsPerInvocation];
     uint values[kRadixSortItemsPerInvocation];
     uint ranks[kRadixSortItemsPerInvocation];
+    uint kept = 0u;  // bit k: pair k is in the block and not a dropped key
     for (uint k = 0u; k < kRadixSortItemsPerInvocation; ++k) {
         uint index = first + k * lanes;
         bool valid = k < chunks && index < block_end;
@@ -108,7 +112,8 @@ void main() {
     }
     for (uint k = 0u; k < kRadixSortItemsPerInvocation; ++k) {
         if (k >= chunks) break;  // uniform
-        bool valid = first + k * lanes < block_end;
+        bool valid = first + k * lanes < block_end && IsKept(keys[k]);
+        if (valid) kept |= 1u << k;
         uint digit = DigitOf(keys[k]);
         // Valid lanes of this subgroup with the same digit.
         uvec4 peers = subgroupBallot(valid);
@@ -141,7 +146,7 @@ void main() {
     barrier();
     for (uint k = 0u; k < kRadixSortItemsPerInvocation; ++k) {
         if (k >= chunks) break;
-        if (first + k * lanes >= block_end) continue;
+        if ((kept & (1u << k)) == 0u) continue;
         uint digit = DigitOf(keys[k]);
         uint position = s_first[digit] + HalfOf(s_counts[row + (digit >> 1u)], digit) + ranks[k];
         if (kLocalCapacity > 1u) {
@@ -155,7 +160,7 @@ void main() {
     if (kLocalCapacity == 1u) return;
     barrier();
     // The whole block is in s_keys and s_values.
-    for (uint i = local; i < block_end - block_begin; i += kRadixSortWorkgroupSize) {
+    for (uint i = local; i < block_kept; i += kRadixSortWorkgroupSize) {
         uint key = s_keys[i];
         uint out_index = s_out_shift[DigitOf(key)] + i;
         keys_out[out_index] = key;

@@ -107,7 +107,8 @@ protected:
     /// keys.size()) on the GPU with `gpu_count` written into the count buffer on the GPU.
     GpuSortResult Sort(const std::vector<uint32_t>& keys, const std::vector<uint32_t>& values,
                        uint32_t gpu_count, uint32_t num_bits,
-                       RadixSort::Params source = RadixSort::Params::kSetupPass) {
+                       RadixSort::Params source = RadixSort::Params::kSetupPass,
+                       const uint32_t* kept_count = nullptr) {
         const auto capacity = static_cast<uint32_t>(keys.size());
         const VkDeviceSize bytes = std::max<VkDeviceSize>(capacity, 1) * 4;
         const VkBufferUsageFlags usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT |
@@ -150,6 +151,8 @@ protected:
         // A producer writes the parameters itself (as a shader would); the sort must not
         // read the count then, so the count binding holds garbage.
         vkCmdFillBuffer(c, count_buffer.Get(), 20, 4, producer ? 0xFFFFFFFFu : gpu_count);
+        // With a drop, the kept count sits at byte 44 (another count of the same producer).
+        if (kept_count) vkCmdFillBuffer(c, count_buffer.Get(), 44, 4, *kept_count);
         if (producer) {
             const shader::RadixSortParams written = shader::RadixSortParamsFor(
                 gpu_count, std::max(capacity, 1u), sort_->GetTargetBlocks());
@@ -162,8 +165,10 @@ protected:
                 VK_ACCESS_2_INDIRECT_COMMAND_READ_BIT);
         RadixSortScratch scratch{keys_alt.Range(), values_alt.Range(), histogram.Range(),
                                  params.Range()};
+        const RadixSort::DropMaxKeys drop{count_buffer.Range(44, 4)};
         sort_->Record(c, key_buffer.Range(), value_buffer.Range(), scratch,
-                      count_buffer.Range(20, 4), capacity, num_bits, source);
+                      count_buffer.Range(20, 4), capacity, num_bits, source,
+                      kept_count ? &drop : nullptr);
         RecordMemoryBarrier(c, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
                             VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, VK_PIPELINE_STAGE_2_TRANSFER_BIT,
                             VK_ACCESS_2_TRANSFER_READ_BIT);
@@ -314,6 +319,68 @@ TEST_F(RadixSortTest, ParamsWrittenByTheProducer) {
         EXPECT_EQ(gpu.params.count, count);
         EXPECT_EQ(gpu.keys, keys) << count;
         EXPECT_EQ(gpu.values, values) << count;
+    }
+}
+
+TEST_F(RadixSortTest, DropMaxKeysSortsOnlyTheKeptPairs) {
+    // Stage A's depth sort: culled slots carry kRadixSortDroppedKey among the visible ones.
+    // The first pass leaves them out; the kept pairs come out first, stably sorted, and the
+    // params describe them. Cases: 4 passes (as Stage A), odd pass counts (the copy reads
+    // the kept params), producer-written params, nothing or everything dropped, runs of
+    // dropped keys longer than a block, and pairs past the count that must stay out.
+    struct DropCase {
+        uint32_t count;
+        uint32_t num_bits;
+        double drop_fraction;
+        RadixSort::Params source;
+    };
+    const DropCase cases[] = {
+        {70000, 32, 0.17, RadixSort::Params::kWrittenByProducer},
+        {70000, 32, 0.17, RadixSort::Params::kSetupPass},
+        {300000, 32, 0.5, RadixSort::Params::kWrittenByProducer},
+        {5000, 8, 0.3, RadixSort::Params::kSetupPass},
+        {5000, 24, 0.3, RadixSort::Params::kSetupPass},
+        {5000, 16, 0.0, RadixSort::Params::kSetupPass},
+        {5000, 32, 1.0, RadixSort::Params::kSetupPass},
+        {257, 32, 0.5, RadixSort::Params::kWrittenByProducer},
+    };
+    for (const DropCase& c : cases) {
+        SCOPED_TRACE(testing::Message() << c.count << " pairs, " << c.num_bits << " bits, "
+                                        << c.drop_fraction << " dropped");
+        std::mt19937 rng(c.count + c.num_bits);
+        std::uniform_real_distribution<double> uniform(0.0, 1.0);
+        std::vector<uint32_t> keys(c.count), values(c.count);
+        for (uint32_t i = 0; i < c.count; ++i) {
+            // Keys below 2^num_bits - 1 with many ties, so stability is tested; a run of
+            // dropped keys across the third block of 2048.
+            keys[i] = (rng() % 997u) * 4099u & ((c.num_bits >= 32 ? 0u : 1u << c.num_bits) - 2u);
+            const bool in_run = i >= 4096 && i < 4096 + 3000 && c.drop_fraction > 0.0;
+            if (in_run || uniform(rng) < c.drop_fraction) keys[i] = shader::kRadixSortDroppedKey;
+            values[i] = i;
+        }
+        std::vector<uint32_t> want_keys, want_values;
+        for (uint32_t i = 0; i < c.count; ++i) {
+            if (keys[i] == shader::kRadixSortDroppedKey) continue;
+            want_keys.push_back(keys[i]);
+            want_values.push_back(values[i]);
+        }
+        ReferenceSort(want_keys, want_values, c.num_bits);
+        const auto kept = static_cast<uint32_t>(want_keys.size());
+        // Small keys past the count would sort first if they leaked in.
+        for (uint32_t i = 0; i < 37; ++i) {
+            keys.push_back(i);
+            values.push_back(0xDEAD0000u + i);
+        }
+        GpuSortResult gpu = Sort(keys, values, c.count, c.num_bits, c.source, &kept);
+        EXPECT_EQ(gpu.params.count, kept);
+        EXPECT_EQ(gpu.params.flags, 0u);
+        for (uint32_t i = 0; i < kept; ++i) {
+            ASSERT_EQ(gpu.keys[i], want_keys[i]) << "key " << i << " of " << kept;
+            ASSERT_EQ(gpu.values[i], want_values[i]) << "value " << i << " of " << kept;
+        }
+        for (uint32_t i = c.count; i < c.count + 37; ++i) {
+            ASSERT_EQ(gpu.values[i], 0xDEAD0000u + (i - c.count)) << "pair " << i << " moved";
+        }
     }
 }
 

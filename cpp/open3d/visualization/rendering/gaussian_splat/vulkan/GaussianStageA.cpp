@@ -236,8 +236,11 @@ void GaussianStageA::Record(VkCommandBuffer cmd, const StageASceneBuffers& scene
     }
 
     // 3. Exact depth order with ties by splat index: slot i of the list holds splat i (culled
-    // and hidden splats carry the key ~0u), so one stable sort of all N slots by the 32-bit
-    // depth key puts the visible splats first, front to back, ties in index order.
+    // and hidden splats carry the key ~0u), so one stable sort of the N slots by the 32-bit
+    // depth key puts the visible splats first, front to back, ties in index order. Its first
+    // pass drops the ~0u keys and the other three sort the visible_count kept ones
+    // (RadixSort::DropMaxKeys; a visible splat's depth is positive, never ~0u); slots past
+    // visible_count are stale afterwards, which the scan and the emit never read.
     // The packed key, like the seed, keeps the projection's append order: its one entry
     // sort decides the depth order, and measuring its error means not helping it here.
     const auto begin = [&](TimedPass pass) {
@@ -248,9 +251,10 @@ void GaussianStageA::Record(VkCommandBuffer cmd, const StageASceneBuffers& scene
     };
     if (!packed_key) {
         begin(TimedPass::kDepthSort);
+        const RadixSort::DropMaxKeys drop_culled{counter_range(kCounterVisibleIndex)};
         sort_.Record(cmd, buffers.depth_keys, buffers.splat_indices, buffers.sort_scratch,
                      counter_range(kCounterNumSplatsIndex), std::max(n, 1u), 32,
-                     RadixSort::Params::kWrittenByProducer);
+                     RadixSort::Params::kWrittenByProducer, &drop_culled);
         ComputeBarrier(cmd);
         end(TimedPass::kDepthSort);
     }

@@ -151,17 +151,27 @@ uint32_t RadixSort::GetTargetBlocks() const {
 
 void RadixSort::Record(VkCommandBuffer cmd, const BufferRange& keys, const BufferRange& values,
                        const RadixSortScratch& scratch, const BufferRange& count,
-                       uint32_t max_count, uint32_t num_bits, Params params) const {
+                       uint32_t max_count, uint32_t num_bits, Params params,
+                       const DropMaxKeys* drop) const {
     CheckArguments(keys, values, scratch, count, max_count, num_bits);
+    if (drop && (drop->kept_count.buffer == VK_NULL_HANDLE || drop->kept_count.offset % 4 != 0)) {
+        core::ThrowError("RadixSort: kept_count needs a buffer and a 4-byte aligned offset");
+    }
     const uint32_t num_passes = GetNumPasses(num_bits);
     if (num_passes == 0) return;  // no key bits: every order is sorted
 
     // The count may sit at any 4-byte offset: bind from the aligned offset below it and
     // index the uint with a push constant.
     const VkDeviceSize alignment = context_->GetDeviceInfo().min_storage_buffer_offset_alignment;
-    const VkDeviceSize count_binding_offset = count.offset - count.offset % alignment;
+    const auto count_binding_offset = [alignment](const BufferRange& range) {
+        return range.offset - range.offset % alignment;
+    };
+    const auto count_index = [&](const BufferRange& range) {
+        return static_cast<uint32_t>((range.offset - count_binding_offset(range)) / 4);
+    };
+    BufferRange count_in = count;  // what the setup dispatch reads
     RadixSortPushConstants push{};
-    push.count_index = static_cast<uint32_t>((count.offset - count_binding_offset) / 4);
+    push.count_index = count_index(count);
     push.max_count = max_count;
     push.target_blocks = GetTargetBlocks();
 
@@ -171,7 +181,8 @@ void RadixSort::Record(VkCommandBuffer cmd, const BufferRange& keys, const Buffe
         std::array<VkDescriptorBufferInfo, kRadixSortNumBindings> buffers{};
         buffers[kRadixSortParamsBinding] = {scratch.params.buffer, scratch.params.offset,
                                             sizeof(RadixSortParams)};
-        buffers[kRadixSortCountBinding] = {count.buffer, count_binding_offset, VK_WHOLE_SIZE};
+        buffers[kRadixSortCountBinding] = {count_in.buffer, count_binding_offset(count_in),
+                                           VK_WHOLE_SIZE};
         buffers[kRadixSortKeysInBinding] = {keys_in.buffer, keys_in.offset, Words(max_count)};
         buffers[kRadixSortValuesInBinding] = {values_in.buffer, values_in.offset, Words(max_count)};
         buffers[kRadixSortKeysOutBinding] = {keys_out.buffer, keys_out.offset, Words(max_count)};
@@ -204,17 +215,27 @@ void RadixSort::Record(VkCommandBuffer cmd, const BufferRange& keys, const Buffe
     const VkBuffer params_buffer = scratch.params.buffer;
     const VkDeviceSize params_offset = scratch.params.offset;
 
-    if (params == Params::kSetupPass) {
+    const auto setup = [&]() {
         bind(keys, values, scratch.keys_alt, scratch.values_alt);
         push_constants();
         vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, setup_.Get());
         vkCmdDispatch(cmd, 1, 1, 1);
         barrier();
-    }
+    };
+    // After a first pass that dropped keys, the kept pairs are packed at the front of the
+    // scratch: the later passes (and the copy of an odd pass count) sort only them.
+    const auto setup_kept = [&]() {
+        count_in = drop->kept_count;
+        push.count_index = count_index(count_in);
+        push.drop_max_keys = 0;
+        setup();
+    };
+    if (params == Params::kSetupPass) setup();
 
     if (max_count == 0) return;  // params now say count 0; nothing to move
 
     for (uint32_t pass = 0; pass < num_passes; ++pass) {
+        if (pass == 1 && drop) setup_kept();
         // Ping-pong: even passes read the caller's buffers, odd passes the scratch.
         if (pass % 2 == 0) {
             bind(keys, values, scratch.keys_alt, scratch.values_alt);
@@ -223,6 +244,7 @@ void RadixSort::Record(VkCommandBuffer cmd, const BufferRange& keys, const Buffe
         }
         push.shift = pass * kRadixSortDigitBits;
         push.digit_bits = std::min(kRadixSortDigitBits, num_bits - push.shift);
+        push.drop_max_keys = pass == 0 && drop ? 1u : 0u;
         push_constants();
         vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, histogram_.Get());
         vkCmdDispatchIndirect(cmd, params_buffer, params_offset);
@@ -235,6 +257,7 @@ void RadixSort::Record(VkCommandBuffer cmd, const BufferRange& keys, const Buffe
         vkCmdDispatchIndirect(cmd, params_buffer, params_offset);
         if (pass + 1 < num_passes || num_passes % 2 == 1) barrier();
     }
+    if (num_passes == 1 && drop) setup_kept();
     if (num_passes % 2 == 1) {
         bind(scratch.keys_alt, scratch.values_alt, keys, values);
         vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, copy_.Get());

@@ -78,9 +78,20 @@ public:
         kWrittenByProducer,
     };
 
+    /// Optional for Record: the first pass leaves out every pair whose key is
+    /// kRadixSortDroppedKey (0xFFFFFFFF), and the later passes sort the kept pairs only.
+    /// Their number is read on the GPU at `kept_count` by a setup dispatch after the first
+    /// pass; the caller counts them (it must be the number of other keys among the first
+    /// `count` pairs). Afterwards the first kept_count pairs are the sorted kept pairs;
+    /// what lies past them is unspecified. Stage A drops its culled splats this way, so
+    /// three of the depth sort's four passes see only the visible ones.
+    struct DropMaxKeys {
+        BufferRange kept_count;  // uint written on the GPU; 4-byte alignment is enough
+    };
+
     /// Records a stable sort of the first `count` pairs of (keys, values) by the low
     /// `num_bits` (0..32) bits of the keys, count = min(the uint at `count`, max_count).
-    /// The result is in `keys` and `values`.
+    /// The result is in `keys` and `values` (with `drop`: see DropMaxKeys).
     ///
     /// Synchronisation: before Record, the caller makes its writes of keys, values and
     /// count visible to COMPUTE_SHADER reads (and orders earlier uses of the scratch);
@@ -92,7 +103,8 @@ public:
                 const BufferRange& values,  // uint32 [max_count], permuted with keys
                 const RadixSortScratch& scratch,
                 const BufferRange& count,  // uint32 written on the GPU by the producer
-                uint32_t max_count, uint32_t num_bits, Params params = Params::kSetupPass) const;
+                uint32_t max_count, uint32_t num_bits, Params params = Params::kSetupPass,
+                const DropMaxKeys* drop = nullptr) const;
 
 private:
     void CheckArguments(const BufferRange& keys, const BufferRange& values,
