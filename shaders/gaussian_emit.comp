@@ -60,7 +60,7 @@ void main() {
     uint begin = scan[k];
     uint end = k + 1u < visible ? scan[k + 1u] : counters.requested_entries;
     if (end > view.limits.x || end == begin) return;
-    uint splat = splat_indices[k];
+    uint splat = ListValueSplat(splat_indices[k], view.scene.x);
     uvec4 tiles = projected[splat].tiles;
     uint min_x = tiles.x & 0xFFFFu, min_y = tiles.x >> 16u;
     uint max_x = tiles.y & 0xFFFFu, max_y = tiles.y >> 16u;
@@ -71,10 +71,26 @@ void main() {
                                                 view.clip.z, view.clip.w)
                            : 0.0;
     uint tile_bits = view.limits.w;
+    uint out_index = begin;
+    if (end - begin == (max_x - min_x) * (max_y - min_y)) {
+        // The projection kept every tile of the rectangle (a row's span is at most its
+        // width): no span to recompute, and the record's centre and conic, the other half
+        // of its 64 bytes, are not read. The grid's splats mostly cover one or two tiles.
+        for (uint ty = min_y; ty < max_y; ++ty) {
+            for (uint tx = min_x; tx < max_x; ++tx) {
+                uint tile = ty * tiles_x + tx;
+                entry_keys[out_index] = kEmitMode == kEmitPackedKeys
+                                                ? PackedSortKey(tile, norm_depth, tile_bits)
+                                                : tile;
+                entry_values[out_index] = splat;
+                ++out_index;
+            }
+        }
+        return;
+    }
     vec4 cdo = projected[splat].center_depth_opacity;
     vec4 conic = projected[splat].conic;
     float det_q = projected[splat].color.w;
-    uint out_index = begin;
     for (uint ty = min_y; ty < max_y && out_index < end; ++ty) {
         uint span = TileRowSpan(cdo.x, cdo.y, conic.x, conic.y, conic.z, det_q, conic.w, ty,
                                 min_x, max_x);

@@ -9,6 +9,7 @@
 #extension GL_KHR_shader_subgroup_basic : require
 #extension GL_KHR_shader_subgroup_arithmetic : require
 #extension GL_KHR_shader_subgroup_ballot : require
+#extension GL_EXT_control_flow_attributes : require
 #include "GaussianSplatContract.h"
 
 layout(local_size_x = kProjectWorkgroupSize) in;
@@ -31,6 +32,14 @@ layout(std430, set = 0, binding = kStageAShapeBinding) readonly buffer ShapeBloc
 };
 layout(std430, set = 0, binding = kStageAShBinding) readonly buffer ShBlock {
     uint sh[];
+};
+// The same bindings read in wider loads where the layout is aligned for them: a warp's
+// scalar loads at a 40- or 96-byte stride touch 32 sectors per instruction.
+layout(std430, set = 0, binding = kStageAShBinding) readonly buffer ShBlock4 {
+    uvec4 sh4[];
+};
+layout(std430, set = 0, binding = kStageAShapeBinding) readonly buffer ShapeBlock2 {
+    uvec2 shape2[];
 };
 layout(std430, set = 0, binding = kStageAVisibilityBinding) readonly buffer VisibilityBlock {
     uint visibility[];
@@ -69,9 +78,22 @@ float HalfAt(uint base, uint k, bool from_sh) {
 }
 
 // Shape value k (0-2 scale, 3-6 rotation wxyz, 7-9 f_dc) of splat i.
+// The exact shape words of the splat being projected, loaded by LoadShape in five uvec2
+// loads (its 40-byte records are 8-byte aligned).
+float g_shape[kShapeWordsExact];
+
+void LoadShape(uint i) {
+    if (kPrecision == kPrecisionCompact) return;
+    [[unroll]] for (uint q = 0u; q < kShapeWordsExact / 2u; ++q) {
+        uvec2 w = shape2[i * (kShapeWordsExact / 2u) + q];
+        g_shape[2u * q] = uintBitsToFloat(w.x);
+        g_shape[2u * q + 1u] = uintBitsToFloat(w.y);
+    }
+}
+
 float ShapeValue(uint i, uint k) {
     if (kPrecision == kPrecisionCompact) return HalfAt(i * kShapeWordsCompact, k, false);
-    return uintBitsToFloat(shape[i * kShapeWordsExact + k]);
+    return g_shape[k];
 }
 
 // SH rest coefficient j (1-based basis index), channel c of splat i; layout [Nc, 3].
@@ -98,8 +120,18 @@ mat3 CovarianceFactor(vec3 s, vec4 q) {
 }
 
 // `relative`: the camera-relative position (never 0: the splat passed the near plane).
+// f_rest words of the evaluated degree; the fast path below needs whole uvec4s of them.
+const uint kShWords = 3u * ((kShDegree + 1u) * (kShDegree + 1u) - 1u);
+const uint kShVec4s = kShWords / 4u;
+// A product, not an && chain: glslang 11 turns && of spec constants into a phi that the
+// OpSpecConstantOp then names before it exists (invalid SPIR-V; spirv-val rejects it).
+const uint kShVec4Layout = uint(kPrecision == kPrecisionExact) * uint(kShWords % 4u == 0u) *
+                           uint(kShWords > 0u);
+
 vec3 ShColor(uint i, vec3 relative) {
     vec3 dc = vec3(ShapeValue(i, 7u), ShapeValue(i, 8u), ShapeValue(i, 9u));
+    bool vec4_path = kShVec4Layout != 0u;
+    if (view.scene.w != kShWords) vec4_path = false;  // packed at another degree
     vec3 rgb = kSH_C0 * dc;
     if (kShDegree >= 1u) {
         vec3 d = normalize(relative);
@@ -127,8 +159,23 @@ vec3 ShColor(uint i, vec3 relative) {
             }
         }
         uint num_basis = (kShDegree + 1u) * (kShDegree + 1u);
-        for (uint j = 1u; j < num_basis; ++j) {
-            rgb += basis[j] * vec3(ShValue(i, j, 0u), ShValue(i, j, 1u), ShValue(i, j, 2u));
+        if (vec4_path) {
+            float words[48];  // f_rest words of degree 3, rounded up to uvec4s
+            [[unroll]] for (uint q = 0u; q < kShVec4s; ++q) {
+                uvec4 w = sh4[i * kShVec4s + q];
+                words[4u * q] = uintBitsToFloat(w.x);
+                words[4u * q + 1u] = uintBitsToFloat(w.y);
+                words[4u * q + 2u] = uintBitsToFloat(w.z);
+                words[4u * q + 3u] = uintBitsToFloat(w.w);
+            }
+            [[unroll]] for (uint j = 1u; j < num_basis; ++j) {
+                uint k = (j - 1u) * 3u;
+                rgb += basis[j] * vec3(words[k], words[k + 1u], words[k + 2u]);
+            }
+        } else {
+            for (uint j = 1u; j < num_basis; ++j) {
+                rgb += basis[j] * vec3(ShValue(i, j, 0u), ShValue(i, j, 1u), ShValue(i, j, 2u));
+            }
         }
     }
     return max(vec3(0.0), 0.5 + rgb);
@@ -143,7 +190,7 @@ uint TileBound(float v, uint tiles) {
 }
 
 // Returns true (and writes the record) when splat i is visible.
-bool Project(uint i, out float depth) {
+bool Project(uint i, out float depth, out uint entries) {
     depth = 0.0;
     if ((visibility[i >> 5u] & (1u << (i & 31u))) == 0u) return false;
     vec4 position_opacity = positions[i];
@@ -159,6 +206,7 @@ bool Project(uint i, out float depth) {
     // value the CPU reference computes bit for bit (SortDepth).
     float sort_depth = SortDepth(r2.x, r2.y, r2.z, rel.x, rel.y, rel.z);
     if (!(sort_depth > view.clip.z)) return false;  // near plane (also NaN)
+    LoadShape(i);
     vec3 v = vec3(dot(view.world_to_camera_row0.xyz, rel), dot(view.world_to_camera_row1.xyz, rel),
                   sort_depth);
     float fx = view.intrinsics.x, fy = view.intrinsics.y;
@@ -229,13 +277,16 @@ bool Project(uint i, out float depth) {
     projected[i] = out_splat;
     tile_counts[i] = num_tiles;
     depth = sort_depth;
+    entries = num_tiles;
     return true;
 }
 
 void main() {
     uint i = gl_GlobalInvocationID.x;
     float depth = 0.0;
-    bool visible = i < view.scene.x && Project(i, depth);
+    uint entries = 0u;
+    bool visible = i < view.scene.x && Project(i, depth, entries);
+    uint value = PackListValue(i, entries, view.scene.x);
 
     // One atomicAdd per subgroup reserves the slots of all its visible splats.
     uint flag = visible ? 1u : 0u;
@@ -250,11 +301,11 @@ void main() {
         // Slot i = splat i; hidden or culled splats get the largest key and sort last.
         if (i < view.scene.x) {
             depth_keys[i] = visible ? floatBitsToUint(depth) : 0xFFFFFFFFu;
-            splat_indices[i] = i;
+            splat_indices[i] = value;
         }
     } else if (visible) {
         // depth > near plane > 0, so the float bits order like the depths.
         depth_keys[base + rank] = floatBitsToUint(depth);
-        splat_indices[base + rank] = i;
+        splat_indices[base + rank] = value;
     }
 }

@@ -45,7 +45,11 @@ uint LoadCount(uint index) {
     // The exact order scans all N slots; past the visible ones the list holds stale slots
     // (the depth sort dropped the culled splats), which count nothing.
     if (index >= counters.visible_count) return 0u;
-    uint count = tile_counts[splat_indices[index]];
+    uint value = splat_indices[index];
+    uint count = ListValueCount(value, view.scene.x);
+    if (count == ListCountSentinel(view.scene.x)) {
+        count = tile_counts[ListValueSplat(value, view.scene.x)];
+    }
     if (count > view.limits.y) {  // over max_tiles_per_splat: the splat emits nothing
         atomicOr(counters.error_flags, kErrorEntriesDropped);
         return 0u;

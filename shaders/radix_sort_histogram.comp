@@ -2,6 +2,7 @@
 // Pass 1 of a digit: per-block digit counts, stored digit-major so that one exclusive scan
 // per digit row (radix_sort_scan.comp) gives every block its output offset within a digit.
 #extension GL_GOOGLE_include_directive : require
+#extension GL_EXT_control_flow_attributes : require
 #include "radix_sort_common.glsl"
 
 layout(local_size_x = kRadixSortWorkgroupSize) in;
@@ -26,11 +27,19 @@ void main() {
     uint count = params.count;
     uint block_size = params.block_size;
     uint block_begin = gl_WorkGroupID.x * block_size;
-    for (uint i = local; i < block_size; i += kRadixSortWorkgroupSize) {
-        uint index = block_begin + i;
-        if (index >= count) continue;
-        uint key = keys_in[index];
-        if (IsKept(key)) atomicAdd(s_counts[DigitOf(key)], 1u);
+    uint chunks = block_size / kRadixSortWorkgroupSize;  // uniform, 1..8
+    // All loads first, so that they are in flight together (one load, then its atomic, per
+    // step took 20-37 us per pass of the grid's sorts on the H200).
+    uint keys[kRadixSortItemsPerInvocation];
+    [[unroll]] for (uint k = 0u; k < kRadixSortItemsPerInvocation; ++k) {
+        uint index = block_begin + local + k * kRadixSortWorkgroupSize;
+        keys[k] = k < chunks && index < count ? keys_in[index] : 0u;
+    }
+    [[unroll]] for (uint k = 0u; k < kRadixSortItemsPerInvocation; ++k) {
+        uint index = block_begin + local + k * kRadixSortWorkgroupSize;
+        if (k < chunks && index < count && IsKept(keys[k])) {
+            atomicAdd(s_counts[DigitOf(keys[k])], 1u);
+        }
     }
     barrier();
     histogram[kRadixSortBins + local * params.num_blocks + gl_WorkGroupID.x] = s_counts[local];

@@ -7,6 +7,7 @@
 #include "VulkanTestFixture.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/Buffer.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/ComputePipeline.h"
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/RadixSort.h"
 #include "shaders/GaussianSplatContract.h"
 #include "vulkan_test_shaders/TestShaders.h"
 
@@ -23,6 +24,39 @@ TEST(GaussianSplatContract, CompilesAsCpp) {
               shader::kRadixSortWorkgroupSize * shader::kRadixSortItemsPerInvocation);
     EXPECT_EQ(sizeof(shader::RadixSortParams), 32u);
     EXPECT_EQ(sizeof(shader::RadixSortPushConstants), 32u);
+}
+
+TEST(GaussianSplatContract, ListValuesCarryTheSplatAndItsEntryCount) {
+    // The depth sort's values: splat index below ListIndexBits(N), the entry count above it
+    // or the sentinel (the scan then gathers tile_counts; the Stress 1080p and 8K cases fail
+    // without that fallback). At the sort's largest N at least 5 count bits remain.
+    static_assert(RadixSort::kMaxCount < (1u << 27));
+    for (uint32_t n : {1u, 2u, 3u, 255u, 256u, 257u, 31000u, 6125000u, 1u << 24, (1u << 24) + 1u,
+                       RadixSort::kMaxCount}) {
+        SCOPED_TRACE(n);
+        const uint32_t index_bits = shader::ListIndexBits(n);
+        EXPECT_GE(index_bits, 1u);
+        EXPECT_LT(uint64_t(n - 1), uint64_t(1) << index_bits);  // every index fits
+        if (n > 2) {
+            EXPECT_GE(uint64_t(n - 1), uint64_t(1) << (index_bits - 1));  // and no more bits
+        }
+        const uint32_t count_bits = shader::ListCountBits(n);
+        EXPECT_GE(count_bits, 5u);
+        EXPECT_LE(count_bits, shader::kListCountMaxBits);
+        EXPECT_LE(index_bits + count_bits, 32u);
+        const uint32_t sentinel = shader::ListCountSentinel(n);
+        EXPECT_EQ(sentinel, (1u << count_bits) - 1u);
+        for (uint32_t splat : {0u, n / 2, n - 1}) {
+            for (uint32_t count : {0u, 1u, sentinel - 1u, sentinel, sentinel + 1u, 1u << 20}) {
+                const uint32_t value = shader::PackListValue(splat, count, n);
+                EXPECT_EQ(shader::ListValueSplat(value, n), splat);
+                EXPECT_EQ(shader::ListValueCount(value, n), count < sentinel ? count : sentinel);
+            }
+        }
+    }
+    EXPECT_EQ(shader::ListIndexBits(6125000u), 23u);  // the grid: 8-bit counts, sentinel 255
+    EXPECT_EQ(shader::ListCountSentinel(6125000u), 255u);
+    EXPECT_EQ(shader::ListCountBits(RadixSort::kMaxCount), 5u);
 }
 
 using GaussianSplatContractGpu = VulkanTest;

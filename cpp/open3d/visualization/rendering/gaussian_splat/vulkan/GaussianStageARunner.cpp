@@ -130,6 +130,10 @@ StageAReadback GaussianStageARunner::Run(const camera::PinholeCamera& camera,
         }
     });
     FinishCopies(pending);
+    // The list's values carry entry counts above the splat index (shader::PackListValue).
+    for (uint32_t& value : out.visible_in_depth_order) {
+        value = shader::ListValueSplat(value, resources_.Layout().num_splats);
+    }
     return out;
 }
 
