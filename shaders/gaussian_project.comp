@@ -123,8 +123,8 @@ mat3 CovarianceFactor(vec3 s, vec4 q) {
 // f_rest words of the evaluated degree; the fast path below needs whole uvec4s of them.
 const uint kShWords = 3u * ((kShDegree + 1u) * (kShDegree + 1u) - 1u);
 const uint kShVec4s = kShWords / 4u;
-// A product, not an && chain: glslang 11 turns && of spec constants into a phi that the
-// OpSpecConstantOp then names before it exists (invalid SPIR-V; spirv-val rejects it).
+// A product, not an && chain: glslang 12 (Debian 12) turns && of spec constants into a phi
+// that the OpSpecConstantOp then names before it exists (invalid SPIR-V, docs/vulkan.md).
 const uint kShVec4Layout = uint(kPrecision == kPrecisionExact) * uint(kShWords % 4u == 0u) *
                            uint(kShWords > 0u);
 
