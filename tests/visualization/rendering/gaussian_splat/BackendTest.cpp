@@ -3,6 +3,9 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <cmath>
+#include <memory>
+#include <string>
 
 #include "open3d/core/Exception.h"
 #include "open3d/core/Logging.h"
@@ -37,6 +40,34 @@ TEST(GaussianSplatBackend, CompositeBeforeGeometryThrows) {
     EXPECT_THROW(CreateGaussianSplatBackend("cpu")->RenderGeometryStage(GetDefaultSceneCamera(),
                                                                         RenderConfig{}),
                  core::Open3DError);
+}
+
+TEST(GaussianSplatBackend, NearPlaneMustBePositiveAndFinite) {
+    // A negative near plane would keep splats behind the camera (projected mirrored), NaN
+    // would cull everything: both are errors on every registered backend, not images.
+    for (const std::string& name : GetGaussianSplatBackendNames()) {
+        SCOPED_TRACE(name);
+        std::unique_ptr<GaussianSplatBackend> backend;
+        try {
+            backend = CreateGaussianSplatBackend(name);
+        } catch (const core::Open3DError&) {
+            continue;  // e.g. "vulkan" without a device; its suite covers it with one
+        }
+        backend->SetScene(CreateDefaultGaussianSplatScene());
+        for (double near : {-1.0, 0.0, std::nan(""), HUGE_VAL}) {
+            RenderConfig config;
+            config.near_plane = near;
+            try {
+                backend->RenderGeometryStage(GetDefaultSceneCamera(), config);
+                FAIL() << "near_plane " << near << " was accepted";
+            } catch (const core::Open3DError& e) {
+                EXPECT_NE(std::string(e.what()).find("near_plane"), std::string::npos) << e.what();
+            }
+        }
+        RenderConfig ok;
+        ok.near_plane = 1e-3;
+        EXPECT_NO_THROW(backend->RenderGeometryStage(GetDefaultSceneCamera(), ok));
+    }
 }
 
 TEST(GaussianSplatBackend, PlaceholderLogsOnceAndDrawsNothing) {

@@ -14,6 +14,7 @@ void PlaceholderBackend::SetScene(const t::geometry::PointCloud& cloud) {
 void PlaceholderBackend::RenderGeometryStage(const camera::PinholeCamera& camera,
                                              const RenderConfig& config) {
     camera.Validate();
+    config.Validate();
     if (!logged_) {
         core::LogWarning(
             "Gaussian splat placeholder backend: {} splats are not drawn (no real backend)",

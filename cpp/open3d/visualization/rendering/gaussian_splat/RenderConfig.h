@@ -46,6 +46,11 @@ struct RenderConfig {
     /// GPU backends skip Stage A when the scene, the camera and this config are unchanged
     /// since the last frame; benchmarks turn it off to time the whole pipeline every frame.
     bool reuse_geometry = true;
+
+    /// Throws core::Open3DError for a near plane that is not a positive finite number (a
+    /// negative one would keep splats behind the camera, mirrored, and NaN would cull
+    /// every splat). Every backend calls it before Stage A.
+    void Validate() const;
 };
 
 /// Bits of RenderStats::error_flags (the same bits the GPU backends read back).

@@ -196,6 +196,21 @@ TEST_F(VulkanBackend, EntryCapacityStopsAtTheSortLimit) {
                  core::Open3DError);
 }
 
+TEST_F(VulkanBackend, RejectsANearPlaneThatIsNotPositive) {
+    // As the CPU backend (BackendTest.cpp): the depth sort orders float bits, which a
+    // negative depth kept by a negative near plane would put after every positive one.
+    auto backend = MakeBackend();
+    backend->SetScene(CreateDefaultGaussianSplatScene());
+    for (double near : {-0.5, 0.0, std::nan("")}) {
+        RenderConfig config;
+        config.near_plane = near;
+        EXPECT_THROW(backend->RenderGeometryStage(GetDefaultSceneCamera(), config),
+                     core::Open3DError)
+            << near;
+    }
+    EXPECT_EQ(backend->GetCounters().geometry_runs, 0);
+}
+
 TEST_F(VulkanBackend, EmptyViewIsBackgroundOnly) {
     auto backend = MakeBackend();
     backend->SetScene(CreateDefaultGaussianSplatScene());

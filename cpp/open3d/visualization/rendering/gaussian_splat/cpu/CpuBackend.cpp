@@ -29,6 +29,7 @@ void CpuBackend::ReleaseResources() {
 void CpuBackend::RenderGeometryStage(const camera::PinholeCamera& camera,
                                      const RenderConfig& config) {
     if (!cloud_) core::ThrowError("cpu backend: RenderGeometryStage called before SetScene");
+    config.Validate();
     const auto start = std::chrono::steady_clock::now();
     projected_ = ProjectSplats(*cloud_, camera, config);
     tile_lists_ =

@@ -153,6 +153,7 @@ void GaussianSplatVulkanBackend::RenderGeometryStage(const camera::PinholeCamera
                                                      const RenderConfig& config) {
     if (!cloud_) core::ThrowError("Vulkan backend: RenderGeometryStage before SetScene");
     camera.Validate();
+    config.Validate();
     const auto start = std::chrono::steady_clock::now();
     const SplatPrecision precision =
         config.compact_storage ? SplatPrecision::kCompact : SplatPrecision::kExact;
