@@ -71,29 +71,24 @@ void main() {
                                                 view.clip.z, view.clip.w)
                            : 0.0;
     uint tile_bits = view.limits.w;
-    uint out_index = begin;
-    if (end - begin == (max_x - min_x) * (max_y - min_y)) {
-        // The projection kept every tile of the rectangle (a row's span is at most its
-        // width): no span to recompute, and the record's centre and conic, the other half
-        // of its 64 bytes, are not read. The grid's splats mostly cover one or two tiles.
-        for (uint ty = min_y; ty < max_y; ++ty) {
-            for (uint tx = min_x; tx < max_x; ++tx) {
-                uint tile = ty * tiles_x + tx;
-                entry_keys[out_index] = kEmitMode == kEmitPackedKeys
-                                                ? PackedSortKey(tile, norm_depth, tile_bits)
-                                                : tile;
-                entry_values[out_index] = splat;
-                ++out_index;
-            }
-        }
-        return;
+    // When the count equals the rectangle's area the projection kept every tile of it (a
+    // row's span is at most its width): every row is whole, no span is recomputed and the
+    // record's centre and conic, the other half of its 64 bytes, are not read. The grid's
+    // splats mostly cover one or two tiles.
+    bool whole_rect = end - begin == (max_x - min_x) * (max_y - min_y);
+    vec4 cdo = vec4(0.0);
+    vec4 conic = vec4(0.0);
+    float det_q = 0.0;
+    if (!whole_rect) {
+        cdo = projected[splat].center_depth_opacity;
+        conic = projected[splat].conic;
+        det_q = projected[splat].color.w;
     }
-    vec4 cdo = projected[splat].center_depth_opacity;
-    vec4 conic = projected[splat].conic;
-    float det_q = projected[splat].color.w;
+    uint out_index = begin;
     for (uint ty = min_y; ty < max_y && out_index < end; ++ty) {
-        uint span = TileRowSpan(cdo.x, cdo.y, conic.x, conic.y, conic.z, det_q, conic.w, ty,
-                                min_x, max_x);
+        uint span = whole_rect ? min_x | (max_x << 16u)
+                               : TileRowSpan(cdo.x, cdo.y, conic.x, conic.y, conic.z, det_q,
+                                             conic.w, ty, min_x, max_x);
         uint last = min(span >> 16u, (span & 0xFFFFu) + (end - out_index));
         for (uint tx = span & 0xFFFFu; tx < last; ++tx) {
             uint tile = ty * tiles_x + tx;

@@ -77,7 +77,6 @@ float HalfAt(uint base, uint k, bool from_sh) {
     return (k & 1u) == 0u ? pair.x : pair.y;
 }
 
-// Shape value k (0-2 scale, 3-6 rotation wxyz, 7-9 f_dc) of splat i.
 // The exact shape words of the splat being projected, loaded by LoadShape in five uvec2
 // loads (its 40-byte records are 8-byte aligned).
 float g_shape[kShapeWordsExact];
@@ -91,6 +90,7 @@ void LoadShape(uint i) {
     }
 }
 
+// Shape value k (0-2 scale, 3-6 rotation wxyz, 7-9 f_dc) of splat i.
 float ShapeValue(uint i, uint k) {
     if (kPrecision == kPrecisionCompact) return HalfAt(i * kShapeWordsCompact, k, false);
     return g_shape[k];
@@ -119,7 +119,6 @@ mat3 CovarianceFactor(vec3 s, vec4 q) {
     return r * mat3(s.x, 0.0, 0.0, 0.0, s.y, 0.0, 0.0, 0.0, s.z);
 }
 
-// `relative`: the camera-relative position (never 0: the splat passed the near plane).
 // f_rest words of the evaluated degree; the fast path below needs whole uvec4s of them.
 const uint kShWords = 3u * ((kShDegree + 1u) * (kShDegree + 1u) - 1u);
 const uint kShVec4s = kShWords / 4u;
@@ -128,6 +127,7 @@ const uint kShVec4s = kShWords / 4u;
 const uint kShVec4Layout = uint(kPrecision == kPrecisionExact) * uint(kShWords % 4u == 0u) *
                            uint(kShWords > 0u);
 
+// `relative`: the camera-relative position (never 0: the splat passed the near plane).
 vec3 ShColor(uint i, vec3 relative) {
     vec3 dc = vec3(ShapeValue(i, 7u), ShapeValue(i, 8u), ShapeValue(i, 9u));
     bool vec4_path = kShVec4Layout != 0u;

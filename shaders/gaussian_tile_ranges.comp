@@ -42,7 +42,7 @@ void main() {
         [[unroll]] for (uint k = 0u; k < kRangeItems; ++k) {
             uint i = first + k * stride;
             keys[k] = i < count ? entry_keys[i] : 0xFFFFFFFFu;
-            before[k] = i > 0u && i <= count ? entry_keys[i - 1u] : 0xFFFFFFFFu;
+            before[k] = i > 0u && i < count ? entry_keys[i - 1u] : 0xFFFFFFFFu;
             after[k] = i + 1u < count ? entry_keys[i + 1u] : 0xFFFFFFFFu;
         }
         [[unroll]] for (uint k = 0u; k < kRangeItems; ++k) {

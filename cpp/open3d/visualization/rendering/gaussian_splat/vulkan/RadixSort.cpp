@@ -104,6 +104,17 @@ RadixSortStorageRequirements RadixSort::GetStorageRequirements(uint32_t max_coun
     return requirements;
 }
 
+namespace {
+
+// A uint the GPU reads from any 4-byte aligned offset (see the binding in Record).
+void RequireCountRange(const BufferRange& range, const char* name) {
+    if (range.buffer == VK_NULL_HANDLE || range.offset % 4 != 0) {
+        core::ThrowError("RadixSort: {} needs a buffer and a 4-byte aligned offset", name);
+    }
+}
+
+}  // namespace
+
 void RadixSort::CheckArguments(const BufferRange& keys, const BufferRange& values,
                                const RadixSortScratch& scratch, const BufferRange& count,
                                uint32_t max_count, uint32_t num_bits) const {
@@ -137,9 +148,7 @@ void RadixSort::CheckArguments(const BufferRange& keys, const BufferRange& value
                              check.name, check.range.size, check.bytes, max_count);
         }
     }
-    if (count.buffer == VK_NULL_HANDLE || count.offset % 4 != 0) {
-        core::ThrowError("RadixSort: count needs a buffer and a 4-byte aligned offset");
-    }
+    RequireCountRange(count, "count");
 }
 
 uint32_t RadixSort::GetTargetBlocks() const {
@@ -154,9 +163,7 @@ void RadixSort::Record(VkCommandBuffer cmd, const BufferRange& keys, const Buffe
                        uint32_t max_count, uint32_t num_bits, Params params,
                        const DropMaxKeys* drop) const {
     CheckArguments(keys, values, scratch, count, max_count, num_bits);
-    if (drop && (drop->kept_count.buffer == VK_NULL_HANDLE || drop->kept_count.offset % 4 != 0)) {
-        core::ThrowError("RadixSort: kept_count needs a buffer and a 4-byte aligned offset");
-    }
+    if (drop) RequireCountRange(drop->kept_count, "kept_count");
     const uint32_t num_passes = GetNumPasses(num_bits);
     if (num_passes == 0) return;  // no key bits: every order is sorted
 
@@ -222,20 +229,11 @@ void RadixSort::Record(VkCommandBuffer cmd, const BufferRange& keys, const Buffe
         vkCmdDispatch(cmd, 1, 1, 1);
         barrier();
     };
-    // After a first pass that dropped keys, the kept pairs are packed at the front of the
-    // scratch: the later passes (and the copy of an odd pass count) sort only them.
-    const auto setup_kept = [&]() {
-        count_in = drop->kept_count;
-        push.count_index = count_index(count_in);
-        push.drop_max_keys = 0;
-        setup();
-    };
     if (params == Params::kSetupPass) setup();
 
     if (max_count == 0) return;  // params now say count 0; nothing to move
 
     for (uint32_t pass = 0; pass < num_passes; ++pass) {
-        if (pass == 1 && drop) setup_kept();
         // Ping-pong: even passes read the caller's buffers, odd passes the scratch.
         if (pass % 2 == 0) {
             bind(keys, values, scratch.keys_alt, scratch.values_alt);
@@ -256,8 +254,15 @@ void RadixSort::Record(VkCommandBuffer cmd, const BufferRange& keys, const Buffe
         vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, scatter_.Get());
         vkCmdDispatchIndirect(cmd, params_buffer, params_offset);
         if (pass + 1 < num_passes || num_passes % 2 == 1) barrier();
+        if (pass == 0 && drop) {
+            // The kept pairs are packed at the front of the scratch: the later passes (and
+            // the copy of an odd pass count) sort only them.
+            count_in = drop->kept_count;
+            push.count_index = count_index(count_in);
+            push.drop_max_keys = 0;
+            setup();
+        }
     }
-    if (num_passes == 1 && drop) setup_kept();
     if (num_passes % 2 == 1) {
         bind(scratch.keys_alt, scratch.values_alt, keys, values);
         vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, copy_.Get());
