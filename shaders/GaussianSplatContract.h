@@ -73,6 +73,8 @@ OPEN3D_SHADER_CONST uint kRadixSortKeysOutBinding = 4u;    // uint[max_count]
 OPEN3D_SHADER_CONST uint kRadixSortValuesOutBinding = 5u;  // uint[max_count]
 OPEN3D_SHADER_CONST uint kRadixSortHistogramBinding = 6u;  // uint[bins + bins * max_blocks]
 OPEN3D_SHADER_CONST uint kRadixSortNumBindings = 7u;
+// Most passes one sort records: 32-bit keys.
+OPEN3D_SHADER_CONST uint kRadixSortMaxPasses = 4u;
 
 // Written on the GPU by radix_sort_setup.comp from the element count; the first three
 // members are a VkDispatchIndirectCommand for the per-block passes.
@@ -84,7 +86,23 @@ struct RadixSortParams {
     uint num_blocks;  // == dispatch_x, row stride of the histogram table
     uint flags;       // kErrorCountsClamped when the producer's count exceeded max_count
     uint block_size;  // elements per block: kRadixSortWorkgroupSize * (1..16)
-    uint reserved1;
+    // Subtracted from every key before its digits are taken; a multiple of kRadixSortBins,
+    // so the first pass's digit is the key's own. Non-zero only with a key range.
+    uint key_base;
+    // With PassCount::kFromKeyRange: the kept keys' smallest and largest key, found by the
+    // first pass's histogram (atomics from ~0u and 0), and from the setup after the first
+    // pass the passes their span needs (1..recorded) and indirect dispatch sizes (x, y, z)
+    // per pass of the histogram and scatter (pass_blocks) and of the row scan (pass_rows),
+    // zero groups for the passes past range_passes, and of the copy that brings an odd
+    // number of passes back to the caller's buffers (copy_blocks). Without it: range
+    // passes 0, every pass's sizes as if it runs, copy_blocks zero groups.
+    uint key_min;
+    uint key_max;
+    uint range_passes;
+    uint reserved0;
+    uvec4 pass_blocks[kRadixSortMaxPasses];
+    uvec4 pass_rows[kRadixSortMaxPasses];
+    uvec4 copy_blocks;
 };
 
 // Push constants of every radix-sort pipeline.
@@ -95,8 +113,10 @@ struct RadixSortPushConstants {
     uint max_count;      // capacity of the key/value buffers
     uint target_blocks;  // 1..kRadixSortTargetBlocks: block count the setup aims at
     uint drop_max_keys;  // 1: this pass leaves out pairs with key kRadixSortDroppedKey
-    uint reserved1;
-    uint reserved2;
+    // 1: PassCount::kFromKeyRange (the first pass's histogram finds the kept keys' range,
+    // the setup after it decides the passes)
+    uint key_range;
+    uint num_passes;  // passes recorded: ceil(num_bits / 8)
 };
 
 // ---- Sort-key layout of the seed's packed (tile, depth) key, a measured option ----
@@ -116,7 +136,7 @@ static_assert(kRadixSortBlockSize == kRadixSortWorkgroupSize * kRadixSortItemsPe
 static_assert(kRadixSortWorkgroupSize % kRadixSortMaxSubgroups == 0);
 static_assert(kErrorEntriesDropped == 1u && kErrorCountsClamped == 2u);
 
-static_assert(sizeof(RadixSortParams) == 32);
+static_assert(sizeof(RadixSortParams) == 192);
 static_assert(offsetof(RadixSortParams, dispatch_x) == 0);
 static_assert(offsetof(RadixSortParams, dispatch_y) == 4);
 static_assert(offsetof(RadixSortParams, dispatch_z) == 8);
@@ -124,7 +144,13 @@ static_assert(offsetof(RadixSortParams, count) == 12);
 static_assert(offsetof(RadixSortParams, num_blocks) == 16);
 static_assert(offsetof(RadixSortParams, flags) == 20);
 static_assert(offsetof(RadixSortParams, block_size) == 24);
-static_assert(offsetof(RadixSortParams, reserved1) == 28);
+static_assert(offsetof(RadixSortParams, key_base) == 28);
+static_assert(offsetof(RadixSortParams, key_min) == 32);
+static_assert(offsetof(RadixSortParams, key_max) == 36);
+static_assert(offsetof(RadixSortParams, range_passes) == 40);
+static_assert(offsetof(RadixSortParams, pass_blocks) == 48);
+static_assert(offsetof(RadixSortParams, pass_rows) == 112);
+static_assert(offsetof(RadixSortParams, copy_blocks) == 176);
 
 static_assert(sizeof(RadixSortPushConstants) == 32);
 static_assert(offsetof(RadixSortPushConstants, target_blocks) == 16);
@@ -299,10 +325,10 @@ struct GaussianDispatchArgsPushConstants {
 
 // Push constants of gaussian_scan.comp.
 struct GaussianScanPushConstants {
-    uint level;        // index into GaussianStageACounters::scan_levels
-    uint base;         // uint offset of this level's data in the scan buffer
-    uint sums_base;    // offset of the next level's data (block sums / scanned block sums)
-    uint add_pass;     // 0: scan blocks and write block sums; 1: add scanned block sums
+    uint level;      // index into GaussianStageACounters::scan_levels
+    uint base;       // uint offset of this level's data in the scan buffer
+    uint sums_base;  // offset of the next level's data (block sums / scanned block sums)
+    uint reserved3;
     uint write_total;  // 1 on the top level: its block sum is the grand total
     uint reserved0;
     uint reserved1;
@@ -529,7 +555,16 @@ OPEN3D_SHADER_FUNC RadixSortParams RadixSortParamsFor(uint count, uint max_count
     p.dispatch_y = 1u;
     p.dispatch_z = 1u;
     p.count = count;
-    p.reserved1 = 0u;
+    p.key_base = 0u;
+    p.key_min = 0xFFFFFFFFu;
+    p.key_max = 0u;
+    p.range_passes = 0u;
+    p.reserved0 = 0u;
+    for (uint pass = 0u; pass < kRadixSortMaxPasses; ++pass) {
+        p.pass_blocks[pass] = uvec4(p.num_blocks, 1u, 1u, 0u);
+        p.pass_rows[pass] = uvec4(kRadixSortBins, 1u, 1u, 0u);
+    }
+    p.copy_blocks = uvec4(0u, 1u, 1u, 0u);
     return p;
 }
 #undef OPEN3D_SHADER_FUNC

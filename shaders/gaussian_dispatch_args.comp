@@ -24,6 +24,7 @@ layout(std430, set = 0, binding = kStageACountersBinding) buffer CountersBlock {
 layout(std430, set = 0, binding = kStageAScanBinding) readonly buffer ScanBlock {
     uint scan[];
 };
+#include "gaussian_scan_offset.glsl"
 layout(std430, set = 0, binding = kStageASortParamsBinding) writeonly buffer SortParamsBlock {
     RadixSortParams sort_params;
 };
@@ -44,7 +45,7 @@ void SizeScanAndEmit() {
 
 // Inclusive offset of sorted visible splat k: the next exclusive offset, or the total.
 uint InclusiveOffset(uint k, uint visible, uint total) {
-    return k + 1u < visible ? scan[k + 1u] : total;
+    return k + 1u < visible ? ScanOffset(k + 1u) : total;
 }
 
 void CountFittingEntries() {
@@ -64,7 +65,7 @@ void CountFittingEntries() {
             lo = mid + 1u;
         }
     }
-    uint entries = lo < visible ? scan[lo] : total;
+    uint entries = lo < visible ? ScanOffset(lo) : total;
     counters.entry_count = entries;
     uint flags = 0u;
     if (entries < total) flags |= kErrorEntriesDropped;

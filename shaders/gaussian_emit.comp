@@ -31,6 +31,7 @@ layout(std430, set = 0, binding = kStageASplatIndexBinding) readonly buffer Spla
 layout(std430, set = 0, binding = kStageAScanBinding) readonly buffer ScanBlock {
     uint scan[];
 };
+#include "gaussian_scan_offset.glsl"
 layout(std430, set = 0, binding = kStageAEntryKeysBinding) buffer EntryKeysBlock {
     uint entry_keys[];
 };
@@ -57,8 +58,8 @@ void main() {
     uint k = gl_GlobalInvocationID.x;
     uint visible = counters.visible_count;
     if (k >= visible) return;
-    uint begin = scan[k];
-    uint end = k + 1u < visible ? scan[k + 1u] : counters.requested_entries;
+    uint begin = ScanOffset(k);
+    uint end = k + 1u < visible ? ScanOffset(k + 1u) : counters.requested_entries;
     if (end > view.limits.x || end == begin) return;
     uint splat = ListValueSplat(splat_indices[k], view.scene.x);
     uvec4 tiles = projected[splat].tiles;

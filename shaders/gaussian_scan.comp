@@ -1,8 +1,8 @@
 #version 460
 // Stage A, exclusive prefix sum of the per-splat tile counts in depth order, one level of
-// a block hierarchy (kScanBlockSize counts per workgroup). Scan passes write exclusive
-// offsets in place and each block's total one level up; add passes add the scanned block
-// totals back down. Additions saturate at kScanSaturation (the total of a frame can pass
+// a block hierarchy (kScanBlockSize counts per workgroup): exclusive offsets within the
+// block in place and the block's total one level up. There is no down-sweep: readers add
+// the levels above (ScanOffset in gaussian_scan_offset.glsl). Additions saturate at kScanSaturation (the total of a frame can pass
 // 2^32), and the workgroup scan runs in shared memory by local index, so the result does
 // not depend on the subgroup size or shape. Level 0 with kScanGather reads its counts
 // from the depth-sorted visible list (splats over max_tiles_per_splat count 0 and flag;
@@ -34,11 +34,9 @@ layout(std430, set = 0, binding = kStageAScanBinding) buffer ScanBlock {
     uint scan[];
 };
 
-shared uint s_sums[kScanWorkgroupSize];
+#include "gaussian_scan_offset.glsl"
 
-uint SatAdd(uint a, uint b) {
-    return min(min(a, kScanSaturation) + min(b, kScanSaturation), kScanSaturation);
-}
+shared uint s_sums[kScanWorkgroupSize];
 
 uint LoadCount(uint index) {
     if (kGather == 0u) return scan[pc.base + index];
@@ -92,20 +90,6 @@ void ScanBlockPass(uint count) {
     }
 }
 
-void AddBlockPass(uint count) {
-    uint block_offset = scan[pc.sums_base + gl_WorkGroupID.x];
-    uint first = gl_WorkGroupID.x * kScanBlockSize;
-    for (uint k = 0u; k < kScanItemsPerInvocation; ++k) {
-        uint index = first + k * kScanWorkgroupSize + gl_LocalInvocationIndex;
-        if (index < count) scan[pc.base + index] = SatAdd(scan[pc.base + index], block_offset);
-    }
-}
-
 void main() {
-    uint count = counters.scan_levels[pc.level].count;
-    if (pc.add_pass != 0u) {
-        AddBlockPass(count);
-    } else {
-        ScanBlockPass(count);
-    }
+    ScanBlockPass(counters.scan_levels[pc.level].count);
 }

@@ -13,8 +13,11 @@ layout(push_constant, std430) uniform PushConstantsBlock {
     RadixSortPushConstants pc;
 };
 
+// RadixSortParams::key_base of this sort; the histogram and scatter set it from params.
+uint g_key_base = 0u;
+
 uint DigitOf(uint key) {
-    return (key >> pc.shift) & ((1u << pc.digit_bits) - 1u);
+    return ((key - g_key_base) >> pc.shift) & ((1u << pc.digit_bits) - 1u);
 }
 
 // Whether a pair in the input takes part in this pass: all of them but the dropped keys of

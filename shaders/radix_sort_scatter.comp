@@ -68,6 +68,7 @@ uint HalfOf(uint word, uint digit) {
 }
 
 void main() {
+    g_key_base = params.key_base;
     InitScanSlot();
     uint local = gl_LocalInvocationIndex;
     uint count = params.count;

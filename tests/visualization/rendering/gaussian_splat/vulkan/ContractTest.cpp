@@ -22,7 +22,7 @@ TEST(GaussianSplatContract, CompilesAsCpp) {
     // Reaching this line means every static_assert in the header held.
     EXPECT_EQ(shader::kRadixSortBlockSize,
               shader::kRadixSortWorkgroupSize * shader::kRadixSortItemsPerInvocation);
-    EXPECT_EQ(sizeof(shader::RadixSortParams), 32u);
+    EXPECT_EQ(sizeof(shader::RadixSortParams), 192u);
     EXPECT_EQ(sizeof(shader::RadixSortPushConstants), 32u);
 }
 
@@ -77,6 +77,9 @@ TEST_F(GaussianSplatContractGpu, ShaderLayoutMatchesCpp) {
     push.count_index = 203;
     push.max_count = 204;
     push.target_blocks = 205;
+    push.drop_max_keys = 206;
+    push.key_range = 207;
+    push.num_passes = 208;
     SubmitAndWait(Context(), Pool(), [&](VkCommandBuffer cmd) {
         VkDescriptorBufferInfo infos[2] = {{params.Get(), 0, VK_WHOLE_SIZE},
                                            {push_out.Get(), 0, VK_WHOLE_SIZE}};
@@ -106,7 +109,20 @@ TEST_F(GaussianSplatContractGpu, ShaderLayoutMatchesCpp) {
     EXPECT_EQ(p.num_blocks, 105u);
     EXPECT_EQ(p.flags, 106u);
     EXPECT_EQ(p.block_size, 107u);
-    EXPECT_EQ(p.reserved1, 108u);
+    EXPECT_EQ(p.key_base, 108u);
+    EXPECT_EQ(p.key_min, 114u);
+    EXPECT_EQ(p.key_max, 115u);
+    EXPECT_EQ(p.range_passes, 109u);
+    for (uint32_t pass = 0; pass < shader::kRadixSortMaxPasses; ++pass) {
+        SCOPED_TRACE(pass);
+        const uint32_t step = 10 * pass;
+        EXPECT_EQ(p.pass_blocks[pass].x, 110u + step);
+        EXPECT_EQ(p.pass_blocks[pass].w, 113u + step);
+        EXPECT_EQ(p.pass_rows[pass].x, 150u + step);
+        EXPECT_EQ(p.pass_rows[pass].z, 152u + step);
+    }
+    EXPECT_EQ(p.copy_blocks.x, 190u);
+    EXPECT_EQ(p.copy_blocks.w, 193u);
     shader::RadixSortPushConstants q;
     std::memcpy(&q, push_out.GetMapped(), sizeof(q));
     EXPECT_EQ(q.shift, 201u);
@@ -114,6 +130,9 @@ TEST_F(GaussianSplatContractGpu, ShaderLayoutMatchesCpp) {
     EXPECT_EQ(q.count_index, 203u);
     EXPECT_EQ(q.max_count, 204u);
     EXPECT_EQ(q.target_blocks, 205u);
+    EXPECT_EQ(q.drop_max_keys, 206u);
+    EXPECT_EQ(q.key_range, 207u);
+    EXPECT_EQ(q.num_passes, 208u);
 }
 
 }  // namespace

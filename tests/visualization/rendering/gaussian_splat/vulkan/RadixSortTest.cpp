@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cstring>
 #include <numeric>
@@ -108,7 +109,8 @@ protected:
     GpuSortResult Sort(const std::vector<uint32_t>& keys, const std::vector<uint32_t>& values,
                        uint32_t gpu_count, uint32_t num_bits,
                        RadixSort::Params source = RadixSort::Params::kSetupPass,
-                       const uint32_t* kept_count = nullptr) {
+                       const uint32_t* kept_count = nullptr,
+                       RadixSort::PassCount pass_count = RadixSort::PassCount::kAll) {
         const auto capacity = static_cast<uint32_t>(keys.size());
         const VkDeviceSize bytes = std::max<VkDeviceSize>(capacity, 1) * 4;
         const VkBufferUsageFlags usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT |
@@ -168,7 +170,7 @@ protected:
         const RadixSort::DropMaxKeys drop{count_buffer.Range(44, 4)};
         sort_->Record(c, key_buffer.Range(), value_buffer.Range(), scratch,
                       count_buffer.Range(20, 4), capacity, num_bits, source,
-                      kept_count ? &drop : nullptr);
+                      kept_count ? &drop : nullptr, pass_count);
         RecordMemoryBarrier(c, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
                             VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, VK_PIPELINE_STAGE_2_TRANSFER_BIT,
                             VK_ACCESS_2_TRANSFER_READ_BIT);
@@ -380,6 +382,86 @@ TEST_F(RadixSortTest, DropMaxKeysSortsOnlyTheKeptPairs) {
         }
         for (uint32_t i = c.count; i < c.count + 37; ++i) {
             ASSERT_EQ(gpu.values[i], 0xDEAD0000u + (i - c.count)) << "pair " << i << " moved";
+        }
+    }
+}
+
+TEST_F(RadixSortTest, KeyRangeSkipsThePassesItsSpanDoesNotNeed) {
+    // Stage A's depth sort: the first pass finds the kept keys' (min, max), the sort orders
+    // by key - base (base = min with its low byte cleared) and runs only the passes that
+    // span needs; the others get zero workgroups, and an odd count is copied back. Cases:
+    // spans of one to four digits, spans that cross a digit boundary of the keys
+    // themselves (the top digits of min and max differ, so without the base the skipped
+    // pass would have been needed), one key value, no kept key, 24-bit keys (three passes
+    // recorded), with and without a drop, setup and producer-written params.
+    struct RangeCase {
+        uint32_t count;
+        uint32_t num_bits;
+        uint32_t key_min;  // keys are drawn from [key_min, key_max], both ends included
+        uint32_t key_max;
+        double drop_fraction;
+        RadixSort::Params source;
+        uint32_t want_passes;  // counted by hand from the span
+    };
+    using P = RadixSort::Params;
+    const RangeCase cases[] = {
+        // Depths 5.17..19.66 as float bits (the grid at 1080p): span 0xF7F167 < 2^24.
+        {70000, 32, 0x40A54F00u, 0x419D4067u, 0.17, P::kWrittenByProducer, 3},
+        {70000, 32, 0x40A54F00u, 0x419D4067u, 0.0, P::kSetupPass, 3},
+        // Span 0x10FF from base 0x40FFFF00: two passes although min and max differ in
+        // their top two digits.
+        {20000, 32, 0x40FFFFF0u, 0x41000FFFu, 0.3, P::kWrittenByProducer, 2},
+        {20000, 32, 0x12345600u, 0x123456FFu, 0.0, P::kSetupPass, 1},  // one digit
+        {20000, 32, 0x12345678u, 0x12345678u, 0.2, P::kSetupPass, 1},  // one key value
+        {20000, 32, 0x00000000u, 0xFFFFFFFEu, 0.2, P::kSetupPass, 4},  // the whole range
+        {20000, 32, 0x01000000u, 0x02000000u, 0.0, P::kSetupPass, 4},  // just past 2^24
+        {20000, 32, 0x01000000u, 0x01FFFFFFu, 0.0, P::kSetupPass, 3},  // just below
+        {20000, 24, 0x00100000u, 0x0010FFFFu, 0.1, P::kSetupPass, 2},  // 3 recorded
+        {20000, 24, 0x00000100u, 0x00FFFFFFu, 0.1, P::kSetupPass, 3},
+        {5000, 32, 0x00000100u, 0x00FFFFFFu, 1.0, P::kSetupPass, 1},  // nothing kept
+    };
+    for (const RangeCase& c : cases) {
+        SCOPED_TRACE(testing::Message() << c.count << " pairs, " << c.num_bits << " bits, ["
+                                        << std::hex << c.key_min << ", " << c.key_max << "]");
+        std::mt19937 rng(c.count + c.key_min);
+        std::uniform_real_distribution<double> uniform(0.0, 1.0);
+        std::vector<uint32_t> keys(c.count), values(c.count);
+        const uint64_t span = uint64_t(c.key_max) - c.key_min;
+        const bool drop = c.drop_fraction > 0.0;
+        for (uint32_t i = 0; i < c.count; ++i) {
+            // Ties from the i % 7 term; both ends kept unless everything is dropped.
+            keys[i] =
+                static_cast<uint32_t>(c.key_min + (uint64_t(rng()) * 977u + i % 7u) % (span + 1));
+            if (i == 1) keys[i] = c.key_min;
+            if (i == 2) keys[i] = c.key_max;
+            const bool end = (i == 1 || i == 2) && c.drop_fraction < 1.0;
+            if (drop && !end && uniform(rng) < c.drop_fraction) {
+                keys[i] = shader::kRadixSortDroppedKey;
+            }
+            values[i] = i;
+        }
+        std::vector<uint32_t> want_keys, want_values;
+        for (uint32_t i = 0; i < c.count; ++i) {
+            if (drop && keys[i] == shader::kRadixSortDroppedKey) continue;
+            want_keys.push_back(keys[i]);
+            want_values.push_back(values[i]);
+        }
+        ReferenceSort(want_keys, want_values, c.num_bits);
+        const auto kept = static_cast<uint32_t>(want_keys.size());
+        GpuSortResult gpu = Sort(keys, values, c.count, c.num_bits, c.source,
+                                 drop ? &kept : nullptr, RadixSort::PassCount::kFromKeyRange);
+        EXPECT_EQ(gpu.params.count, kept);
+        EXPECT_EQ(gpu.params.range_passes, c.want_passes);
+        if (kept > 0) {
+            EXPECT_EQ(gpu.params.key_min, c.key_min);
+            EXPECT_EQ(gpu.params.key_max, c.key_max);
+            EXPECT_EQ(gpu.params.key_base, c.key_min & ~0xFFu);
+        } else {
+            EXPECT_GT(gpu.params.key_min, gpu.params.key_max);  // the empty range
+        }
+        for (uint32_t i = 0; i < kept; ++i) {
+            ASSERT_EQ(gpu.keys[i], want_keys[i]) << "key " << i << " of " << kept;
+            ASSERT_EQ(gpu.values[i], want_values[i]) << "value " << i << " of " << kept;
         }
     }
 }

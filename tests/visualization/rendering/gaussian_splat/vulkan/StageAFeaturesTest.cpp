@@ -18,6 +18,7 @@
 #include "open3d/visualization/rendering/gaussian_splat/DefaultScene.h"
 #include "open3d/visualization/rendering/gaussian_splat/GaussianSplatDataPacking.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/GaussianStageARunner.h"
+#include "shaders/GaussianSplatContract.h"
 #include "visualization/rendering/gaussian_splat/cpu/SplatTestScene.h"
 #include "visualization/rendering/gaussian_splat/vulkan/VulkanTestFixture.h"
 
@@ -224,6 +225,47 @@ TEST_F(StageAFeatures, CapacityOverflowDropsEntriesFlagsAndWarnsOnce) {
         EXPECT_EQ(GpuLists(gpu, grid), PrefixRuleLists(gpu, ref, grid, config, 1u << 16));
     }
     core::SetLogSink(previous);
+}
+
+TEST_F(StageAFeatures, CapacityCutsTheListWhereTheScanSaysAcrossScanLevels) {
+    // 31,000 list slots are 31 scan blocks under one top level: the offsets that decide
+    // where the capacity cuts the list (and where each splat writes) add the block sums
+    // (ScanOffset). Expected: the uncut run's lists, keeping the splats that fit whole
+    // front to back, up to the first that does not.
+    OPEN3D_REQUIRE_DATA("playbot/playbot_31k.ply");
+    OPEN3D_REQUIRE_DATA("playbot/cameras.json");
+    const auto cloud = ReadScene("playbot/playbot_31k.ply");
+    const auto cam =
+        camera::ReadCamerasJson(DataPath("playbot/cameras.json")).at(0).camera.Resized(128, 96);
+    const auto grid = cpu::TileGrid::ForImage(cam.width, cam.height);
+    const PackedGaussianSplats packed = PackGaussianSplatAttrs(cloud);
+    GaussianStageARunner uncut_runner(Context(), packed, 1u << 20);
+    const StageAReadback uncut = uncut_runner.Run(cam, RenderConfig{});
+    ASSERT_EQ(uncut.counters.error_flags, 0u);
+    ASSERT_GT(uncut.visible_in_depth_order.size(), 2u * shader::kScanBlockSize);
+    std::vector<uint32_t> entries_of(cloud.NumPoints(), 0);
+    for (uint32_t splat : uncut.entry_splats) ++entries_of.at(splat);
+    const uint32_t capacity = uncut.counters.entry_count / 2;
+    std::vector<bool> kept(entries_of.size(), false);
+    uint32_t total = 0;
+    size_t cut = 0;  // list position of the first splat that does not fit
+    for (; cut < uncut.visible_in_depth_order.size(); ++cut) {
+        const uint32_t splat = uncut.visible_in_depth_order[cut];
+        if (total + entries_of[splat] > capacity) break;
+        total += entries_of[splat];
+        kept[splat] = true;
+    }
+    ASSERT_GT(cut, 2u * shader::kScanBlockSize) << "the cut must lie past the first blocks";
+    std::vector<std::vector<uint32_t>> want = GpuLists(uncut, grid);
+    for (auto& tile : want) {
+        std::erase_if(tile, [&](uint32_t splat) { return !kept[splat]; });
+    }
+    GaussianStageARunner cut_runner(Context(), packed, capacity);
+    const StageAReadback gpu = cut_runner.Run(cam, RenderConfig{});
+    EXPECT_EQ(gpu.counters.error_flags, kEntriesDropped | kCountsClamped);
+    EXPECT_EQ(gpu.counters.requested_entries, uncut.counters.entry_count);
+    EXPECT_EQ(gpu.counters.entry_count, total);
+    EXPECT_EQ(GpuLists(gpu, grid), want);
 }
 
 TEST_F(StageAFeatures, NothingVisible) {

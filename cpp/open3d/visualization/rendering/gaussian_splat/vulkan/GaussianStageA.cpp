@@ -240,7 +240,9 @@ void GaussianStageA::Record(VkCommandBuffer cmd, const StageASceneBuffers& scene
     // depth key puts the visible splats first, front to back, ties in index order. Its first
     // pass drops the ~0u keys and the other three sort the visible_count kept ones
     // (RadixSort::DropMaxKeys; a visible splat's depth is positive, never ~0u); slots past
-    // visible_count are stale afterwards, which the scan and the emit never read.
+    // visible_count are stale afterwards, which the scan and the emit never read. Of those
+    // three, only the ones the visible depth keys' span needs run (PassCount::kFromKeyRange):
+    // two when the farthest visible splat is less than 2-4 times as far as the nearest.
     // The packed key, like the seed, keeps the projection's append order: its one entry
     // sort decides the depth order, and measuring its error means not helping it here.
     const auto begin = [&](TimedPass pass) {
@@ -254,34 +256,30 @@ void GaussianStageA::Record(VkCommandBuffer cmd, const StageASceneBuffers& scene
         const RadixSort::DropMaxKeys drop_culled{counter_range(kCounterVisibleIndex)};
         sort_.Record(cmd, buffers.depth_keys, buffers.splat_indices, buffers.sort_scratch,
                      counter_range(kCounterNumSplatsIndex), std::max(n, 1u), 32,
-                     RadixSort::Params::kWrittenByProducer, &drop_culled);
+                     RadixSort::Params::kWrittenByProducer, &drop_culled,
+                     RadixSort::PassCount::kFromKeyRange);
         ComputeBarrier(cmd);
         end(TimedPass::kDepthSort);
     }
     begin(TimedPass::kScanEmit);
 
-    // 4. Exclusive scan of the tile counts in depth order, up the block levels and down.
+    // 4. Exclusive scan of the tile counts in depth order, up the block levels (readers add
+    // the levels above a slot themselves: ScanOffset in gaussian_scan_offset.glsl).
     PushBindings(cmd, scene, buffers);  // the sorts bound their own layout
     GaussianScanPushConstants scan{};
-    const auto scan_level = [&](uint32_t level, bool add) {
+    for (uint32_t level = 0; level < need.num_scan_levels; ++level) {
+        vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE,
+                          level == 0 ? scan_gather_.Get() : scan_.Get());
         scan.level = level;
         scan.base = need.scan_level_base[level];
         scan.sums_base = level + 1 < need.num_scan_levels ? need.scan_level_base[level + 1] : 0u;
-        scan.add_pass = add ? 1u : 0u;
-        scan.write_total = !add && level + 1 == need.num_scan_levels ? 1u : 0u;
+        scan.write_total = level + 1 == need.num_scan_levels ? 1u : 0u;
         vkCmdPushConstants(cmd, layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(scan), &scan);
         vkCmdDispatchIndirect(cmd, counters,
                               counters_offset + offsetof(GaussianStageACounters, scan_levels) +
                                   level * sizeof(GaussianScanLevel));
         ComputeBarrier(cmd);
-    };
-    for (uint32_t level = 0; level < need.num_scan_levels; ++level) {
-        vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE,
-                          level == 0 ? scan_gather_.Get() : scan_.Get());
-        scan_level(level, false);
     }
-    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, scan_.Get());
-    for (uint32_t level = need.num_scan_levels - 1; level-- > 0;) scan_level(level, true);
 
     // 5. How many entries fit (whole splats, front to back) -> entry_count, error flags.
     args.mode = kDispatchArgsAfterScan;

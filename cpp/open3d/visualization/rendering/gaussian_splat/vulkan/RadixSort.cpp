@@ -161,11 +161,13 @@ uint32_t RadixSort::GetTargetBlocks() const {
 void RadixSort::Record(VkCommandBuffer cmd, const BufferRange& keys, const BufferRange& values,
                        const RadixSortScratch& scratch, const BufferRange& count,
                        uint32_t max_count, uint32_t num_bits, Params params,
-                       const DropMaxKeys* drop) const {
+                       const DropMaxKeys* drop, PassCount pass_count) const {
     CheckArguments(keys, values, scratch, count, max_count, num_bits);
     if (drop) RequireCountRange(drop->kept_count, "kept_count");
     const uint32_t num_passes = GetNumPasses(num_bits);
     if (num_passes == 0) return;  // no key bits: every order is sorted
+    // A range can only save passes after the first.
+    const bool by_range = pass_count == PassCount::kFromKeyRange && num_passes > 1;
 
     // The count may sit at any 4-byte offset: bind from the aligned offset below it and
     // index the uint with a push constant.
@@ -181,6 +183,7 @@ void RadixSort::Record(VkCommandBuffer cmd, const BufferRange& keys, const Buffe
     push.count_index = count_index(count);
     push.max_count = max_count;
     push.target_blocks = GetTargetBlocks();
+    push.num_passes = num_passes;
 
     const VkPipelineLayout layout = pipeline_layout_.Get();
     const auto bind = [&](const BufferRange& keys_in, const BufferRange& values_in,
@@ -230,9 +233,18 @@ void RadixSort::Record(VkCommandBuffer cmd, const BufferRange& keys, const Buffe
         barrier();
     };
     if (params == Params::kSetupPass) setup();
+    // From here the first pass's histogram finds the kept keys' range and the setup after
+    // it reads the range (the setup above must not: the range is not known yet).
+    push.key_range = by_range ? 1u : 0u;
 
     if (max_count == 0) return;  // params now say count 0; nothing to move
 
+    // With a range, the passes after the first and the copy take their sizes from the
+    // setup after the first pass (zero groups for the passes it skips); else they all run.
+    const bool copies = by_range || num_passes % 2 == 1;
+    const auto pass_args = [&](VkDeviceSize member, uint32_t pass) {
+        return by_range && pass > 0 ? params_offset + member + pass * sizeof(uvec4) : params_offset;
+    };
     for (uint32_t pass = 0; pass < num_passes; ++pass) {
         // Ping-pong: even passes read the caller's buffers, odd passes the scratch.
         if (pass % 2 == 0) {
@@ -244,29 +256,38 @@ void RadixSort::Record(VkCommandBuffer cmd, const BufferRange& keys, const Buffe
         push.digit_bits = std::min(kRadixSortDigitBits, num_bits - push.shift);
         push.drop_max_keys = pass == 0 && drop ? 1u : 0u;
         push_constants();
+        const VkDeviceSize blocks = pass_args(offsetof(RadixSortParams, pass_blocks), pass);
         vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, histogram_.Get());
-        vkCmdDispatchIndirect(cmd, params_buffer, params_offset);
+        vkCmdDispatchIndirect(cmd, params_buffer, blocks);
         barrier();
         // One workgroup per digit; rows of digits above digit_bits are all zero.
         vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, scan_.Get());
-        vkCmdDispatch(cmd, kRadixSortBins, 1, 1);
+        if (by_range && pass > 0) {
+            vkCmdDispatchIndirect(cmd, params_buffer,
+                                  pass_args(offsetof(RadixSortParams, pass_rows), pass));
+        } else {
+            vkCmdDispatch(cmd, kRadixSortBins, 1, 1);
+        }
         barrier();
         vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, scatter_.Get());
-        vkCmdDispatchIndirect(cmd, params_buffer, params_offset);
-        if (pass + 1 < num_passes || num_passes % 2 == 1) barrier();
-        if (pass == 0 && drop) {
+        vkCmdDispatchIndirect(cmd, params_buffer, blocks);
+        if (pass + 1 < num_passes || copies) barrier();
+        if (pass == 0 && (drop || by_range)) {
             // The kept pairs are packed at the front of the scratch: the later passes (and
-            // the copy of an odd pass count) sort only them.
-            count_in = drop->kept_count;
+            // the copy of an odd pass count) sort only them. The range decides which of
+            // the later passes run.
+            if (drop) count_in = drop->kept_count;
             push.count_index = count_index(count_in);
             push.drop_max_keys = 0;
             setup();
         }
     }
-    if (num_passes % 2 == 1) {
+    if (copies) {
         bind(scratch.keys_alt, scratch.values_alt, keys, values);
         vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, copy_.Get());
-        vkCmdDispatchIndirect(cmd, params_buffer, params_offset);
+        vkCmdDispatchIndirect(
+            cmd, params_buffer,
+            by_range ? params_offset + offsetof(RadixSortParams, copy_blocks) : params_offset);
     }
 }
 

@@ -74,7 +74,8 @@ public:
         kSetupPass,  ///< the sort's own setup dispatch, from the GPU count at `count`
         /// The producer already wrote RadixSortParamsFor(count, max_count, GetTargetBlocks())
         /// (from a shader, or from the host with vkCmdUpdateBuffer) and made it visible to
-        /// COMPUTE_SHADER and DRAW_INDIRECT reads: one dispatch fewer. `count` is not read.
+        /// COMPUTE_SHADER and DRAW_INDIRECT reads: one dispatch fewer. `count` is not read
+        /// (but by the setup after the first pass of kFromKeyRange without a DropMaxKeys).
         kWrittenByProducer,
     };
 
@@ -87,6 +88,20 @@ public:
     /// three of the depth sort's four passes see only the visible ones.
     struct DropMaxKeys {
         BufferRange kept_count;  // uint written on the GPU; 4-byte alignment is enough
+    };
+
+    /// How many passes run. kFromKeyRange: the first pass's histogram also finds the
+    /// smallest and largest kept key (one atomic pair per block), the pairs are sorted by
+    /// key - base, base = that minimum rounded down to a multiple of 256 (the same order),
+    /// and only the passes up to the highest non-zero digit of max - base run: a setup
+    /// dispatch after the first pass gives the others zero workgroups and copies an odd
+    /// number of passes back to `keys` and `values`. `scratch.params` then has key_min,
+    /// key_max and range_passes. Stage A's depth keys (float bits) of a frame whose
+    /// farthest visible splat is less than 2 to 4 times as far as the nearest span less
+    /// than 2^24: three passes instead of four.
+    enum class PassCount {
+        kAll,  ///< ceil(num_bits / 8)
+        kFromKeyRange,
     };
 
     /// Records a stable sort of the first `count` pairs of (keys, values) by the low
@@ -104,7 +119,7 @@ public:
                 const RadixSortScratch& scratch,
                 const BufferRange& count,  // uint32 written on the GPU by the producer
                 uint32_t max_count, uint32_t num_bits, Params params = Params::kSetupPass,
-                const DropMaxKeys* drop = nullptr) const;
+                const DropMaxKeys* drop = nullptr, PassCount pass_count = PassCount::kAll) const;
 
 private:
     void CheckArguments(const BufferRange& keys, const BufferRange& values,

@@ -25,11 +25,22 @@ void main() {
     params_out.num_blocks = 105u;
     params_out.flags = 106u;
     params_out.block_size = 107u;
-    params_out.reserved1 = 108u;
+    params_out.key_base = 108u;
+    params_out.key_min = 114u;
+    params_out.key_max = 115u;
+    params_out.range_passes = 109u;
+    for (uint pass = 0u; pass < kRadixSortMaxPasses; ++pass) {
+        params_out.pass_blocks[pass] = uvec4(110u, 111u, 112u, 113u) + 10u * pass;
+        params_out.pass_rows[pass] = uvec4(150u, 151u, 152u, 153u) + 10u * pass;
+    }
+    params_out.copy_blocks = uvec4(190u, 191u, 192u, 193u);
     // Push constants read by member name, written back member by member.
     push_out.shift = pc.shift;
     push_out.digit_bits = pc.digit_bits;
     push_out.count_index = pc.count_index;
     push_out.max_count = pc.max_count;
     push_out.target_blocks = pc.target_blocks;
+    push_out.drop_max_keys = pc.drop_max_keys;
+    push_out.key_range = pc.key_range;
+    push_out.num_passes = pc.num_passes;
 }
