@@ -117,6 +117,11 @@ struct RadixSortPushConstants {
     // the setup after it decides the passes)
     uint key_range;
     uint num_passes;  // passes recorded: ceil(num_bits / 8)
+    // 1: RadixSort::Output::kValuesOnly (the last pass that runs and the copy write no keys)
+    uint values_only;
+    uint reserved0;
+    uint reserved1;
+    uint reserved2;
 };
 
 // ---- Sort-key layout of the seed's packed (tile, depth) key, a measured option ----
@@ -152,7 +157,7 @@ static_assert(offsetof(RadixSortParams, pass_blocks) == 48);
 static_assert(offsetof(RadixSortParams, pass_rows) == 112);
 static_assert(offsetof(RadixSortParams, copy_blocks) == 176);
 
-static_assert(sizeof(RadixSortPushConstants) == 32);
+static_assert(sizeof(RadixSortPushConstants) == 48);
 static_assert(offsetof(RadixSortPushConstants, target_blocks) == 16);
 static_assert(offsetof(RadixSortPushConstants, shift) == 0);
 static_assert(offsetof(RadixSortPushConstants, digit_bits) == 4);

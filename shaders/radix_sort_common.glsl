@@ -20,6 +20,12 @@ uint DigitOf(uint key) {
     return ((key - g_key_base) >> pc.shift) & ((1u << pc.digit_bits) - 1u);
 }
 
+// Whether this pass writes keys: all but the last pass that runs (`passes_run` of them) of
+// a values-only sort.
+bool WritesKeys(uint passes_run) {
+    return pc.values_only == 0u || pc.shift / kRadixSortDigitBits + 1u < passes_run;
+}
+
 // Whether a pair in the input takes part in this pass: all of them but the dropped keys of
 // a first pass with drop_max_keys (RadixSort::DropMaxKeys).
 bool IsKept(uint key) {

@@ -29,7 +29,7 @@ void main() {
     for (uint i = gl_LocalInvocationIndex; i < block_size; i += kRadixSortWorkgroupSize) {
         uint index = block_begin + i;
         if (index < count) {
-            keys_out[index] = keys_in[index];
+            if (pc.values_only == 0u) keys_out[index] = keys_in[index];
             values_out[index] = values_in[index];
         }
     }

@@ -75,6 +75,7 @@ void main() {
     uint num_blocks = params.num_blocks;
     uint block = gl_WorkGroupID.x;
     uint block_kept;  // pairs of this block the histogram counted (all but dropped keys)
+    bool write_keys = WritesKeys(params.range_passes != 0u ? params.range_passes : pc.num_passes);
 
     // The scan left the block's first output index within each digit; the block's count of
     // a digit is the next block's index minus its own (the digit's total after the last
@@ -154,7 +155,7 @@ void main() {
             s_keys[position] = keys[k];
             s_values[position] = values[k];
         } else {
-            keys_out[s_out_shift[digit] + position] = keys[k];
+            if (write_keys) keys_out[s_out_shift[digit] + position] = keys[k];
             values_out[s_out_shift[digit] + position] = values[k];
         }
     }
@@ -164,7 +165,7 @@ void main() {
     for (uint i = local; i < block_kept; i += kRadixSortWorkgroupSize) {
         uint key = s_keys[i];
         uint out_index = s_out_shift[DigitOf(key)] + i;
-        keys_out[out_index] = key;
+        if (write_keys) keys_out[out_index] = key;
         values_out[out_index] = s_values[i];
     }
 }

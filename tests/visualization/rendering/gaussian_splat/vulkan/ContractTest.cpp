@@ -23,7 +23,7 @@ TEST(GaussianSplatContract, CompilesAsCpp) {
     EXPECT_EQ(shader::kRadixSortBlockSize,
               shader::kRadixSortWorkgroupSize * shader::kRadixSortItemsPerInvocation);
     EXPECT_EQ(sizeof(shader::RadixSortParams), 192u);
-    EXPECT_EQ(sizeof(shader::RadixSortPushConstants), 32u);
+    EXPECT_EQ(sizeof(shader::RadixSortPushConstants), 48u);
 }
 
 TEST(GaussianSplatContract, ListValuesCarryTheSplatAndItsEntryCount) {
@@ -80,6 +80,7 @@ TEST_F(GaussianSplatContractGpu, ShaderLayoutMatchesCpp) {
     push.drop_max_keys = 206;
     push.key_range = 207;
     push.num_passes = 208;
+    push.values_only = 209;
     SubmitAndWait(Context(), Pool(), [&](VkCommandBuffer cmd) {
         VkDescriptorBufferInfo infos[2] = {{params.Get(), 0, VK_WHOLE_SIZE},
                                            {push_out.Get(), 0, VK_WHOLE_SIZE}};
@@ -133,6 +134,7 @@ TEST_F(GaussianSplatContractGpu, ShaderLayoutMatchesCpp) {
     EXPECT_EQ(q.drop_max_keys, 206u);
     EXPECT_EQ(q.key_range, 207u);
     EXPECT_EQ(q.num_passes, 208u);
+    EXPECT_EQ(q.values_only, 209u);
 }
 
 }  // namespace

@@ -110,7 +110,8 @@ protected:
                        uint32_t gpu_count, uint32_t num_bits,
                        RadixSort::Params source = RadixSort::Params::kSetupPass,
                        const uint32_t* kept_count = nullptr,
-                       RadixSort::PassCount pass_count = RadixSort::PassCount::kAll) {
+                       RadixSort::PassCount pass_count = RadixSort::PassCount::kAll,
+                       RadixSort::Output output = RadixSort::Output::kKeysAndValues) {
         const auto capacity = static_cast<uint32_t>(keys.size());
         const VkDeviceSize bytes = std::max<VkDeviceSize>(capacity, 1) * 4;
         const VkBufferUsageFlags usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT |
@@ -170,7 +171,7 @@ protected:
         const RadixSort::DropMaxKeys drop{count_buffer.Range(44, 4)};
         sort_->Record(c, key_buffer.Range(), value_buffer.Range(), scratch,
                       count_buffer.Range(20, 4), capacity, num_bits, source,
-                      kept_count ? &drop : nullptr, pass_count);
+                      kept_count ? &drop : nullptr, pass_count, output);
         RecordMemoryBarrier(c, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
                             VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, VK_PIPELINE_STAGE_2_TRANSFER_BIT,
                             VK_ACCESS_2_TRANSFER_READ_BIT);
@@ -463,6 +464,33 @@ TEST_F(RadixSortTest, KeyRangeSkipsThePassesItsSpanDoesNotNeed) {
             ASSERT_EQ(gpu.keys[i], want_keys[i]) << "key " << i << " of " << kept;
             ASSERT_EQ(gpu.values[i], want_values[i]) << "value " << i << " of " << kept;
         }
+        // As Stage A sorts: the values only. The keys are not checked: the last pass that
+        // runs does not write them.
+        GpuSortResult values_only =
+            Sort(keys, values, c.count, c.num_bits, c.source, drop ? &kept : nullptr,
+                 RadixSort::PassCount::kFromKeyRange, RadixSort::Output::kValuesOnly);
+        for (uint32_t i = 0; i < kept; ++i) {
+            ASSERT_EQ(values_only.values[i], want_values[i]) << "value " << i << " of " << kept;
+        }
+    }
+}
+
+TEST_F(RadixSortTest, ValuesOnlySortsTheValuesForEveryPassCount) {
+    // Without a key range: one to four passes recorded (the copy of an odd count included).
+    for (uint32_t num_bits : {8u, 13u, 24u, 32u}) {
+        SCOPED_TRACE(num_bits);
+        std::mt19937 rng(num_bits);
+        std::vector<uint32_t> keys(30000), values(30000);
+        for (uint32_t i = 0; i < keys.size(); ++i) {
+            keys[i] = rng() % 5000u * 858993u;  // ties, and digits above num_bits that are carried
+            values[i] = i;
+        }
+        std::vector<uint32_t> want_keys = keys, want_values = values;
+        ReferenceSort(want_keys, want_values, num_bits);
+        GpuSortResult gpu = Sort(keys, values, static_cast<uint32_t>(keys.size()), num_bits,
+                                 RadixSort::Params::kSetupPass, nullptr, RadixSort::PassCount::kAll,
+                                 RadixSort::Output::kValuesOnly);
+        ASSERT_EQ(gpu.values, want_values);
     }
 }
 

@@ -257,7 +257,7 @@ void GaussianStageA::Record(VkCommandBuffer cmd, const StageASceneBuffers& scene
         sort_.Record(cmd, buffers.depth_keys, buffers.splat_indices, buffers.sort_scratch,
                      counter_range(kCounterNumSplatsIndex), std::max(n, 1u), 32,
                      RadixSort::Params::kWrittenByProducer, &drop_culled,
-                     RadixSort::PassCount::kFromKeyRange);
+                     RadixSort::PassCount::kFromKeyRange, RadixSort::Output::kValuesOnly);
         ComputeBarrier(cmd);
         end(TimedPass::kDepthSort);
     }

@@ -161,7 +161,7 @@ uint32_t RadixSort::GetTargetBlocks() const {
 void RadixSort::Record(VkCommandBuffer cmd, const BufferRange& keys, const BufferRange& values,
                        const RadixSortScratch& scratch, const BufferRange& count,
                        uint32_t max_count, uint32_t num_bits, Params params,
-                       const DropMaxKeys* drop, PassCount pass_count) const {
+                       const DropMaxKeys* drop, PassCount pass_count, Output output) const {
     CheckArguments(keys, values, scratch, count, max_count, num_bits);
     if (drop) RequireCountRange(drop->kept_count, "kept_count");
     const uint32_t num_passes = GetNumPasses(num_bits);
@@ -184,6 +184,7 @@ void RadixSort::Record(VkCommandBuffer cmd, const BufferRange& keys, const Buffe
     push.max_count = max_count;
     push.target_blocks = GetTargetBlocks();
     push.num_passes = num_passes;
+    push.values_only = output == Output::kValuesOnly ? 1u : 0u;
 
     const VkPipelineLayout layout = pipeline_layout_.Get();
     const auto bind = [&](const BufferRange& keys_in, const BufferRange& values_in,

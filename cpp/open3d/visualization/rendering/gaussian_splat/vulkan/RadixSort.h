@@ -104,6 +104,14 @@ public:
         kFromKeyRange,
     };
 
+    /// What the caller reads afterwards. kValuesOnly: the keys are left unspecified, and
+    /// the last pass that runs and the copy write no keys (Stage A's depth sort reads only
+    /// the splat indices: 20 us of the grid's depth sort).
+    enum class Output {
+        kKeysAndValues,
+        kValuesOnly,
+    };
+
     /// Records a stable sort of the first `count` pairs of (keys, values) by the low
     /// `num_bits` (0..32) bits of the keys, count = min(the uint at `count`, max_count).
     /// The result is in `keys` and `values` (with `drop`: see DropMaxKeys).
@@ -119,7 +127,8 @@ public:
                 const RadixSortScratch& scratch,
                 const BufferRange& count,  // uint32 written on the GPU by the producer
                 uint32_t max_count, uint32_t num_bits, Params params = Params::kSetupPass,
-                const DropMaxKeys* drop = nullptr, PassCount pass_count = PassCount::kAll) const;
+                const DropMaxKeys* drop = nullptr, PassCount pass_count = PassCount::kAll,
+                Output output = Output::kKeysAndValues) const;
 
 private:
     void CheckArguments(const BufferRange& keys, const BufferRange& values,

@@ -43,4 +43,5 @@ void main() {
     push_out.drop_max_keys = pc.drop_max_keys;
     push_out.key_range = pc.key_range;
     push_out.num_passes = pc.num_passes;
+    push_out.values_only = pc.values_only;
 }
