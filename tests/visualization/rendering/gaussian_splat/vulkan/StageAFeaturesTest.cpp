@@ -51,6 +51,13 @@ t::geometry::PointCloud ReadScene(const std::string& relative) {
     return cloud;
 }
 
+// cameras.json view 0 of playbot at a small size (the caller requires the data).
+camera::PinholeCamera PlaybotView0(int width, int height) {
+    return camera::ReadCamerasJson(DataPath("playbot/cameras.json"))
+        .at(0)
+        .camera.Resized(width, height);
+}
+
 camera::PinholeCamera LookAtCloud(int width, int height) {
     camera::LookAtCamera look;
     look.eye = {0.0, 0.0, -3.0};
@@ -235,8 +242,7 @@ TEST_F(StageAFeatures, CapacityCutsTheListWhereTheScanSaysAcrossScanLevels) {
     OPEN3D_REQUIRE_DATA("playbot/playbot_31k.ply");
     OPEN3D_REQUIRE_DATA("playbot/cameras.json");
     const auto cloud = ReadScene("playbot/playbot_31k.ply");
-    const auto cam =
-        camera::ReadCamerasJson(DataPath("playbot/cameras.json")).at(0).camera.Resized(128, 96);
+    const auto cam = PlaybotView0(128, 96);
     const auto grid = cpu::TileGrid::ForImage(cam.width, cam.height);
     const PackedGaussianSplats packed = PackGaussianSplatAttrs(cloud);
     GaussianStageARunner uncut_runner(Context(), packed, 1u << 20);
@@ -283,8 +289,7 @@ TEST_F(StageAFeatures, CompactPrecisionStaysClose) {
     OPEN3D_REQUIRE_DATA("playbot/playbot_31k.ply");
     OPEN3D_REQUIRE_DATA("playbot/cameras.json");
     const auto cloud = ReadScene("playbot/playbot_31k.ply");
-    const auto cam =
-        camera::ReadCamerasJson(DataPath("playbot/cameras.json")).at(0).camera.Resized(128, 96);
+    const auto cam = PlaybotView0(128, 96);
     const PackedGaussianSplats compact = PackGaussianSplatAttrs(cloud, SplatPrecision::kCompact);
     EXPECT_LE(compact.BytesPerSplat(), 140u);
     GaussianStageARunner runner(Context(), compact, 1u << 18);
