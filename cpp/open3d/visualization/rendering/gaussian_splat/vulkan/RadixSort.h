@@ -2,11 +2,12 @@
 // caller allocates the scratch buffers from GetStorageRequirements and Record() only
 // records commands. The element count is read on the GPU from the producer's buffer.
 //
-// Algorithm (docs/vulkan.md): LSD, 8-bit digits, ceil(num_bits / 8) passes. Per pass:
+// Algorithm (docs/vulkan.md): LSD, 8-bit digits, ceil(num_bits / 8) passes (fewer with
+// PassCount::kFromKeyRange). Per pass:
 // histogram (per-block digit counts) -> scan (one workgroup per digit) -> scatter (stable
 // in-workgroup ranking from subgroup ballots), each per-block pass dispatched indirectly
-// with the block count a setup shader writes: blocks of 256..4096 elements, at most
-// kRadixSortTargetBlocks of them while 4096-element blocks are not needed. Stable for any subgroup
+// with the block count a setup shader writes: blocks of 256..2048 elements, at most
+// kRadixSortTargetBlocks of them while 2048-element blocks are not needed. Stable for any subgroup
 // size; keys bits at and above num_bits are carried but do not affect the order.
 #pragma once
 
@@ -105,8 +106,9 @@ public:
     };
 
     /// What the caller reads afterwards. kValuesOnly: the keys are left unspecified, and
-    /// the last pass that runs and the copy write no keys (Stage A's depth sort reads only
-    /// the splat indices: 20 us of the grid's depth sort).
+    /// the last pass that runs and the copy write no keys (but the first pass of a
+    /// kFromKeyRange sort, which runs before the range is known). Stage A's depth sort
+    /// reads only the splat indices: 34 us of the grid's depth sort on the H200.
     enum class Output {
         kKeysAndValues,
         kValuesOnly,
