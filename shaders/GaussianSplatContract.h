@@ -330,10 +330,10 @@ struct GaussianDispatchArgsPushConstants {
 
 // Push constants of gaussian_scan.comp.
 struct GaussianScanPushConstants {
-    uint level;      // index into GaussianStageACounters::scan_levels
-    uint base;       // uint offset of this level's data in the scan buffer
-    uint sums_base;  // offset of the next level's data (block sums / scanned block sums)
-    uint reserved3;
+    uint level;        // index into GaussianStageACounters::scan_levels
+    uint base;         // uint offset of this level's data in the scan buffer
+    uint sums_base;    // offset of the next level's data, where the block sums go
+    uint reserved3;    // was the down-sweep's add flag; kept so the offsets stay put
     uint write_total;  // 1 on the top level: its block sum is the grand total
     uint reserved0;
     uint reserved1;

@@ -2,9 +2,10 @@
 // Stage A, exclusive prefix sum of the per-splat tile counts in depth order, one level of
 // a block hierarchy (kScanBlockSize counts per workgroup): exclusive offsets within the
 // block in place and the block's total one level up. There is no down-sweep: readers add
-// the levels above (ScanOffset in gaussian_scan_offset.glsl). Additions saturate at kScanSaturation (the total of a frame can pass
-// 2^32), and the workgroup scan runs in shared memory by local index, so the result does
-// not depend on the subgroup size or shape. Level 0 with kScanGather reads its counts
+// the levels above (ScanOffset in gaussian_scan_offset.glsl). Additions saturate at
+// kScanSaturation (the total of a frame can pass 2^32), and the workgroup scan runs in
+// shared memory by local index, so the result does not depend on the subgroup size or
+// shape. Level 0 with kScanGather reads its counts
 // from the depth-sorted visible list (splats over max_tiles_per_splat count 0 and flag;
 // slots past visible_count, which the exact order also scans, count 0).
 #extension GL_GOOGLE_include_directive : require
