@@ -5,8 +5,9 @@
 //
 // One workgroup per 16x16 tile, one invocation per pixel, each 32 invocations an 8x4 pixel
 // block. A fixed grid of workgroups steals tiles from a global atomic counter until none is
-// left. A tile's entries are its range of the tile-sorted entries, found beforehand by
-// gaussian_tile_ranges.comp (depth order preserved inside a tile); its splats are loaded
+// left, each claiming its next tile while it composites the current one. A tile's entries
+// are its range of the tile-sorted entries, found beforehand by gaussian_tile_ranges.comp
+// (depth order preserved inside a tile); its splats are loaded
 // cooperatively into shared memory in batches of 256 and blended front to back with exactly
 // the 3DGS rules (docs/DESIGN.md section 3, cpu/Composite.cpp). Each pixel block visits only
 // the batch splats whose culling ellipse meets it (CompositeBlockMask), a
@@ -184,10 +185,127 @@ const uint kUnroll = 16u;
         }                                                                     \
     }
 
-void main() {
+// The entry range of a tile; past the last tile (a claim that found none left) empty.
+uvec2 TileRange(uint tile, uint num_tiles) {
+    return tile < num_tiles ? tile_ranges[tile] : uvec2(0u);
+}
+
+// The splat index of this invocation's entry in the first batch of `range`; 0 past its end.
+uint FirstIndex(uvec2 range, uint slot) {
+    return range.x + slot < range.y ? entry_values[range.x + slot] : 0u;
+}
+
+// Composites one tile from its entries [range.x, range.y). next_index is entry_values[range.x
+// + slot] (0 past the range), read by the caller one tile ahead; the same read for
+// `upcoming`, the range of the tile this workgroup takes next, is returned: it is issued after
+// the blending, when that range has long arrived, and is waited for only at the next tile's
+// first batch, so its latency overlaps this tile's stores and the next tile's set-up.
+uint CompositeTile(uint tile, uvec2 range, uint next_index, uvec2 upcoming, uint slot,
+                   uvec2 in_tile, uint block) {
     uint local = gl_LocalInvocationIndex;
     uvec2 size = pc.image.xy;
     uint tiles_x = pc.image.z;
+    uvec2 tile_origin = uvec2(tile % tiles_x, tile / tiles_x) * kCompositeTileSize;
+    ivec2 pixel = ivec2(tile_origin + in_tile);
+    bool inside = pixel.x < int(size.x) && pixel.y < int(size.y);
+    uint begin = range.x;
+    uint end = range.y;
+    if (local == 0u) s_done = 0u;
+    PixelState p;
+    p.position = vec2(pixel);
+    p.scene_z = uintBitsToFloat(0x7F800000u);
+    if (kSceneDepth != 0u && inside) p.scene_z = SceneViewDepth(pixel);
+    p.transmittance = 1.0;
+    p.color = vec3(0.0);
+    p.weighted_depth = 0.0;
+    p.weight = 0.0;
+    p.median_depth = 0.0;
+    p.median_found = false;
+    p.done = !inside;
+    // s_done reset before the increments below. main() relies on this barrier too: every
+    // invocation has read s_tile before it is written for the tile after the next.
+    barrier();
+    if (p.done) atomicAdd(s_done, 1u);
+
+    // The splat index of this invocation's next batch entry is read one batch ahead, so a
+    // batch load waits on one gather instead of two dependent ones: grid composite 1.583
+    // -> 1.566 ms (H100, 1080p). Reading the whole next record ahead held 12 more
+    // registers across the blend loop and measured slower (1.611 ms).
+    for (uint batch = begin; batch < end; batch += kCompositeBatchSize) {
+        barrier();  // the previous batch is consumed and its s_done increments made
+        // Early exit when every pixel of the tile is done. Uniform: s_done is read
+        // between two barriers, where no invocation changes it.
+        if (s_done == kCompositeWorkgroupSize) break;
+        uint entry = batch + slot;
+        uint mask = 0u;
+        if (entry < end) {
+            GaussianProjectedSplat splat = projected[next_index];
+            if (entry + kCompositeBatchSize < end) {
+                next_index = entry_values[entry + kCompositeBatchSize];
+            }
+            s_center_depth_opacity[slot] = splat.center_depth_opacity;
+            s_conic[slot] = splat.conic * vec4(-0.5 * kLog2E, -kLog2E, -0.5 * kLog2E,
+                                               -0.5 * kLog2E);
+            s_color[slot] = splat.color;
+            mask = CompositeBlockMask(splat.center_depth_opacity.x,
+                                      splat.center_depth_opacity.y, splat.conic.x,
+                                      splat.conic.y, splat.conic.z, splat.color.w,
+                                      splat.conic.w,
+                                      float(tile_origin.x), float(tile_origin.y));
+        }
+        // Each block's list of the slots whose bit is set, in slot (depth) order: a
+        // workgroup scan of the eight counters at once.
+        uvec4 spread = SpreadBlockBits(mask);
+        uvec4 inclusive = subgroupInclusiveAdd(spread);
+        if (gl_SubgroupInvocationID == subgroupMax(gl_SubgroupInvocationID)) {
+            s_subgroup_counts[gl_SubgroupID] = inclusive;
+        }
+        barrier();
+        uvec4 before = uvec4(0u);
+        uvec4 total = uvec4(0u);
+        for (uint s = 0u; s < gl_NumSubgroups; ++s) {
+            if (s == gl_SubgroupID) before = total;
+            total += s_subgroup_counts[s];
+        }
+        uvec4 position = before + inclusive - spread;
+        [[unroll]] for (uint k = 0u; k < kCompositeBlocks; ++k) {
+            if (((mask >> k) & 1u) != 0u) {
+                s_block_slots[k * kCompositeBatchSize + BlockCounter(position, k)] = slot;
+            }
+        }
+        barrier();
+        if (p.done) continue;
+        uint count = BlockCounter(total, block);
+        uint list = block * kCompositeBatchSize;
+        uint j = 0u;
+        // An alpha does not depend on the transmittance: a step's loads and exp2s overlap,
+        // and only its blending is a serial chain. Steps of 16, one of 8, then one by one.
+        for (; j + kUnroll <= count && !p.done; j += kUnroll) BLEND_STEP(kUnroll);
+        if (j + kUnroll / 2u <= count && !p.done) {
+            BLEND_STEP(kUnroll / 2u);
+            j += kUnroll / 2u;
+        }
+        for (; j < count && !p.done; ++j) BlendSplat(s_block_slots[list + j], p);
+        if (p.done) atomicAdd(s_done, 1u);  // once: done pixels skip later batches
+    }
+    uint upcoming_index = FirstIndex(upcoming, slot);
+
+    if (inside) {
+        float accumulated = 1.0 - p.transmittance;
+        imageStore(out_color, pixel,
+                   vec4(p.color + p.transmittance * pc.background.rgb, accumulated));
+        if (kExpectedDepth) {
+            imageStore(out_depth, pixel,
+                       vec4(p.weight > 0.0 ? p.weighted_depth / p.weight : 0.0));
+            imageStore(out_alpha, pixel, vec4(accumulated));
+        }
+        if (kMedianDepth) imageStore(out_median_depth, pixel, vec4(p.median_depth));
+    }
+    return upcoming_index;
+}
+
+void main() {
+    uint local = gl_LocalInvocationIndex;
     uint num_tiles = pc.image.z * pc.image.w;
     // Workgroup i starts with tile i, then steals tiles num_workgroups, num_workgroups + 1...
     // from the counter: with as many workgroups as tiles (CPU devices) each does one tile.
@@ -212,111 +330,31 @@ void main() {
     barrier();
     uint slot = subgroupExclusiveAdd(1u);
     for (uint s = 0u; s < gl_SubgroupID; ++s) slot += s_subgroup_counts[s].x;
+
+    // Tiles are claimed one ahead: while a workgroup composites a tile, the tile after it is
+    // already in s_tile and its range in flight, and the claim of the one after that is in
+    // flight too. Claiming, reading the range and then the first index between two tiles
+    // waited on three dependent global accesses per tile: 0.509 -> 0.482 ms composite for
+    // playbot_125k at 4K (32,400 tiles) on the H200, 1080p unchanged (0.173 ms),
+    // the grid 1.540 -> 1.553 ms (one run each).
+    uvec2 range = TileRange(tile, num_tiles);
+    uint next_index = FirstIndex(range, slot);
+    if (local == 0u) s_tile = gl_NumWorkGroups.x + atomicAdd(state.next_tile, 1u);
     barrier();
-
     while (tile < num_tiles) {  // uniform: tile comes from shared memory after a barrier
-        if (local == 0u) s_done = 0u;
-
-        uvec2 tile_origin = uvec2(tile % tiles_x, tile / tiles_x) * kCompositeTileSize;
-        ivec2 pixel = ivec2(tile_origin + in_tile);
-        bool inside = pixel.x < int(size.x) && pixel.y < int(size.y);
-        PixelState p;
-        p.position = vec2(pixel);
-        p.scene_z = uintBitsToFloat(0x7F800000u);
-        if (kSceneDepth != 0u && inside) p.scene_z = SceneViewDepth(pixel);
-        p.transmittance = 1.0;
-        p.color = vec3(0.0);
-        p.weighted_depth = 0.0;
-        p.weight = 0.0;
-        p.median_depth = 0.0;
-        p.median_found = false;
-        p.done = !inside;
-        barrier();  // s_done reset before the increments below
-        if (p.done) atomicAdd(s_done, 1u);
-        uvec2 range = tile_ranges[tile];
-        uint begin = range.x;
-        uint end = range.y;
-
-        // The splat index of this invocation's next batch entry is read one batch ahead, so a
-        // batch load waits on one gather instead of two dependent ones: grid composite 1.583
-        // -> 1.566 ms (H100, 1080p). Reading the whole next record ahead held 12 more
-        // registers across the blend loop and measured slower (1.611 ms).
-        uint next_index = begin + slot < end ? entry_values[begin + slot] : 0u;
-        for (uint batch = begin; batch < end; batch += kCompositeBatchSize) {
-            barrier();  // the previous batch is consumed and its s_done increments made
-            // Early exit when every pixel of the tile is done. Uniform: s_done is read
-            // between two barriers, where no invocation changes it.
-            if (s_done == kCompositeWorkgroupSize) break;
-            uint entry = batch + slot;
-            uint mask = 0u;
-            if (entry < end) {
-                GaussianProjectedSplat splat = projected[next_index];
-                if (entry + kCompositeBatchSize < end) {
-                    next_index = entry_values[entry + kCompositeBatchSize];
-                }
-                s_center_depth_opacity[slot] = splat.center_depth_opacity;
-                s_conic[slot] = splat.conic * vec4(-0.5 * kLog2E, -kLog2E, -0.5 * kLog2E,
-                                                   -0.5 * kLog2E);
-                s_color[slot] = splat.color;
-                mask = CompositeBlockMask(splat.center_depth_opacity.x,
-                                          splat.center_depth_opacity.y, splat.conic.x,
-                                          splat.conic.y, splat.conic.z, splat.color.w,
-                                          splat.conic.w,
-                                          float(tile_origin.x), float(tile_origin.y));
-            }
-            // Each block's list of the slots whose bit is set, in slot (depth) order: a
-            // workgroup scan of the eight counters at once.
-            uvec4 spread = SpreadBlockBits(mask);
-            uvec4 inclusive = subgroupInclusiveAdd(spread);
-            if (gl_SubgroupInvocationID == subgroupMax(gl_SubgroupInvocationID)) {
-                s_subgroup_counts[gl_SubgroupID] = inclusive;
-            }
-            barrier();
-            uvec4 before = uvec4(0u);
-            uvec4 total = uvec4(0u);
-            for (uint s = 0u; s < gl_NumSubgroups; ++s) {
-                if (s == gl_SubgroupID) before = total;
-                total += s_subgroup_counts[s];
-            }
-            uvec4 position = before + inclusive - spread;
-            [[unroll]] for (uint k = 0u; k < kCompositeBlocks; ++k) {
-                if (((mask >> k) & 1u) != 0u) {
-                    s_block_slots[k * kCompositeBatchSize + BlockCounter(position, k)] = slot;
-                }
-            }
-            barrier();
-            if (p.done) continue;
-            uint count = BlockCounter(total, block);
-            uint list = block * kCompositeBatchSize;
-            uint j = 0u;
-            // An alpha does not depend on the transmittance: a step's loads and exp2s overlap,
-            // and only its blending is a serial chain. Steps of 16, one of 8, then one by one.
-            for (; j + kUnroll <= count && !p.done; j += kUnroll) BLEND_STEP(kUnroll);
-            if (j + kUnroll / 2u <= count && !p.done) {
-                BLEND_STEP(kUnroll / 2u);
-                j += kUnroll / 2u;
-            }
-            for (; j < count && !p.done; ++j) BlendSplat(s_block_slots[list + j], p);
-            if (p.done) atomicAdd(s_done, 1u);  // once: done pixels skip later batches
-        }
-
-        if (inside) {
-            float accumulated = 1.0 - p.transmittance;
-            imageStore(out_color, pixel,
-                       vec4(p.color + p.transmittance * pc.background.rgb, accumulated));
-            if (kExpectedDepth) {
-                imageStore(out_depth, pixel,
-                           vec4(p.weight > 0.0 ? p.weighted_depth / p.weight : 0.0));
-                imageStore(out_alpha, pixel, vec4(accumulated));
-            }
-            if (kMedianDepth) imageStore(out_median_depth, pixel, vec4(p.median_depth));
-        }
-        // Claim the next tile. The barrier also makes sure every invocation has read
-        // s_done before it is reset for that tile.
+        uint following = s_tile;
+        uvec2 following_range = TileRange(following, num_tiles);
+        uint claimed = 0u;
+        if (local == 0u) claimed = atomicAdd(state.next_tile, 1u);
+        next_index = CompositeTile(tile, range, next_index, following_range, slot, in_tile,
+                                   block);
+        // Publish the claim (every invocation read s_tile before CompositeTile's first
+        // barrier). The barrier also makes sure every invocation has read s_done before the
+        // next tile resets it.
+        if (local == 0u) s_tile = gl_NumWorkGroups.x + claimed;
         barrier();
-        if (local == 0u) s_tile = gl_NumWorkGroups.x + atomicAdd(state.next_tile, 1u);
-        barrier();
-        tile = s_tile;
+        tile = following;
+        range = following_range;
     }
 }
 

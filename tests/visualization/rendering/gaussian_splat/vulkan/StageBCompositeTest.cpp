@@ -164,10 +164,14 @@ TEST_F(StageBComposite, ShapesAndBatches) {
         const auto lists = BuildTileLists(splats, TileGrid::ForImage(size.width, size.height), {});
         gpu::StageBRunInputs in = ToStageBInputs(splats, lists, size.width, size.height);
         const auto many = Run(in);
-        in.max_workgroups = 1;  // one workgroup steals every tile in turn
-        const auto one = Run(in);
-        EXPECT_EQ(many.color, one.color);
-        EXPECT_EQ(many.depth, one.depth);
+        // One workgroup steals every tile in turn; three interleave their claims, each
+        // holding the claim of its next tile while it composites the current one.
+        for (const uint32_t workgroups : {1u, 3u}) {
+            in.max_workgroups = workgroups;
+            const auto few = Run(in);
+            EXPECT_EQ(many.color, few.color) << workgroups << " workgroups";
+            EXPECT_EQ(many.depth, few.depth) << workgroups << " workgroups";
+        }
     }
 }
 
