@@ -336,7 +336,7 @@ void main() {
     // the one after that is in flight too. Claiming, reading the range and then the first
     // index between two tiles waited on three dependent global accesses per tile: 0.509 ->
     // 0.482 ms composite for playbot_125k at 4K (32,400 tiles) on the H200, 1080p unchanged
-    // (0.173 ms), the grid 1.540 -> 1.553 ms (two runs each; not explained).
+    // (0.173 ms), the grid 1.540 -> 1.550-1.553 ms (four runs; not explained).
     uvec2 range = TileRange(tile, num_tiles);
     uint next_index = FirstIndex(range, slot);
     if (local == 0u) s_tile = gl_NumWorkGroups.x + atomicAdd(state.next_tile, 1u);
