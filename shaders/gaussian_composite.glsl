@@ -7,15 +7,15 @@
 // block. A fixed grid of workgroups steals tiles from a global atomic counter until none is
 // left, each claiming its next tile while it composites the current one. A tile's entries
 // are its range of the tile-sorted entries, found beforehand by gaussian_tile_ranges.comp
-// (depth order preserved inside a tile); its splats are loaded
-// cooperatively into shared memory in batches of 256 and blended front to back with exactly
-// the 3DGS rules (docs/DESIGN.md section 3, cpu/Composite.cpp). Each pixel block visits only
-// the batch splats whose culling ellipse meets it (CompositeBlockMask), a
-// list built per batch by one workgroup scan, and takes them sixteen at a time (then eight,
-// then singly): a step's alphas first (independent loads and arithmetic), then the serial
-// transmittance chain. On the H100 the lists with steps of eight took the grid's composite
-// from 2.42 to 1.58 ms (1080p) and playbot_125k's from 0.232 to 0.181 ms (1080p), the lists
-// alone gained nothing, and steps of sixteen took the grid to 1.54 ms.
+// (depth order preserved inside a tile); its splats are loaded cooperatively into shared
+// memory in batches of 256 and blended front to back with exactly the 3DGS rules
+// (docs/DESIGN.md section 3, cpu/Composite.cpp). Each pixel block visits only the batch
+// splats whose culling ellipse meets it (CompositeBlockMask), a list built per batch by one
+// workgroup scan, and takes them sixteen at a time (then eight, then singly): a step's
+// alphas first (independent loads and arithmetic), then the serial transmittance chain. On
+// the H100 the lists with steps of eight took the grid's composite from 2.42 to 1.58 ms
+// (1080p) and playbot_125k's from 0.232 to 0.181 ms (1080p), the lists alone gained
+// nothing, and steps of sixteen took the grid to 1.54 ms.
 #ifndef OPEN3D_GAUSSIAN_COMPOSITE_GLSL
 #define OPEN3D_GAUSSIAN_COMPOSITE_GLSL
 
