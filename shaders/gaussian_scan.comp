@@ -5,9 +5,9 @@
 // the levels above (ScanOffset in gaussian_scan_offset.glsl). Additions saturate at
 // kScanSaturation (the total of a frame can pass 2^32), and the workgroup scan runs in
 // shared memory by local index, so the result does not depend on the subgroup size or
-// shape. Level 0 with kScanGather reads its counts
-// from the depth-sorted visible list (splats over max_tiles_per_splat count 0 and flag;
-// slots past visible_count, which the exact order also scans, count 0).
+// shape. Level 0 with kScanGather reads its counts from the depth-sorted visible list
+// (splats over max_tiles_per_splat count 0 and flag; slots past visible_count, which the
+// exact order also scans, count 0).
 #extension GL_GOOGLE_include_directive : require
 #include "GaussianSplatContract.h"
 
