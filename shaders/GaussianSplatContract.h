@@ -215,6 +215,11 @@ OPEN3D_SHADER_CONST uint kScanMaxLevels = 4u;
 // are kept below S, so a saturated offset always reads as "does not fit".
 OPEN3D_SHADER_CONST uint kScanSaturation = 0x7FFFFFFFu;
 
+// The depth that orders splats and culls at the near plane (RenderConfig::depth_order,
+// GaussianSplatSortDepth.h): the original rasterizer's float32 view z, or the camera-relative one.
+OPEN3D_SHADER_CONST uint kDepthOrderReference = 0u;
+OPEN3D_SHADER_CONST uint kDepthOrderCameraRelative = 1u;
+
 // Precision of the packed attributes (specialisation constant kSpecPrecision).
 OPEN3D_SHADER_CONST uint kPrecisionExact = 0u;    // fp32 everything
 OPEN3D_SHADER_CONST uint kPrecisionCompact = 1u;  // fp16 scale, rotation, f_dc, SH
@@ -280,6 +285,9 @@ struct GaussianViewParams {
     uvec4 scene;                // num_splats, sh_degree evaluated, antialias, sh_words_per_splat
     uvec4 flags;                // scene depth present, precision, shape_words_per_splat,
                                 // entry capacity allocated
+    vec4 reference_depth_row;   // m2, m6, m10, m14: row 2 of the float32 world-to-view matrix
+                                // [R | t], the original rasterizer's (ReferenceViewDepth)
+    uvec4 depth_order;          // x: kDepthOrderReference / kDepthOrderCameraRelative; yzw: 0
 };
 
 // One projected splat, written for visible splats only, indexed by splat index (std430).
@@ -346,6 +354,7 @@ struct GaussianScanPushConstants {
 #define OPEN3D_SHADER_FUNC inline
 #define OPEN3D_SHADER_PRECISE
 inline uint floatBitsToUint(float value) { return std::bit_cast<uint>(value); }
+inline float uintBitsToFloat(uint value) { return std::bit_cast<float>(value); }
 #else
 #define OPEN3D_SHADER_FUNC
 #define OPEN3D_SHADER_PRECISE precise
@@ -402,26 +411,8 @@ OPEN3D_SHADER_FUNC uint ListValueCount(uint value, uint num_splats) {
     return value >> ListIndexBits(num_splats);
 }
 
-// One coordinate of the camera-relative position (p - c_hi) - c_lo (GaussianViewParams):
-// p - c_hi is exact when p is within a factor 2 of c_hi (Sterbenz), i.e. for everything
-// near a camera far from the origin, and c_lo restores the centre's float32 rounding.
-OPEN3D_SHADER_FUNC float CameraRelative(float p, float c_hi, float c_lo) {
-    OPEN3D_SHADER_PRECISE float d = (p - c_hi) - c_lo;
-    return d;
-}
-
-// The view depth that orders splats (both sorts), culls at the near plane and that the
-// composite reads: float32 with a fixed operation order, every product and sum rounded
-// (`precise`: no fused multiply-add, no reordering), from row 2 of the float32
-// world-to-camera rotation and the camera-relative position (CameraRelative). The CPU
-// reference sorts and near-culls by the same function, so near-tied splats come out in
-// the same order and a splat at the near plane is culled on every device alike (a double
-// depth rounded once differs by an ulp; docs/vulkan.md "Sort depth").
-OPEN3D_SHADER_FUNC float SortDepth(float r0, float r1, float r2, float dx, float dy, float dz) {
-    OPEN3D_SHADER_PRECISE float xy = r0 * dx + r1 * dy;
-    OPEN3D_SHADER_PRECISE float d = xy + r2 * dz;
-    return d;
-}
+// CameraRelative, SortDepth and ReferenceViewDepth: the depths that order splats.
+#include "GaussianSplatSortDepth.h"
 
 // ---- Tile culling: which tiles of the 3DGS rectangle a splat can change ----
 // The composite skips a splat at a pixel when alpha = o exp(-q / 2) < 1/255, where
@@ -579,7 +570,7 @@ OPEN3D_SHADER_FUNC RadixSortParams RadixSortParamsFor(uint count, uint max_count
 static_assert(kScanBlockSize == kScanWorkgroupSize * kScanItemsPerInvocation);
 static_assert(kCounterVisibleIndex * 4 == 0 && kCounterEntriesIndex * 4 == 8);
 
-static_assert(sizeof(GaussianViewParams) == 160);
+static_assert(sizeof(GaussianViewParams) == 192);
 static_assert(offsetof(GaussianViewParams, world_to_camera_row0) == 0);
 static_assert(offsetof(GaussianViewParams, world_to_camera_row1) == 16);
 static_assert(offsetof(GaussianViewParams, world_to_camera_row2) == 32);
@@ -590,6 +581,8 @@ static_assert(offsetof(GaussianViewParams, image) == 96);
 static_assert(offsetof(GaussianViewParams, limits) == 112);
 static_assert(offsetof(GaussianViewParams, scene) == 128);
 static_assert(offsetof(GaussianViewParams, flags) == 144);
+static_assert(offsetof(GaussianViewParams, reference_depth_row) == 160);
+static_assert(offsetof(GaussianViewParams, depth_order) == 176);
 
 static_assert(sizeof(GaussianProjectedSplat) == 64);
 static_assert(offsetof(GaussianProjectedSplat, center_depth_opacity) == 0);

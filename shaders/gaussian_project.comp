@@ -202,13 +202,19 @@ bool Project(uint i, out float depth, out uint entries) {
     vec3 rel = vec3(CameraRelative(p.x, c_hi.x, c_lo.x), CameraRelative(p.y, c_hi.y, c_lo.y),
                     CameraRelative(p.z, c_hi.z, c_lo.z));
     vec3 r2 = view.world_to_camera_row2.xyz;
-    // The sort depth is the view z: the near cull, the sorts and the composite all read the
-    // value the CPU reference computes bit for bit (SortDepth).
-    float sort_depth = SortDepth(r2.x, r2.y, r2.z, rel.x, rel.y, rel.z);
-    if (!(sort_depth > view.clip.z)) return false;  // near plane (also NaN)
+    // The camera-relative view z: the projection, the composite's depth and depth images.
+    float view_z = SortDepth(r2.x, r2.y, r2.z, rel.x, rel.y, rel.z);
+    // The depth that orders the splat and culls it at the near plane, bit for bit the CPU
+    // reference's: the original rasterizer's float32 z by default (GaussianSplatSortDepth.h).
+    float order_depth = view_z;
+    if (view.depth_order.x == kDepthOrderReference) {
+        vec4 m = view.reference_depth_row;
+        order_depth = ReferenceViewDepth(m.x, m.y, m.z, m.w, p.x, p.y, p.z);
+    }
+    if (!(order_depth > view.clip.z)) return false;  // near plane (also NaN)
     LoadShape(i);
     vec3 v = vec3(dot(view.world_to_camera_row0.xyz, rel), dot(view.world_to_camera_row1.xyz, rel),
-                  sort_depth);
+                  view_z);
     float fx = view.intrinsics.x, fy = view.intrinsics.y;
     float px = fx * v.x / v.z + view.intrinsics.z;
     float py = fy * v.y / v.z + view.intrinsics.w;
@@ -269,14 +275,14 @@ bool Project(uint i, out float depth, out uint entries) {
 
     vec3 color = ShColor(i, rel);
     GaussianProjectedSplat out_splat;
-    out_splat.center_depth_opacity = vec4(px, py, sort_depth, opacity);
+    out_splat.center_depth_opacity = vec4(px, py, view_z, opacity);
     out_splat.conic = vec4(conic, cull_t);
     out_splat.color = vec4(color, det_q);
     out_splat.tiles = uvec4(rect_min.x | (rect_min.y << 16u), rect_max.x | (rect_max.y << 16u),
                             num_tiles, radius);
     projected[i] = out_splat;
     tile_counts[i] = num_tiles;
-    depth = sort_depth;
+    depth = order_depth;
     entries = num_tiles;
     return true;
 }

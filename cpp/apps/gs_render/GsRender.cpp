@@ -43,6 +43,7 @@ struct Options {
     bool antialias = false;
     std::vector<double> background;
     double near_plane = 0.2;
+    std::string depth_order = "reference";
     std::vector<double> eye, center, up;
     std::optional<double> fov;
     double orbit_angle = 0.0;
@@ -131,6 +132,8 @@ int Run(const Options& opt) {
     config.sh_degree = opt.sh_degree;
     config.antialias = opt.antialias;
     config.near_plane = opt.near_plane;
+    config.depth_order = opt.depth_order == "reference" ? rendering::DepthOrder::kReference
+                                                        : rendering::DepthOrder::kCameraRelative;
     if (!opt.background.empty()) config.background = ToVec(opt.background);
 
     std::string backend_name = opt.backend;
@@ -258,6 +261,12 @@ int main(int argc, char** argv) {
         ->expected(3);
     app.add_option("--near", opt.near_plane, "Near cull distance (view z)")
         ->check(CLI::PositiveNumber)
+        ->capture_default_str();
+    app.add_option("--depth-order", opt.depth_order,
+                   "Depth that orders splats: reference (the original 3DGS rasterizer's float32 "
+                   "view z) or camera-relative (accurate for scenes far from the origin; "
+                   "docs/accuracy.md)")
+        ->check(CLI::IsMember({"reference", "camera-relative"}))
         ->capture_default_str();
     app.add_option("--eye", opt.eye, "Look-at camera position x,y,z")->delimiter(',')->expected(3);
     app.add_option("--center", opt.center, "Look-at target x,y,z")->delimiter(',')->expected(3);

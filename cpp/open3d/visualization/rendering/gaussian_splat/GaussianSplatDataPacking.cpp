@@ -193,6 +193,13 @@ CameraCenterSplit SplitCameraCenter(const camera::PinholeCamera& camera) {
     return split;
 }
 
+ReferenceDepthRow GetReferenceDepthRow(const camera::PinholeCamera& camera) {
+    // The float32 matrix the original is given: R and t = -R c, each rounded from double.
+    const Eigen::Matrix3d r = camera.GetRotation();
+    const Eigen::Vector3d t = camera.GetTranslation();
+    return {float(r(2, 0)), float(r(2, 1)), float(r(2, 2)), float(t.z())};
+}
+
 bool UsesPackedSortKey(const shader::GaussianViewParams& params) { return params.clip.w > 0.0f; }
 
 shader::GaussianViewParams PackGaussianViewParams(const camera::PinholeCamera& camera,
@@ -245,6 +252,12 @@ shader::GaussianViewParams PackGaussianViewParams(const camera::PinholeCamera& c
                inputs.precision == SplatPrecision::kExact ? shader::kPrecisionExact
                                                           : shader::kPrecisionCompact,
                words, inputs.entry_capacity};
+    const ReferenceDepthRow m = GetReferenceDepthRow(camera);
+    p.reference_depth_row = {m.m2, m.m6, m.m10, m.m14};
+    p.depth_order = {config.depth_order == DepthOrder::kReference
+                         ? shader::kDepthOrderReference
+                         : shader::kDepthOrderCameraRelative,
+                     0u, 0u, 0u};
     return p;
 }
 

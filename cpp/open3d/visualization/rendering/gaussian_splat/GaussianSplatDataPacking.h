@@ -108,6 +108,14 @@ struct CameraCenterSplit {
 };
 CameraCenterSplit SplitCameraCenter(const camera::PinholeCamera& camera);
 
+/// Row 2 of the world-to-view matrix [R | t] as the original rasterizer receives it (each
+/// entry rounded to float32): m2, m6, m10, m14 of shader::ReferenceViewDepth, for the GPU's
+/// GaussianViewParams::reference_depth_row and the CPU reference alike.
+struct ReferenceDepthRow {
+    float m2 = 0.f, m6 = 0.f, m10 = 0.f, m14 = 0.f;
+};
+ReferenceDepthRow GetReferenceDepthRow(const camera::PinholeCamera& camera);
+
 /// True when `params` select the packed 32-bit key (clip.w > 0), false for exact order.
 bool UsesPackedSortKey(const shader::GaussianViewParams& params);
 

@@ -23,6 +23,19 @@ enum class SortMode {
     kPackedKey32,
 };
 
+/// The view depth that orders splats front to back (ties by splat index) and culls them at
+/// the near plane, on every backend (docs/accuracy.md).
+enum class DepthOrder {
+    /// The original 3DGS rasterizer's float32 view z, computed in its operation order
+    /// (shader::ReferenceViewDepth): splats whose depths differ by less than a float32 step
+    /// blend in the original's order. Its float32 world-space arithmetic loses the order of
+    /// near splats far from the origin (about 1e4 units and beyond).
+    kReference,
+    /// Depth from the camera-relative position (shader::SortDepth): accurate to float32
+    /// rounding of the position relative to the camera wherever the scene lies.
+    kCameraRelative,
+};
+
 struct RenderConfig {
     /// Splats with view-space z <= near_plane are culled (3DGS: 0.2).
     double near_plane = 0.2;
@@ -37,6 +50,8 @@ struct RenderConfig {
     uint32_t max_tiles_per_splat = 1u << 16;
     /// Entries beyond this total are dropped, farthest splats first (flag kEntriesDropped).
     uint64_t max_tile_entries_total = 1ull << 26;
+    /// Which depth orders the splats and culls them at the near plane; see DepthOrder.
+    DepthOrder depth_order = DepthOrder::kReference;
     /// Exact depth order (default) or the seed's packed 32-bit key; see SortMode.
     SortMode sort_mode = SortMode::kExact;
     /// GPU storage of the splat attributes: false = `exact` (fp32 where it matters), true =

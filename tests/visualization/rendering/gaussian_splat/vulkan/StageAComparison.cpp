@@ -143,11 +143,10 @@ StageAComparison CompareStageA(const t::geometry::PointCloud& cloud,
     }
     c.border_splats.assign(border.begin(), border.end());
 
-    // The GPU's own order: float32 depth bits of its projection, then splat
-    // index.
-    const auto gpu_key = [&](uint32_t i) {
-        return OrderKey{gpu.projected.at(i).center_depth_opacity.z, i};
-    };
+    // The order both sides must give: the reference's float32 order depth (which the GPU
+    // computes bit for bit, RenderConfig::depth_order), then splat index. The record's z is
+    // the camera-relative view z, which orders only in DepthOrder::kCameraRelative.
+    const auto gpu_key = [&](uint32_t i) { return OrderKey{ref.at(i).sort_depth, i}; };
     for (size_t k = 1; k < gpu.visible_in_depth_order.size(); ++k) {
         if (!(gpu_key(gpu.visible_in_depth_order[k - 1]) <
               gpu_key(gpu.visible_in_depth_order[k]))) {

@@ -222,8 +222,11 @@ void StageAPackedKeyScene::CompareModes(int width, int height) {
     const PackedGaussianSplats packed = PackGaussianSplatAttrs(cloud);
     GaussianStageARunner runner(Context(), packed, 1u << 22);
 
+    // The packed key truncates the record's (camera-relative) view z, so the exact order it
+    // is held against is the exact order of that same depth.
     RenderConfig exact_config;
-    RenderConfig packed_config;
+    exact_config.depth_order = DepthOrder::kCameraRelative;
+    RenderConfig packed_config = exact_config;
     packed_config.sort_mode = SortMode::kPackedKey32;
     const StageAReadback exact = runner.Run(cam, exact_config);
     const StageAReadback gpu = runner.Run(cam, packed_config);

@@ -21,8 +21,10 @@ namespace shader = visualization::rendering::shader;
 TEST(StageAPacking, ContractLayoutsArePinned) {
     // The same numbers as the static_asserts in the contract header, checked at
     // run time too so a layout change shows up as a named test failure.
-    EXPECT_EQ(sizeof(shader::GaussianViewParams), 160u);
+    EXPECT_EQ(sizeof(shader::GaussianViewParams), 192u);
     EXPECT_EQ(offsetof(shader::GaussianViewParams, limits), 112u);
+    EXPECT_EQ(offsetof(shader::GaussianViewParams, reference_depth_row), 160u);
+    EXPECT_EQ(offsetof(shader::GaussianViewParams, depth_order), 176u);
     EXPECT_EQ(sizeof(shader::GaussianProjectedSplat), 64u);
     EXPECT_EQ(offsetof(shader::GaussianProjectedSplat, tiles), 48u);
     EXPECT_EQ(sizeof(shader::GaussianStageACounters), 32u + 16u * shader::kScanMaxLevels);

@@ -61,6 +61,8 @@ inline rendering::cpu::ProjectedSplat MakeSplat(double x, double y, double depth
     s.cull = rendering::cpu::CullReason::kVisible;
     s.x = x;
     s.y = y;
+    s.original_x = static_cast<float>(x);  // the centre the composite's decisions read
+    s.original_y = static_cast<float>(y);
     s.depth = depth;
     s.cov_a = s.cov_c = sigma * sigma;
     s.conic_a = s.conic_c = 1.0 / (sigma * sigma);

@@ -89,6 +89,43 @@ void ComputeTileRect(double x, double y, int radius, const TileGrid& grid, Proje
     splat.rect_max_y = lo(y + radius + kTileSize - 1, grid.tiles_y);
 }
 
+OriginalProjection GetOriginalProjection(const camera::PinholeCamera& camera) {
+    OriginalProjection m;
+    m.width = camera.width;
+    m.height = camera.height;
+    m.centered = camera.cx == 0.5 * (camera.width - 1) && camera.cy == 0.5 * (camera.height - 1);
+    const Eigen::Matrix3d r = camera.GetRotation();
+    const Eigen::Vector3d t = camera.GetTranslation();
+    const float sx = static_cast<float>(2.0 * camera.fx / camera.width);
+    const float sy = static_cast<float>(2.0 * camera.fy / camera.height);
+    for (int j = 0; j < 4; ++j) {
+        const float wx = static_cast<float>(j < 3 ? r(0, j) : t.x());
+        const float wy = static_cast<float>(j < 3 ? r(1, j) : t.y());
+        const float wz = static_cast<float>(j < 3 ? r(2, j) : t.z());
+        volatile float px = sx * wx, py = sy * wy;  // rounded to float32, never fused
+        m.row_x[j] = px;
+        m.row_y[j] = py;
+        m.row_w[j] = wz;
+    }
+    return m;
+}
+
+std::array<float, 2> OriginalPixelCenter(const OriginalProjection& m, const float* p, double x,
+                                         double y) {
+    if (!m.centered) return {static_cast<float>(x), static_cast<float>(y)};
+    auto row = [&](const float* r) {
+        return shader::ReferenceViewDepth(r[0], r[1], r[2], r[3], p[0], p[1], p[2]);
+    };
+    const float hx = row(m.row_x), hy = row(m.row_y);
+    volatile float w_guard = row(m.row_w) + 0.0000001f;
+    volatile float inv_w = 1.0f / w_guard;
+    volatile float ndc_x = hx * inv_w, ndc_y = hy * inv_w;
+    auto to_pixel = [](float v, int size) {
+        return static_cast<float>(((double(v) + 1.0) * size - 1.0) * 0.5);
+    };
+    return {to_pixel(ndc_x, m.width), to_pixel(ndc_y, m.height)};
+}
+
 namespace {
 
 struct ViewParams {
@@ -96,6 +133,8 @@ struct ViewParams {
     Eigen::Vector3d translation;
     Eigen::Vector3d center;          // camera centre, world space
     CameraCenterSplit center_split;  // the same as float32 high + low (the sort depth's)
+    ReferenceDepthRow depth_row;     // the original's float32 matrix row (its view z)
+    OriginalProjection original;     // its full projection, for its float32 pixel centre
     double fx, fy, cx, cy;
     double lim_x, lim_y;  // 1.3 tan(fov / 2): the Jacobian guard band
     TileGrid grid;
@@ -113,6 +152,23 @@ Eigen::Matrix3d CovarianceFactor(const float* scale, const float* rot) {
     return q.toRotationMatrix() * s.asDiagonal();
 }
 
+// The float32 depth that orders and near-culls the splat, exactly as the GPU computes it.
+float OrderDepth(const ViewParams& view, DepthOrder order, const float* position) {
+    if (order == DepthOrder::kReference) {
+        const ReferenceDepthRow& m = view.depth_row;
+        return shader::ReferenceViewDepth(m.m2, m.m6, m.m10, m.m14, position[0], position[1],
+                                          position[2]);
+    }
+    const Eigen::Matrix3d& r = view.rotation;
+    float rel[3];
+    for (int i = 0; i < 3; ++i) {
+        rel[i] = shader::CameraRelative(position[i], view.center_split.high[i],
+                                        view.center_split.low[i]);
+    }
+    return shader::SortDepth(float(r(2, 0)), float(r(2, 1)), float(r(2, 2)), rel[0], rel[1],
+                             rel[2]);
+}
+
 ProjectedSplat ProjectOne(const ViewParams& view, const RenderConfig& config, int sh_degree,
                           int64_t num_rest, const float* position, const float* scale,
                           const float* rot, float opacity_logit, const float* f_dc,
@@ -121,14 +177,7 @@ ProjectedSplat ProjectOne(const ViewParams& view, const RenderConfig& config, in
     const Eigen::Vector3d p(position[0], position[1], position[2]);
     const Eigen::Vector3d v = view.rotation * p + view.translation;
     out.depth = v.z();
-    const Eigen::Matrix3d& r = view.rotation;
-    float rel[3];
-    for (int i = 0; i < 3; ++i) {
-        rel[i] = shader::CameraRelative(position[i], view.center_split.high[i],
-                                        view.center_split.low[i]);
-    }
-    out.sort_depth =
-        shader::SortDepth(float(r(2, 0)), float(r(2, 1)), float(r(2, 2)), rel[0], rel[1], rel[2]);
+    out.sort_depth = OrderDepth(view, config.depth_order, position);
     // The near cull compares the GPU's float32 depth with the float32 near plane (3DGS:
     // p_view.z <= 0.2f in float), so a splat within rounding of the plane is culled or kept
     // on every backend alike; the double z would keep a splat at 0.2f (> 0.2).
@@ -138,6 +187,14 @@ ProjectedSplat ProjectOne(const ViewParams& view, const RenderConfig& config, in
     }
     out.x = view.fx * v.x() / v.z() + view.cx;
     out.y = view.fy * v.y() / v.z() + view.cy;
+    // The original's float32 centre for the threshold decisions in its order; with the
+    // camera-relative order (scenes far from the origin, where the original's float32
+    // world-space centre is off by pixels) our own centre rounded to float32.
+    const auto original = config.depth_order == DepthOrder::kReference
+                              ? OriginalPixelCenter(view.original, position, out.x, out.y)
+                              : std::array<float, 2>{float(out.x), float(out.y)};
+    out.original_x = original[0];
+    out.original_y = original[1];
 
     // Perspective Jacobian at the clamped position: splats far outside the view would
     // otherwise get huge, smeared footprints.
@@ -209,6 +266,8 @@ std::vector<ProjectedSplat> ProjectSplats(const t::geometry::PointCloud& cloud,
     view.translation = camera.GetTranslation();
     view.center = camera.GetCenter();
     view.center_split = SplitCameraCenter(camera);
+    view.depth_row = GetReferenceDepthRow(camera);
+    view.original = GetOriginalProjection(camera);
     view.fx = camera.fx;
     view.fy = camera.fy;
     view.cx = camera.cx;

@@ -30,9 +30,14 @@ struct ProjectedSplat {
     CullReason cull = CullReason::kNearPlane;
     double x = 0.0, y = 0.0;  ///< centre in pixels: fx * X / Z + cx, fy * Y / Z + cy
     double depth = 0.0;       ///< view-space Z
-    /// The depth that orders splats: shader::SortDepth, float32 with a fixed operation
-    /// order, exactly as the GPU computes it (ties broken by splat index).
+    /// The depth that orders splats and culls them at the near plane, float32, exactly as the
+    /// GPU computes it (ties broken by splat index): shader::ReferenceViewDepth or
+    /// shader::SortDepth, as RenderConfig::depth_order says.
     float sort_depth = 0.0f;
+    /// The centre the composite's float32 threshold decisions read, as the original takes
+    /// them: its own float32 pixel centre (OriginalPixelCenter) with DepthOrder::kReference,
+    /// (x, y) rounded to float32 with kCameraRelative. The blended values use x, y.
+    float original_x = 0.0f, original_y = 0.0f;
     /// 2D covariance after the +0.3 dilation: [[cov_a, cov_b], [cov_b, cov_c]] (pixels^2).
     double cov_a = 0.0, cov_b = 0.0, cov_c = 0.0;
     /// Inverse of the dilated covariance: [[conic_a, conic_b], [conic_b, conic_c]].
@@ -91,6 +96,25 @@ ScreenEllipse ComputeScreenEllipse(double cov_a, double cov_b, double cov_c, boo
 /// 3DGS getRect: rect_min = clamp((int)((p - r) / 16)), rect_max = clamp((int)((p + r + 15) / 16))
 /// per axis, clamped to [0, tiles]. Writes [min, max) into the splat.
 void ComputeTileRect(double x, double y, int radius, const TileGrid& grid, ProjectedSplat& splat);
+
+/// Rows x, y and w of the original rasterizer's float32 full projection matrix P [R | t]
+/// (column-major m[0..15] in its code): P scales view x and y by 2 fx / W and 2 fy / H
+/// (1 / tan(fov / 2)) and copies view z into w, so each entry is one float32 product of two
+/// float32 values, whichever way the matrix product was evaluated. Valid for a principal
+/// point at the image centre, the only camera the original supports.
+struct OriginalProjection {
+    float row_x[4], row_y[4], row_w[4];
+    int width = 0, height = 0;
+    bool centered = false;  ///< principal point at ((W - 1) / 2, (H - 1) / 2)
+};
+OriginalProjection GetOriginalProjection(const camera::PinholeCamera& camera);
+
+/// The original's pixel centre of world position p, bit for bit as its preprocess computes
+/// it: p_hom = m p with its fused multiply-adds (as shader::ReferenceViewDepth), p_proj =
+/// p_hom * (1 / (p_hom.w + 1e-7)), then ndc2Pix ((v + 1) S - 1) / 2 in double (its literals
+/// are doubles) rounded to float32. Without a centred principal point: (x, y) rounded.
+std::array<float, 2> OriginalPixelCenter(const OriginalProjection& m, const float* position,
+                                         double x, double y);
 
 /// Projects every splat of a valid Gaussian splat cloud for one camera, multi-threaded.
 /// Throws core::Open3DError for an invalid cloud or camera.

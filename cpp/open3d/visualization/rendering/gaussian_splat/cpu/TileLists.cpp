@@ -8,7 +8,7 @@ namespace rendering {
 namespace cpu {
 
 std::vector<uint32_t> SortVisibleByDepth(const std::vector<ProjectedSplat>& splats) {
-    // The GPU's key: shader::SortDepth (float32, fixed operation order), ties by splat
+    // The GPU's key: ProjectedSplat::sort_depth (float32, bit for bit the GPU's), ties by splat
     // index, so near-tied splats are ordered identically on both sides.
     struct Key {
         float depth;
