@@ -6,6 +6,7 @@
 
 #include <bit>
 #include <cmath>
+#include <cstdio>
 #include <cstdint>
 #include <random>
 #include <vector>
@@ -70,8 +71,10 @@ TEST(SortDepth, ExactFmaEqualsTheFusedOperation) {
     check(k, k, -1.0f);
     check(k, -k, std::ldexp(1.0f, -30));
     // The random hard cases must be hard: rounding twice gets many of them wrong, so a plain
-    // a * b + c inside ExactFma would fail above (measured: about a third of the cases).
-    EXPECT_GT(unfused_differs, cases / 10) << unfused_differs << " of " << cases;
+    // a * b + c inside ExactFma would fail above (measured: 666,162 of 1,000,003 cases).
+    std::printf("[sort depth] a * b + c rounded twice differs from fma in %lld of %lld cases\n",
+                static_cast<long long>(unfused_differs), static_cast<long long>(cases));
+    EXPECT_GT(unfused_differs, cases / 3) << unfused_differs << " of " << cases;
 }
 
 TEST(SortDepth, ReferenceViewDepthIsTheOriginalsFusedExpression) {
