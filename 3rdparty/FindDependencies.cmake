@@ -8,6 +8,12 @@ find_package(Eigen3 3.3 REQUIRED NO_MODULE)
 find_package(nlohmann_json 3 REQUIRED)
 find_package(CLI11 REQUIRED)
 find_package(PNG REQUIRED)
+# Compressed splat formats (t/io): zlib 1.2.13 (gzip SPZ, deflate in zip), zstd 1.5.4 (SPZ
+# v4 streams), libwebp 1.2.4 (SOG images). Debian ships no CMake config for webp.
+find_package(ZLIB REQUIRED)
+find_package(PkgConfig REQUIRED)
+pkg_check_modules(ZSTD REQUIRED IMPORTED_TARGET libzstd)
+pkg_check_modules(WEBP REQUIRED IMPORTED_TARGET libwebp)
 
 # Eigen's headers are included as SYSTEM through its imported target already.
 if(OPEN3D_BUILD_TESTS)

@@ -11,7 +11,9 @@ data="${OPEN3D_DATA_DIR:-$root/../shared/data}"
 bash "$root/scripts/setup.sh"
 CC=clang-14 CXX=clang++-14 cmake -S "$root" -B "$build_dir" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
   -DOPEN3D_SANITIZE=ON -DOPEN3D_BUILD_FUZZERS=ON -DOPEN3D_BUILD_TESTS=OFF -DOPEN3D_BUILD_BENCHMARKS=OFF >/dev/null
-cmake --build "$build_dir" -j"$(nproc)" --target fuzz_ply_reader fuzz_splat_reader fuzz_cameras_json
+cmake --build "$build_dir" -j"$(nproc)" --target fuzz_ply_reader fuzz_splat_reader fuzz_cameras_json \
+  fuzz_spz_reader fuzz_compressed_ply_reader fuzz_sog_reader fuzz_gltf_reader fuzz_glb_reader \
+  fuzz_ksplat_reader
 artifacts="$build_dir/fuzz-artifacts"
 mkdir -p "$artifacts"
 run() {  # name, seed files...
@@ -26,3 +28,10 @@ run() {  # name, seed files...
 run fuzz_ply_reader "$data/pc_short/pc_short.ply" "$data/train3/train_3points.ply" "$root"/tests/fuzz/seeds/*.ply
 run fuzz_splat_reader "$data/train3/one_splat.splat"
 run fuzz_cameras_json "$data/playbot/cameras.json" "$data/chair/cameras.json"
+formats="$data/formats"
+run fuzz_spz_reader "$formats/minimal-v3.spz" "$formats/minimal-v4.spz" "$root"/tests/fuzz/seeds/*.spz
+run fuzz_compressed_ply_reader "$root"/tests/fuzz/seeds/*.compressed.ply
+run fuzz_sog_reader "$root"/tests/fuzz/seeds/*.sog
+run fuzz_gltf_reader "$formats/cesium_synthetic_0.gltf" "$root"/tests/fuzz/seeds/*.gltf
+run fuzz_glb_reader "$root"/tests/fuzz/seeds/*.glb
+run fuzz_ksplat_reader "$formats/minimal.ksplat" "$root"/tests/fuzz/seeds/*.ksplat

@@ -5,7 +5,7 @@ set -euo pipefail
 
 packages=(
   build-essential cmake ninja-build pkg-config git python3
-  libfmt-dev libeigen3-dev nlohmann-json3-dev libcli11-dev libpng-dev libstb-dev zlib1g-dev
+  libfmt-dev libeigen3-dev nlohmann-json3-dev libcli11-dev libpng-dev libstb-dev zlib1g-dev libzstd-dev libwebp-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   clang-14 clang-format-14 libclang-rt-14-dev libfuzzer-14-dev
   libvulkan-dev mesa-vulkan-drivers vulkan-tools vulkan-validationlayers

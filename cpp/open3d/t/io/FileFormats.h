@@ -19,6 +19,40 @@ geometry::PointCloud ReadSplat(const std::string& filename, const ReadPointCloud
                                ReadPointCloudReport& report);
 void WriteSplat(const std::string& filename, const geometry::PointCloud& cloud);
 
+// Compressed and interchange formats (docs/formats.md). Each reader checks every size and
+// offset against the file, names the file and the offending field in its errors, and hands
+// its columns to FinalizeColumns.
+
+/// SPZ (nianticlabs/spz): v1-3 (gzip) and v4 (zstd streams), SH degrees 0-3; stored RUB,
+/// converted to and from the RDF axes of 3DGS. Written as v4. SpzFormat.cpp.
+geometry::PointCloud ReadSpz(const std::string& filename, const ReadPointCloudOptions& options,
+                             ReadPointCloudReport& report);
+void WriteSpz(const std::string& filename, const geometry::PointCloud& cloud);
+
+/// PlayCanvas compressed PLY (`element chunk` bounds + packed vertices, optional `sh`).
+/// CompressedPlyFormat.cpp.
+geometry::PointCloud ReadCompressedPly(const std::string& filename,
+                                       const ReadPointCloudOptions& options,
+                                       ReadPointCloudReport& report);
+void WriteCompressedPly(const std::string& filename, const geometry::PointCloud& cloud);
+
+/// PlayCanvas SOG v2 and v3: a bundled .sog (zip) or a folder holding meta.json and its
+/// WebP images (`filename` is the folder or its meta.json). Written as a bundled v3 .sog.
+/// SogFormat.cpp.
+geometry::PointCloud ReadSog(const std::string& filename, const ReadPointCloudOptions& options,
+                             ReadPointCloudReport& report);
+void WriteSog(const std::string& filename, const geometry::PointCloud& cloud);
+
+/// glTF 2.0 with KHR_gaussian_splatting: .gltf (external or data-URI buffers) and .glb.
+/// Written as .glb, or as .gltf with one data-URI buffer. GltfFormat.cpp.
+geometry::PointCloud ReadGltf(const std::string& filename, const ReadPointCloudOptions& options,
+                              ReadPointCloudReport& report);
+void WriteGltf(const std::string& filename, const geometry::PointCloud& cloud, bool binary);
+
+/// mkkellogg's .ksplat, compression modes 0-2 (read only). KsplatFormat.cpp.
+geometry::PointCloud ReadKsplat(const std::string& filename, const ReadPointCloudOptions& options,
+                                ReadPointCloudReport& report);
+
 /// The float32 log-scale whose exp (computed as the reader does, in double) gives back
 /// `scale` exactly when such a value exists; otherwise the nearest one. Zero maps to a
 /// finite log whose exp is zero.

@@ -1,5 +1,6 @@
-// Reading and writing Gaussian splat clouds: 3DGS PLY (binary LE/BE, ASCII) and
-// antimatter15 .splat. Failures throw core::Open3DError naming the file and the problem.
+// Reading and writing Gaussian splat clouds: 3DGS PLY (binary LE/BE, ASCII), antimatter15
+// .splat, SPZ, PlayCanvas compressed PLY, SOG, glTF KHR_gaussian_splatting and .ksplat
+// (docs/formats.md). Failures throw core::Open3DError naming the file and the problem.
 #pragma once
 
 #include <cstdint>
@@ -23,8 +24,28 @@ struct ReadPointCloudReport {
     int64_t trailing_bytes = 0;  // bytes after the declared vertices (warned, ignored)
 };
 
-/// Reads a .ply or .splat file (chosen by extension, case-insensitive). On failure
-/// throws and leaves `cloud` unchanged.
+/// The file formats ReadPointCloud knows.
+enum class PointCloudFileFormat {
+    kPly,            ///< 3DGS PLY (binary or ASCII)
+    kCompressedPly,  ///< PlayCanvas compressed PLY (`element chunk`)
+    kSplat,          ///< antimatter15 .splat
+    kSpz,            ///< Niantic SPZ, v1-3 (gzip) or v4
+    kSog,            ///< PlayCanvas SOG: bundled .sog (zip) or a folder / its meta.json
+    kGltf,           ///< glTF 2.0 JSON (.gltf) with KHR_gaussian_splatting
+    kGlb,            ///< binary glTF (.glb)
+    kKsplat,         ///< GaussianSplats3D .ksplat
+};
+/// Its name as docs/formats.md spells it (e.g. "SPZ").
+const char* PointCloudFileFormatName(PointCloudFileFormat format);
+
+/// The format of a file from its content: magic bytes and headers (PLY, compressed PLY,
+/// SPZ, zip/SOG, glb, glTF JSON); the formats without a signature (.splat, .ksplat) and a
+/// SOG folder by their extension or layout. Throws naming the file when neither tells.
+PointCloudFileFormat DetectPointCloudFileFormat(const std::string& filename);
+
+/// Reads a splat file of any format above, detected by content (DetectPointCloudFileFormat;
+/// a warning is logged when the extension says otherwise). On failure throws and leaves
+/// `cloud` unchanged.
 ReadPointCloudReport ReadPointCloud(const std::string& filename, geometry::PointCloud& cloud,
                                     const ReadPointCloudOptions& options = {});
 
@@ -34,8 +55,9 @@ struct WritePointCloudOptions {
     PlyFormat ply_format = PlyFormat::BinaryLittleEndian;
 };
 
-/// Writes a .ply (3DGS layout, log-scales) or .splat file. Writing a cloud with SH
-/// degree > 0 to .splat drops f_rest with a warning (the format cannot hold it).
+/// Writes the format the extension names (case-insensitive): .ply (3DGS layout,
+/// log-scales), .compressed.ply, .splat, .spz (v4), .sog (bundled v3), .glb, .gltf (one
+/// data-URI buffer). Writing SH a format cannot hold (.splat: degree 0) drops it with a warning.
 void WritePointCloud(const std::string& filename, const geometry::PointCloud& cloud,
                      const WritePointCloudOptions& options = {});
 

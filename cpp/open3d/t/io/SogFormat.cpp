@@ -1,0 +1,20 @@
+// Placeholder until the format is implemented: every call throws.
+#include "open3d/core/Exception.h"
+#include "open3d/t/io/FileFormats.h"
+
+namespace open3d {
+namespace t {
+namespace io {
+
+geometry::PointCloud ReadSog(const std::string& filename, const ReadPointCloudOptions&,
+                             ReadPointCloudReport&) {
+    core::ThrowError("'{}': reading this format is not implemented yet", filename);
+}
+
+void WriteSog(const std::string& filename, const geometry::PointCloud&) {
+    core::ThrowError("'{}': writing this format is not implemented yet", filename);
+}
+
+}  // namespace io
+}  // namespace t
+}  // namespace open3d
