@@ -1,8 +1,8 @@
-// GaussianSplat: the interactive viewer (docs/viewer.md). Opens a 3DGS .ply / .splat (or the
-// built-in default scene), adds a red sphere mesh that shows the depth compositing of
-// meshes and splats, and runs the Visualizer: orbit/pan/zoom, the ImGui settings panel,
-// screenshots. Test and benchmark flags: --frames, --exit-after-seconds, --screenshot-dir,
-// --screenshot-on-exit, --spin.
+// GaussianSplat: the interactive viewer (docs/viewer.md). Opens a splat scene in any format
+// t::io reads (docs/formats.md) or the built-in default scene, adds a red sphere mesh that
+// shows the depth compositing of meshes and splats, and runs the Visualizer: orbit/pan/zoom,
+// the ImGui settings panel, screenshots. Test and benchmark flags: --frames,
+// --exit-after-seconds, --screenshot-dir, --screenshot-on-exit, --spin.
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cstdio>
@@ -156,8 +156,9 @@ int main(int argc, char** argv) {
     Options opt;
     CLI::App app{
         "GaussianSplat: interactive viewer for 3D Gaussian Splatting scenes, drawn with\n"
-        "Vulkan compute (splats) and Filament (meshes, the panel). Opens SCENE (3DGS .ply or\n"
-        ".splat) or, without one, the built-in default scene, and adds a red sphere mesh to\n"
+        "Vulkan compute (splats) and Filament (meshes, the panel). Opens SCENE (.ply,\n"
+        ".compressed.ply, .splat, .spz, .sog or a SOG folder, .gltf, .glb, .ksplat) or,\n"
+        "without one, the built-in default scene, and adds a red sphere mesh to\n"
         "show depth compositing. Needs an X server (run under `xvfb-run -a` without a display).\n"
         "\n"
         "Mouse: left drag orbits, right/middle/shift+left drag pans, wheel zooms.\n"
@@ -168,8 +169,8 @@ int main(int argc, char** argv) {
         "--continuous, --frames or --spin is given. At exit it prints the frame time summary\n"
         "(back-to-back frames only, without the first 3) and the last frame's GPU times.",
         "GaussianSplat"};
-    app.add_option("scene", opt.input, "3DGS .ply or .splat file (default: built-in scene)")
-        ->check(CLI::ExistingFile);
+    app.add_option("scene", opt.input, "Splat scene file or SOG folder (default: built-in scene)")
+        ->check(CLI::ExistingPath);
     app.add_option("--width", opt.width, "Window width in pixels")
         ->check(CLI::Range(1, 16384))
         ->capture_default_str();

@@ -390,8 +390,8 @@ int main(int argc, char** argv) {
         "columns compare the colour with the CPU reference (default knobs but the SH cap and\n"
         "antialias) rendered in the same run (worst view).",
         "gs-bench"};
-    app.add_option("-i,--input", opt.inputs, "Scene file(s): .ply or .splat")
-        ->check(CLI::ExistingFile)
+    app.add_option("-i,--input", opt.inputs, "Scene file(s) in any format gs-convert reads")
+        ->check(CLI::ExistingPath)
         ->required();
     app.add_option("--cameras", opt.cameras, "cameras.json per input")->check(CLI::ExistingFile);
     app.add_option("--views", opt.views, "View indices, e.g. 0,5,9, or 'all'")

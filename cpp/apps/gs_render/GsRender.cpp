@@ -223,8 +223,9 @@ int main(int argc, char** argv) {
         "--sphere or --filament render through Filament (meshes and splats composited with the\n"
         "depth test; needs an X server: run under xvfb-run -a on machines without a display).",
         "gs-render"};
-    app.add_option("-i,--input", opt.input, "Scene file: 3DGS .ply or .splat")
-        ->check(CLI::ExistingFile);
+    app.add_option("-i,--input", opt.input,
+                   "Scene file in any format gs-convert reads (docs/formats.md)")
+        ->check(CLI::ExistingPath);
     app.add_option("--cameras", opt.cameras, "3DGS cameras.json with the views")
         ->check(CLI::ExistingFile);
     app.add_option("--view", opt.view, "View index in cameras.json")->capture_default_str();
