@@ -34,15 +34,17 @@
 // without a "version" field, is refused); a quats alpha outside 252..255 or a palette label
 // at or above shN.count is an error naming the splat; files named in meta.json must be plain
 // relative names (no "..", no absolute paths); all per-Gaussian images must have the same
-// size; at most 2^26 texels per image.
+// size; at most 2^24 texels per image.
 //
 // The writer writes a bundled .sog of version 2 (kWriteVersion; the version-3 changes could
-// not be consulted): the cloud's own order (no Morton sort, so written and read splats match
-// by index), positions rounded to the nearest 16-bit code, quaternions in the mode that
-// reproduces them best, 1D k-means codebooks (exact when a column has <= 256 distinct
-// values), a shN palette from k-means over the coefficient vectors (exact when there are
-// few enough distinct vectors; otherwise a palette size bounded by a compute budget).
-// Everything is deterministic, and a written file read back and written again gives the
+// not be consulted, and version 2 is the one every PlayCanvas tool reads): texture sides
+// multiples of 4 as PlayCanvas writes them; the cloud's own order (no Morton sort, so written
+// and read splats match by index); positions rounded to the nearest 16-bit code; quaternions
+// in the unit-decoding mode that reproduces them best; scale (log) and f_dc codebooks by 1D
+// k-means over the three columns together (exact when there are <= 256 distinct values);
+// opacity rounded to 8 bits; the shN palette exact up to 65536 distinct coefficient vectors,
+// else k-means trained on a sample with a palette size set by a compute budget (1024 at
+// 150k splats of SH 3). Deterministic; a written file read back and written again gives the
 // same values.
 
 #include <algorithm>
@@ -52,6 +54,7 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <random>
 #include <string>
@@ -76,7 +79,9 @@ namespace fs = std::filesystem;
 using Json = nlohmann::json;
 
 constexpr int kWriteVersion = 2;
-constexpr int64_t kMaxTexels = int64_t(1) << 26;
+// At most 16.7M splats (4096 x 4096 texels): lossless WebP compresses a constant image to a
+// few bytes, so the image sizes, not the file size, bound what a reader allocates.
+constexpr int64_t kMaxTexels = int64_t(1) << 24;
 constexpr size_t kMaxMetaBytes = size_t(64) << 20;
 constexpr size_t kMaxImageBytes = size_t(1) << 30;
 constexpr int kCodebookSize = 256;
