@@ -24,7 +24,7 @@ void WriteSplat(const std::string& filename, const geometry::PointCloud& cloud);
 // its columns to FinalizeColumns.
 
 /// SPZ (nianticlabs/spz): v1-3 (gzip) and v4 (zstd streams), SH degrees 0-3; stored RUB,
-/// converted to and from the RDF axes of 3DGS. Written as v4. SpzFormat.cpp.
+/// converted to and from the RDF axes of 3DGS. Written as v4. SpzReader.cpp, SpzWriter.cpp.
 geometry::PointCloud ReadSpz(const std::string& filename, const ReadPointCloudOptions& options,
                              ReadPointCloudReport& report);
 void WriteSpz(const std::string& filename, const geometry::PointCloud& cloud);
