@@ -30,7 +30,7 @@ geometry::PointCloud ReadSpz(const std::string& filename, const ReadPointCloudOp
 void WriteSpz(const std::string& filename, const geometry::PointCloud& cloud);
 
 /// PlayCanvas compressed PLY (`element chunk` bounds + packed vertices, optional `sh`).
-/// CompressedPlyFormat.cpp.
+/// CompressedPlyReader.cpp, CompressedPlyWriter.cpp.
 geometry::PointCloud ReadCompressedPly(const std::string& filename,
                                        const ReadPointCloudOptions& options,
                                        ReadPointCloudReport& report);
