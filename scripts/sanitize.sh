@@ -11,10 +11,10 @@ bash "$root/scripts/setup.sh"
 cmake -S "$root" -B "$build_dir" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DOPEN3D_SANITIZE=ON \
   -DOPEN3D_BUILD_BENCHMARKS=OFF >/dev/null
 cmake --build "$build_dir" -j"$(nproc)" --target tests_core tests_geometry tests_io tests_camera \
-  tests_gaussian_splat tests_gaussian_splat_cpu tests_gaussian_splat_vulkan gs-render
+  tests_gaussian_splat tests_gaussian_splat_cpu tests_gaussian_splat_vulkan gs-render gs-convert
 cd "$build_dir"
 export OPEN3D_VULKAN_VALIDATION=0
 export ASAN_OPTIONS="detect_leaks=1:abort_on_error=1"
 export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
-# The gs-render command-line tests run the binary: they are sanitized too.
+# The gs-render and gs-convert command-line tests run the binaries: they are sanitized too.
 ctest --output-on-failure -j"$(nproc)" --timeout 1200 -L "^(cpu|vulkan)$" "$@"
