@@ -37,7 +37,7 @@ TEST(FormatRender, BikerInEveryFormatAgainstThePly) {
     t::geometry::PointCloud reference;
     t::io::ReadPointCloud(ply, reference);
     const camera::PinholeCamera cam =
-            camera::ReadCamerasJson(DataPath("biker/cameras.json")).at(0).camera.Resized(400, 400);
+        camera::ReadCamerasJson(DataPath("biker/cameras.json")).at(0).camera.Resized(400, 400);
     const t::geometry::Image want = cpu::RenderReference(reference, cam).color;
     const double splats = double(reference.NumPoints());
 
@@ -47,14 +47,14 @@ TEST(FormatRender, BikerInEveryFormatAgainstThePly) {
     // linear alpha: the logit comes back to the float rounding of its sigmoid); PLY identical.
     // The bounds are those less 1 dB: the writers and the CPU reference are deterministic.
     const FormCase cases[] = {
-            {"SPZ v4 (shipped)", "formats/biker.spz", nullptr, 102.6},
-            {"compressed PLY (shipped)", "formats/biker.compressed.ply", nullptr, 58.7},
-            {"3DGS PLY (written)", nullptr, ".ply", 1000.0},
-            {".splat (written)", nullptr, ".splat", 66.5},
-            {"SPZ v4 (written)", nullptr, ".spz", 102.6},
-            {"compressed PLY (written)", nullptr, ".compressed.ply", 65.4},
-            {"SOG v2 (written)", nullptr, ".sog", 68.0},
-            {"glb (written)", nullptr, ".glb", 175.6},
+        {"SPZ v4 (shipped)", "formats/biker.spz", nullptr, 102.6},
+        {"compressed PLY (shipped)", "formats/biker.compressed.ply", nullptr, 58.7},
+        {"3DGS PLY (written)", nullptr, ".ply", 1000.0},
+        {".splat (written)", nullptr, ".splat", 66.5},
+        {"SPZ v4 (written)", nullptr, ".spz", 102.6},
+        {"compressed PLY (written)", nullptr, ".compressed.ply", 65.4},
+        {"SOG v2 (written)", nullptr, ".sog", 68.0},
+        {"glb (written)", nullptr, ".glb", 175.6},
     };
     const std::string dir = TempDir();
     for (const FormCase& c : cases) {
