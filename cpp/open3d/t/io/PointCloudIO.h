@@ -56,7 +56,7 @@ struct WritePointCloudOptions {
 };
 
 /// Writes the format the extension names (case-insensitive): .ply (3DGS layout,
-/// log-scales), .compressed.ply, .splat, .spz (v4), .sog (bundled v3), .glb, .gltf (one
+/// log-scales), .compressed.ply, .splat, .spz (v4), .sog (bundled, version 2), .glb, .gltf (one
 /// data-URI buffer). Writing SH a format cannot hold (.splat: degree 0) drops it with a warning.
 void WritePointCloud(const std::string& filename, const geometry::PointCloud& cloud,
                      const WritePointCloudOptions& options = {});
