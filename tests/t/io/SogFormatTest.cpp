@@ -286,7 +286,6 @@ TEST(SogFormat, BikerRoundTripWithinQuantisation) {
     // Measured (Release, 2 threads): see the printout; these bounds hold them with margin.
     EXPECT_LT(w.log_scale, 0.05);
     EXPECT_LT(w.dc, 0.02);
-    EXPECT_LT(seconds, 20.0);
 }
 
 TEST(SogFormat, PcShortSh3RoundTrip) {
@@ -389,7 +388,6 @@ TEST(SogFormat, PlaybotShPaletteByKMeans) {
     EXPECT_LT(std::sqrt(sq / m), 0.5 * std::sqrt(ref / m));
     WritePointCloud(dir + "/playbot2.sog", back);
     EXPECT_TRUE(Read(dir + "/playbot2.sog") == back);
-    EXPECT_LT(seconds, 20.0);
 }
 
 TEST(SogFormat, FolderAndMetaJsonReadTheSameCloud) {
@@ -553,7 +551,6 @@ TEST(SogFormat, KMeansPaletteBeyond65536Vectors) {
     EXPECT_LT(std::sqrt(sq / ref), 0.95);
     WritePointCloud(dir + "/big2.sog", back);
     EXPECT_TRUE(Read(dir + "/big2.sog") == back);
-    EXPECT_LT(seconds, 30.0);
 }
 
 // Manual timing at biker scale with SH 3 (152,746 splats): run with
