@@ -26,5 +26,6 @@ ctest --output-on-failure -j"$(nproc)" --timeout 1200 -L "^cpu$" -E "^gs_render_
   status=$?
 export ASAN_OPTIONS="detect_leaks=0:abort_on_error=1"
 ctest --output-on-failure -j"$(nproc)" --timeout 1200 -L "^vulkan$" "$@" || status=$?
-ctest --output-on-failure -j"$(nproc)" --timeout 1200 -R "^gs_render_cli\." "$@" || status=$?
+ctest --output-on-failure -j"$(nproc)" --timeout 1200 -L "^cpu$" -R "^gs_render_cli\." "$@" ||
+  status=$?
 exit "$status"
