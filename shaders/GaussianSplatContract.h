@@ -173,9 +173,9 @@ static_assert(offsetof(RadixSortPushConstants, max_count) == 12);
 #undef OPEN3D_SHADER_CONST
 #endif  // OPEN3D_SHADERS_GAUSSIAN_SPLAT_CONTRACT_H
 
-// ---- Projection (Stage A) ----
+// ---- Projection (geometry stage) ----
 // Appended by the projection work (vulkan/GaussianProjection.*, GaussianSplatDataPacking.*):
-// view parameters, packed splat attributes, projected splats, Stage A counters, bindings.
+// view parameters, packed splat attributes, projected splats, geometry stage counters, bindings.
 // Kept as its own guarded block so the section above can change independently.
 #ifndef OPEN3D_SHADERS_GAUSSIAN_SPLAT_CONTRACT_PROJECTION_H
 #define OPEN3D_SHADERS_GAUSSIAN_SPLAT_CONTRACT_PROJECTION_H
@@ -201,7 +201,7 @@ OPEN3D_SHADER_CONST uint kGaussianTileSize = 16u;
 // the image still covers the whole grid (at most 65535 tiles, ~1e6 px, per axis) as its
 // true radius would; farther out a float32 centre is not resolved to a tile anyway.
 OPEN3D_SHADER_CONST uint kMaxSplatRadius = 1073741824u;  // 2^30, exact in float32
-// Workgroup sizes of the Stage A passes (one invocation per splat / per visible splat).
+// Workgroup sizes of the geometry stage passes (one invocation per splat / per visible splat).
 OPEN3D_SHADER_CONST uint kProjectWorkgroupSize = 256u;
 OPEN3D_SHADER_CONST uint kEmitWorkgroupSize = 256u;
 // The tile-count scan: a workgroup scans a block of 256 * 4 = 1024 counts.
@@ -243,25 +243,26 @@ OPEN3D_SHADER_CONST uint kEmitTileKeys = 0u;    // exact order: key = tile index
 OPEN3D_SHADER_CONST uint kEmitPackedKeys = 1u;  // packed option: key = PackedSortKey(...)
 OPEN3D_SHADER_CONST uint kEmitUnpackKeys = 2u;  // after the packed sort: key >>= depth bits
 
-// Descriptor set 0 of every Stage A projection pipeline (one push-descriptor layout; each
+// Descriptor set 0 of every geometry stage projection pipeline (one push-descriptor layout; each
 // shader declares only the bindings it uses).
-OPEN3D_SHADER_CONST uint kStageAViewBinding = 0u;          // GaussianViewParams
-OPEN3D_SHADER_CONST uint kStageAPositionsBinding = 1u;     // vec4[N]: xyz, sigmoid(opacity)
-OPEN3D_SHADER_CONST uint kStageAShapeBinding = 2u;         // uint[N * shape words]
-OPEN3D_SHADER_CONST uint kStageAShBinding = 3u;            // uint[N * sh words]; unread at degree 0
-OPEN3D_SHADER_CONST uint kStageAVisibilityBinding = 4u;    // uint[ceil(N / 32)], bit i = splat i
-OPEN3D_SHADER_CONST uint kStageAProjectedBinding = 5u;     // GaussianProjectedSplat[N]
-OPEN3D_SHADER_CONST uint kStageACountersBinding = 6u;      // GaussianStageACounters
-OPEN3D_SHADER_CONST uint kStageADepthKeysBinding = 7u;     // uint[N]: visible depth keys
-OPEN3D_SHADER_CONST uint kStageASplatIndexBinding = 8u;    // uint[N]: visible splat indices
-OPEN3D_SHADER_CONST uint kStageAScanBinding = 9u;          // uint[scan words]: all levels
-OPEN3D_SHADER_CONST uint kStageAEntryKeysBinding = 10u;    // uint[capacity]: tile index
-OPEN3D_SHADER_CONST uint kStageAEntryValuesBinding = 11u;  // uint[capacity]: splat index
-OPEN3D_SHADER_CONST uint kStageASortParamsBinding = 12u;   // RadixSortParams of the next sort
-OPEN3D_SHADER_CONST uint kStageATileCountsBinding = 13u;   // uint[N]: tiles of splat i
-OPEN3D_SHADER_CONST uint kStageANumBindings = 14u;
+OPEN3D_SHADER_CONST uint kGeometryStageViewBinding = 0u;       // GaussianViewParams
+OPEN3D_SHADER_CONST uint kGeometryStagePositionsBinding = 1u;  // vec4[N]: xyz, sigmoid(opacity)
+OPEN3D_SHADER_CONST uint kGeometryStageShapeBinding = 2u;      // uint[N * shape words]
+OPEN3D_SHADER_CONST uint kGeometryStageShBinding = 3u;  // uint[N * sh words]; unread at degree 0
+OPEN3D_SHADER_CONST uint kGeometryStageVisibilityBinding =
+    4u;  // uint[ceil(N / 32)], bit i = splat i
+OPEN3D_SHADER_CONST uint kGeometryStageProjectedBinding = 5u;     // GaussianProjectedSplat[N]
+OPEN3D_SHADER_CONST uint kGeometryStageCountersBinding = 6u;      // GaussianGeometryStageCounters
+OPEN3D_SHADER_CONST uint kGeometryStageDepthKeysBinding = 7u;     // uint[N]: visible depth keys
+OPEN3D_SHADER_CONST uint kGeometryStageSplatIndexBinding = 8u;    // uint[N]: visible splat indices
+OPEN3D_SHADER_CONST uint kGeometryStageScanBinding = 9u;          // uint[scan words]: all levels
+OPEN3D_SHADER_CONST uint kGeometryStageEntryKeysBinding = 10u;    // uint[capacity]: tile index
+OPEN3D_SHADER_CONST uint kGeometryStageEntryValuesBinding = 11u;  // uint[capacity]: splat index
+OPEN3D_SHADER_CONST uint kGeometryStageSortParamsBinding = 12u;  // RadixSortParams of the next sort
+OPEN3D_SHADER_CONST uint kGeometryStageTileCountsBinding = 13u;  // uint[N]: tiles of splat i
+OPEN3D_SHADER_CONST uint kGeometryStageNumBindings = 14u;
 
-// uint indices into GaussianStageACounters, used as the radix sorter's count_index.
+// uint indices into GaussianGeometryStageCounters, used as the radix sorter's count_index.
 OPEN3D_SHADER_CONST uint kCounterVisibleIndex = 0u;
 OPEN3D_SHADER_CONST uint kCounterEntriesIndex = 2u;
 OPEN3D_SHADER_CONST uint kCounterNumSplatsIndex = 7u;  // N, written by the recorder
@@ -310,9 +311,9 @@ struct GaussianScanLevel {
     uint count;
 };
 
-// GPU-side counts of Stage A (std430). Zeroed by the recorder before the projection;
+// GPU-side counts of geometry stage (std430). Zeroed by the recorder before the projection;
 // read back after the fence for stats and error flags.
-struct GaussianStageACounters {
+struct GaussianGeometryStageCounters {
     uint visible_count;      // splats that passed culling and the visibility mask
     uint requested_entries;  // sum of tile counts (saturates at kScanSaturation)
     uint entry_count;        // tile entries emitted (<= limits.x)
@@ -338,7 +339,7 @@ struct GaussianDispatchArgsPushConstants {
 
 // Push constants of gaussian_scan.comp.
 struct GaussianScanPushConstants {
-    uint level;        // index into GaussianStageACounters::scan_levels
+    uint level;        // index into GaussianGeometryStageCounters::scan_levels
     uint base;         // uint offset of this level's data in the scan buffer
     uint sums_base;    // offset of the next level's data, where the block sums go
     uint reserved3;    // was the down-sweep's add flag; kept so the offsets stay put
@@ -511,7 +512,7 @@ OPEN3D_SHADER_FUNC uint TileSpanCount(uint span) { return (span >> 16u) - (span 
 // Indirect size of scan level `level` of a scan over `count` elements (level l + 1 scans
 // the block sums of level l, ceil(count / kScanBlockSize^l) of them); levels at and past
 // `num_levels` are not recorded and get zero groups. gaussian_dispatch_args.comp sizes the
-// packed key's scan from visible_count with it, GaussianStageA the exact order's from N.
+// packed key's scan from visible_count with it, GaussianGeometryStage the exact order's from N.
 OPEN3D_SHADER_FUNC GaussianScanLevel ScanLevelFor(uint count, uint level, uint num_levels) {
     for (uint l = 0u; l < level; ++l) count = (count + kScanBlockSize - 1u) / kScanBlockSize;
     bool recorded = level < num_levels;
@@ -528,7 +529,7 @@ OPEN3D_SHADER_FUNC GaussianScanLevel ScanLevelFor(uint count, uint level, uint n
 // fewest chunks of kRadixSortWorkgroupSize that keep the block count at or below
 // target_blocks (clamped to 1..kRadixSortTargetBlocks), 1..kRadixSortItemsPerInvocation
 // chunks. radix_sort_setup.comp calls it, and so does a producer that writes the sort's
-// parameters itself (gaussian_dispatch_args.comp, and GaussianStageA on the host for the
+// parameters itself (gaussian_dispatch_args.comp, and GaussianGeometryStage on the host for the
 // depth sort, whose count is N), saving the sort its setup dispatch. No
 // overflow: the host keeps max_count far below 2^32 - kRadixSortBlockSize.
 OPEN3D_SHADER_FUNC RadixSortParams RadixSortParamsFor(uint count, uint max_count,
@@ -591,14 +592,14 @@ static_assert(offsetof(GaussianProjectedSplat, color) == 32);
 static_assert(offsetof(GaussianProjectedSplat, tiles) == 48);
 
 static_assert(sizeof(GaussianScanLevel) == 16);
-static_assert(sizeof(GaussianStageACounters) == 32 + 16 * kScanMaxLevels);
-static_assert(offsetof(GaussianStageACounters, visible_count) == 4 * kCounterVisibleIndex);
-static_assert(offsetof(GaussianStageACounters, num_splats) == 4 * kCounterNumSplatsIndex);
-static_assert(offsetof(GaussianStageACounters, requested_entries) == 4);
-static_assert(offsetof(GaussianStageACounters, entry_count) == 4 * kCounterEntriesIndex);
-static_assert(offsetof(GaussianStageACounters, error_flags) == 12);
-static_assert(offsetof(GaussianStageACounters, emit_dispatch_x) == 16);
-static_assert(offsetof(GaussianStageACounters, scan_levels) == 32);
+static_assert(sizeof(GaussianGeometryStageCounters) == 32 + 16 * kScanMaxLevels);
+static_assert(offsetof(GaussianGeometryStageCounters, visible_count) == 4 * kCounterVisibleIndex);
+static_assert(offsetof(GaussianGeometryStageCounters, num_splats) == 4 * kCounterNumSplatsIndex);
+static_assert(offsetof(GaussianGeometryStageCounters, requested_entries) == 4);
+static_assert(offsetof(GaussianGeometryStageCounters, entry_count) == 4 * kCounterEntriesIndex);
+static_assert(offsetof(GaussianGeometryStageCounters, error_flags) == 12);
+static_assert(offsetof(GaussianGeometryStageCounters, emit_dispatch_x) == 16);
+static_assert(offsetof(GaussianGeometryStageCounters, scan_levels) == 32);
 
 static_assert(sizeof(GaussianDispatchArgsPushConstants) == 16);
 static_assert(offsetof(GaussianDispatchArgsPushConstants, num_levels) == 4);
@@ -614,10 +615,11 @@ static_assert(offsetof(GaussianScanPushConstants, write_total) == 16);
 #undef OPEN3D_SHADER_CONST
 #endif  // OPEN3D_SHADERS_GAUSSIAN_SPLAT_CONTRACT_PROJECTION_H
 
-// ---- Composite (Stage B) ----
-// Appended by the composite work (vulkan/GaussianStageB.*, shaders/gaussian_composite*.comp,
-// shaders/gaussian_depth_merge.comp): bindings, push constants, the work-stealing state and
-// the blending thresholds. Kept as its own guarded block like the Stage A section.
+// ---- Composite (composite stage) ----
+// Appended by the composite work (vulkan/GaussianCompositeStage.*,
+// shaders/gaussian_composite*.comp, shaders/gaussian_depth_merge.comp): bindings, push constants,
+// the work-stealing state and the blending thresholds. Kept as its own guarded block like the
+// geometry stage section.
 #ifndef OPEN3D_SHADERS_GAUSSIAN_SPLAT_CONTRACT_COMPOSITE_H
 #define OPEN3D_SHADERS_GAUSSIAN_SPLAT_CONTRACT_COMPOSITE_H
 

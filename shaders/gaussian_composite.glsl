@@ -1,4 +1,4 @@
-// Stage B body shared by gaussian_composite.comp (RGBA32F colour, for readback) and
+// Composite stage body shared by gaussian_composite.comp (RGBA32F colour, for readback) and
 // gaussian_composite_rgba16f.comp (RGBA16F, the Filament overlay): the storage image format
 // must be declared in GLSL (no shaderStorageImageWriteWithoutFormat), so each colour format
 // is its own SPIR-V module that defines OPEN3D_COMPOSITE_COLOR_FORMAT and includes this.

@@ -1,5 +1,5 @@
 #version 460
-// Stage A indirect sizes from GPU-side counts (no CPU readback between passes).
+// Geometry stage indirect sizes from GPU-side counts (no CPU readback between passes).
 // After the projection (packed key only; the exact order's sizes depend on N alone and the
 // host writes them): the scan levels and the emit pass, from the visible count. After the
 // scan: how many entries fit, and the tile sort's parameters (RadixSortParamsFor, what the
@@ -15,17 +15,17 @@ layout(push_constant, std430) uniform PushConstantsBlock {
     GaussianDispatchArgsPushConstants pc;
 };
 
-layout(std430, set = 0, binding = kStageAViewBinding) readonly buffer ViewBlock {
+layout(std430, set = 0, binding = kGeometryStageViewBinding) readonly buffer ViewBlock {
     GaussianViewParams view;
 };
-layout(std430, set = 0, binding = kStageACountersBinding) buffer CountersBlock {
-    GaussianStageACounters counters;
+layout(std430, set = 0, binding = kGeometryStageCountersBinding) buffer CountersBlock {
+    GaussianGeometryStageCounters counters;
 };
-layout(std430, set = 0, binding = kStageAScanBinding) readonly buffer ScanBlock {
+layout(std430, set = 0, binding = kGeometryStageScanBinding) readonly buffer ScanBlock {
     uint scan[];
 };
 #include "gaussian_scan_offset.glsl"
-layout(std430, set = 0, binding = kStageASortParamsBinding) writeonly buffer SortParamsBlock {
+layout(std430, set = 0, binding = kGeometryStageSortParamsBinding) writeonly buffer SortParamsBlock {
     RadixSortParams sort_params;
 };
 

@@ -1,5 +1,5 @@
 #version 460
-// Stage A, tile entries: one invocation per visible splat in list order writes
+// Geometry stage, tile entries: one invocation per visible splat in list order writes
 // (key, splat index) for every tile of its rectangle that TileRowSpan keeps, at its scanned
 // offset. (Sharing splats of 32+ entries across the subgroup measured slower on the H100:
 // 0.071 vs 0.063 ms scan + emit for playbot_125k at 1080p.) A splat whose
@@ -16,26 +16,26 @@ layout(local_size_x = kEmitWorkgroupSize) in;
 
 layout(constant_id = kSpecEmitMode) const uint kEmitMode = kEmitTileKeys;
 
-layout(std430, set = 0, binding = kStageAViewBinding) readonly buffer ViewBlock {
+layout(std430, set = 0, binding = kGeometryStageViewBinding) readonly buffer ViewBlock {
     GaussianViewParams view;
 };
-layout(std430, set = 0, binding = kStageAProjectedBinding) readonly buffer ProjectedBlock {
+layout(std430, set = 0, binding = kGeometryStageProjectedBinding) readonly buffer ProjectedBlock {
     GaussianProjectedSplat projected[];
 };
-layout(std430, set = 0, binding = kStageACountersBinding) readonly buffer CountersBlock {
-    GaussianStageACounters counters;
+layout(std430, set = 0, binding = kGeometryStageCountersBinding) readonly buffer CountersBlock {
+    GaussianGeometryStageCounters counters;
 };
-layout(std430, set = 0, binding = kStageASplatIndexBinding) readonly buffer SplatIndexBlock {
+layout(std430, set = 0, binding = kGeometryStageSplatIndexBinding) readonly buffer SplatIndexBlock {
     uint splat_indices[];
 };
-layout(std430, set = 0, binding = kStageAScanBinding) readonly buffer ScanBlock {
+layout(std430, set = 0, binding = kGeometryStageScanBinding) readonly buffer ScanBlock {
     uint scan[];
 };
 #include "gaussian_scan_offset.glsl"
-layout(std430, set = 0, binding = kStageAEntryKeysBinding) buffer EntryKeysBlock {
+layout(std430, set = 0, binding = kGeometryStageEntryKeysBinding) buffer EntryKeysBlock {
     uint entry_keys[];
 };
-layout(std430, set = 0, binding = kStageAEntryValuesBinding) writeonly buffer EntryValuesBlock {
+layout(std430, set = 0, binding = kGeometryStageEntryValuesBinding) writeonly buffer EntryValuesBlock {
     uint entry_values[];
 };
 

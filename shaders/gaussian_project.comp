@@ -1,5 +1,5 @@
 #version 460
-// Stage A, pass 1: one invocation per splat. Exactly the 3DGS rasterizer's preprocess
+// Geometry stage, pass 1: one invocation per splat. Exactly the 3DGS rasterizer's preprocess
 // (docs/DESIGN.md section 3, mirrored from cpu/Projection.cpp) in float32: near cull,
 // guard-band clamped Jacobian, +0.3 dilation, optional antialias compensation, det == 0
 // cull, 3-sigma radius with the 0.1 eigenvalue floor, tile rectangle, SH colour. Visible
@@ -21,44 +21,44 @@ layout(constant_id = kSpecAntialias) const uint kAntialias = 0u;
 layout(constant_id = kSpecPrecision) const uint kPrecision = kPrecisionExact;
 layout(constant_id = kSpecIndexedList) const uint kIndexedList = 1u;
 
-layout(std430, set = 0, binding = kStageAViewBinding) readonly buffer ViewBlock {
+layout(std430, set = 0, binding = kGeometryStageViewBinding) readonly buffer ViewBlock {
     GaussianViewParams view;
 };
-layout(std430, set = 0, binding = kStageAPositionsBinding) readonly buffer PositionsBlock {
+layout(std430, set = 0, binding = kGeometryStagePositionsBinding) readonly buffer PositionsBlock {
     vec4 positions[];  // xyz, sigmoid(opacity)
 };
-layout(std430, set = 0, binding = kStageAShapeBinding) readonly buffer ShapeBlock {
+layout(std430, set = 0, binding = kGeometryStageShapeBinding) readonly buffer ShapeBlock {
     uint shape[];
 };
-layout(std430, set = 0, binding = kStageAShBinding) readonly buffer ShBlock {
+layout(std430, set = 0, binding = kGeometryStageShBinding) readonly buffer ShBlock {
     uint sh[];
 };
 // The same bindings read in wider loads where the layout is aligned for them: a warp's
 // scalar loads at a 40- or 96-byte stride touch 32 sectors per instruction.
-layout(std430, set = 0, binding = kStageAShBinding) readonly buffer ShBlock4 {
+layout(std430, set = 0, binding = kGeometryStageShBinding) readonly buffer ShBlock4 {
     uvec4 sh4[];
 };
-layout(std430, set = 0, binding = kStageAShapeBinding) readonly buffer ShapeBlock2 {
+layout(std430, set = 0, binding = kGeometryStageShapeBinding) readonly buffer ShapeBlock2 {
     uvec2 shape2[];
 };
-layout(std430, set = 0, binding = kStageAVisibilityBinding) readonly buffer VisibilityBlock {
+layout(std430, set = 0, binding = kGeometryStageVisibilityBinding) readonly buffer VisibilityBlock {
     uint visibility[];
 };
-layout(std430, set = 0, binding = kStageAProjectedBinding) writeonly buffer ProjectedBlock {
+layout(std430, set = 0, binding = kGeometryStageProjectedBinding) writeonly buffer ProjectedBlock {
     GaussianProjectedSplat projected[];
 };
-layout(std430, set = 0, binding = kStageACountersBinding) buffer CountersBlock {
-    GaussianStageACounters counters;
+layout(std430, set = 0, binding = kGeometryStageCountersBinding) buffer CountersBlock {
+    GaussianGeometryStageCounters counters;
 };
-layout(std430, set = 0, binding = kStageADepthKeysBinding) writeonly buffer DepthKeysBlock {
+layout(std430, set = 0, binding = kGeometryStageDepthKeysBinding) writeonly buffer DepthKeysBlock {
     uint depth_keys[];
 };
-layout(std430, set = 0, binding = kStageASplatIndexBinding) writeonly buffer SplatIndexBlock {
+layout(std430, set = 0, binding = kGeometryStageSplatIndexBinding) writeonly buffer SplatIndexBlock {
     uint splat_indices[];
 };
 // The scan gathers these 4 bytes per visible splat in depth order: a dense array stays in
 // the GPU's L2 cache where a field of the 64-byte projected records did not.
-layout(std430, set = 0, binding = kStageATileCountsBinding) writeonly buffer TileCountsBlock {
+layout(std430, set = 0, binding = kGeometryStageTileCountsBinding) writeonly buffer TileCountsBlock {
     uint tile_counts[];
 };
 

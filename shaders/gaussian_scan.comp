@@ -1,5 +1,5 @@
 #version 460
-// Stage A, exclusive prefix sum of the per-splat tile counts in depth order, one level of
+// Geometry stage, exclusive prefix sum of the per-splat tile counts in depth order, one level of
 // a block hierarchy (kScanBlockSize counts per workgroup): exclusive offsets within the
 // block in place and the block's total one level up. There is no down-sweep: readers add
 // the levels above (ScanOffset in gaussian_scan_offset.glsl). Additions saturate at
@@ -19,19 +19,19 @@ layout(push_constant, std430) uniform PushConstantsBlock {
     GaussianScanPushConstants pc;
 };
 
-layout(std430, set = 0, binding = kStageAViewBinding) readonly buffer ViewBlock {
+layout(std430, set = 0, binding = kGeometryStageViewBinding) readonly buffer ViewBlock {
     GaussianViewParams view;
 };
-layout(std430, set = 0, binding = kStageATileCountsBinding) readonly buffer TileCountsBlock {
+layout(std430, set = 0, binding = kGeometryStageTileCountsBinding) readonly buffer TileCountsBlock {
     uint tile_counts[];  // by splat index, written by the projection for visible splats
 };
-layout(std430, set = 0, binding = kStageACountersBinding) buffer CountersBlock {
-    GaussianStageACounters counters;
+layout(std430, set = 0, binding = kGeometryStageCountersBinding) buffer CountersBlock {
+    GaussianGeometryStageCounters counters;
 };
-layout(std430, set = 0, binding = kStageASplatIndexBinding) readonly buffer SplatIndexBlock {
+layout(std430, set = 0, binding = kGeometryStageSplatIndexBinding) readonly buffer SplatIndexBlock {
     uint splat_indices[];
 };
-layout(std430, set = 0, binding = kStageAScanBinding) buffer ScanBlock {
+layout(std430, set = 0, binding = kGeometryStageScanBinding) buffer ScanBlock {
     uint scan[];
 };
 

@@ -1,7 +1,7 @@
 // The tile-count scan's offsets, for the shaders that read them (the emit, the dispatch-args
 // pass) and the scan itself. Included after the `view` and `scan[]` buffer declarations.
 // The scan buffer holds level 0 (the N list slots), then the block sums of every level
-// above (GaussianStageA::GetStorageRequirements). The scan only goes up: each level is
+// above (GaussianGeometryStage::GetStorageRequirements). The scan only goes up: each level is
 // exclusive within its blocks of kScanBlockSize and the top level is whole, so a slot's
 // offset is the sum of its value and its blocks' values on every level above, the sums a
 // down-sweep would have added. That saves the down-sweep's dispatches (22 us of the grid's

@@ -1,5 +1,5 @@
 #version 460
-// Stage B, before the composite: each tile's range [begin, end) of the tile-sorted entries.
+// Composite stage, before the composite: each tile's range [begin, end) of the tile-sorted entries.
 // An entry that starts (ends) a run of equal tile keys writes its tile's begin (end); the
 // recorder zeroed the ranges, so tiles without entries keep the empty range [0, 0). This
 // replaces a binary search per tile in the composite, whose ~20 dependent loads were paid

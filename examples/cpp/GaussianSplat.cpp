@@ -146,7 +146,8 @@ int Run(const Options& opt) {
         "%.2f ms, sort %.2f ms, composite %.2f ms%s\n",
         static_cast<long long>(s.num_visible), static_cast<long long>(s.num_splats),
         static_cast<long long>(s.num_tile_entries), s.gpu_project_ms, s.gpu_sort_ms,
-        s.gpu_composite_ms, s.geometry_reused ? " (stage A reused: the camera did not move)" : "");
+        s.gpu_composite_ms,
+        s.geometry_reused ? " (geometry stage reused: the camera did not move)" : "");
     return 0;
 }
 

@@ -20,7 +20,7 @@
 #include "open3d/core/Timer.h"
 #include "open3d/t/geometry/ImageMetrics.h"
 #include "open3d/t/io/PointCloudIO.h"
-#include "open3d/visualization/rendering/gaussian_splat/GaussianSplatRenderer.h"
+#include "open3d/visualization/rendering/gaussian_splat/GaussianSplatBackend.h"
 #include "open3d/visualization/rendering/gaussian_splat/cpu/CpuBackend.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/GaussianSplatVulkanBackend.h"
 
@@ -121,12 +121,12 @@ struct TimedFrames {
     double cpu_frame_ms = 0.0;   // CPU wall time per frame, submit to fence
 };
 
-// Times `frames` frames (Stage A + Stage B, no readback) after at least kWarmUpSeconds of
-// the same frames, and returns the median of each GPU pass and of the CPU wall time per
-// frame. Frames follow each other with only the submit/fence gap, so a
-// GPU that lowers its clocks when idle (every NVIDIA board does) is timed at full clock:
-// with a readback between frames the H100 ran the same depth sort 2.5-5x slower. (Run
-// loops time everything before the CPU references: see Run.)
+// Times `frames` frames (geometry stage + composite stage, no readback) after at least
+// kWarmUpSeconds of the same frames, and returns the median of each GPU pass and of the CPU wall
+// time per frame. Frames follow each other with only the submit/fence gap, so a GPU that lowers its
+// clocks when idle (every NVIDIA board does) is timed at full clock: with a readback between frames
+// the H100 ran the same depth sort 2.5-5x slower. (Run loops time everything before the CPU
+// references: see Run.)
 TimedFrames RunTimedFrames(rendering::GaussianSplatBackend& backend,
                            const camera::PinholeCamera& camera,
                            const rendering::RenderConfig& config, int frames,

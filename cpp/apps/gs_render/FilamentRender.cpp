@@ -34,7 +34,7 @@ void RenderWithFilament(const t::geometry::PointCloud& cloud, const camera::Pinh
     scene.SetBackground(Eigen::Vector4f(bg.x(), bg.y(), bg.z(), 1.0f));
     scene.SetupCamera(camera);
     scene.GetSplatConfig() = config;
-    // Every frame runs the whole pipeline (Stage A too), so the times are comparable.
+    // Every frame runs the whole pipeline (geometry stage too), so the times are comparable.
     scene.GetSplatConfig().reuse_geometry = options.frames <= 1;
 
     t::geometry::Image image;
@@ -43,9 +43,9 @@ void RenderWithFilament(const t::geometry::PointCloud& cloud, const camera::Pinh
         image = scene.RenderToImage();
         const rendering::FrameTimes& t = scene.GetLastFrame().times;
         if (i == 0 && options.frames > 1) continue;  // shader compilation, first uploads
-        sum.stage_a_ms += t.stage_a_ms;
+        sum.geometry_stage_ms += t.geometry_stage_ms;
         sum.filament_ms += t.filament_ms;
-        sum.stage_b_ms += t.stage_b_ms;
+        sum.composite_stage_ms += t.composite_stage_ms;
         sum.readback_ms += t.readback_ms;
         sum.total_ms += t.total_ms;
     }
@@ -62,11 +62,12 @@ void RenderWithFilament(const t::geometry::PointCloud& cloud, const camera::Pinh
             ? "zero-copy"
             : "host copies");
     std::printf(
-        "frame time (mean of %d): %.2f ms = Stage A %.2f + Filament %.2f + Stage B %.2f + "
+        "frame time (mean of %d): %.2f ms = geometry stage %.2f + Filament %.2f + composite stage "
+        "%.2f + "
         "readback/blend %.2f (GPU: project %.3f, sort %.3f, composite %.3f ms)\n",
-        n, sum.total_ms / n, sum.stage_a_ms / n, sum.filament_ms / n, sum.stage_b_ms / n,
-        sum.readback_ms / n, last.splat_stats.gpu_project_ms, last.splat_stats.gpu_sort_ms,
-        last.splat_stats.gpu_composite_ms);
+        n, sum.total_ms / n, sum.geometry_stage_ms / n, sum.filament_ms / n,
+        sum.composite_stage_ms / n, sum.readback_ms / n, last.splat_stats.gpu_project_ms,
+        last.splat_stats.gpu_sort_ms, last.splat_stats.gpu_composite_ms);
     t::io::WriteImage(options.output, image);
     std::printf("wrote %s\n", options.output.c_str());
     if (!options.depth_output.empty()) {

@@ -1,6 +1,6 @@
 // gs-render's Filament path (--sphere, --filament): the splats and an optional red sphere
-// through the whole integration (Open3DScene: Filament meshes, Vulkan Stage A and B with
-// the depth test, the blend), with the time of each part of the frame.
+// through the whole integration (Open3DScene: Filament meshes, Vulkan geometry and composite stages
+// with the depth test, the blend), with the time of each part of the frame.
 #pragma once
 
 #include <Eigen/Core>
@@ -25,8 +25,8 @@ struct FilamentRenderOptions {
     double depth_scale = 1000.0;
 };
 
-/// Renders and writes the images; prints the frame time split into Stage A, Filament,
-/// Stage B and readback. Throws core::Open3DError (e.g. no X server: run under xvfb-run).
+/// Renders and writes the images; prints the frame time split into geometry stage, Filament,
+/// Composite stage and readback. Throws core::Open3DError (e.g. no X server: run under xvfb-run).
 void RenderWithFilament(const open3d::t::geometry::PointCloud& cloud,
                         const open3d::camera::PinholeCamera& camera,
                         const open3d::visualization::rendering::RenderConfig& config,

@@ -18,7 +18,7 @@
 #include "open3d/t/io/ImageIO.h"
 #include "open3d/t/io/PointCloudIO.h"
 #include "open3d/visualization/rendering/gaussian_splat/DefaultScene.h"
-#include "open3d/visualization/rendering/gaussian_splat/GaussianSplatRenderer.h"
+#include "open3d/visualization/rendering/gaussian_splat/GaussianSplatBackend.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/VulkanBackendRegistry.h"
 
 namespace {

@@ -16,9 +16,9 @@ rendering::FrameTimes Mix(const rendering::FrameTimes& old_value,
                           const rendering::FrameTimes& new_value, double w) {
     auto mix = [w](double a, double b) { return (1.0 - w) * a + w * b; };
     rendering::FrameTimes out;
-    out.stage_a_ms = mix(old_value.stage_a_ms, new_value.stage_a_ms);
+    out.geometry_stage_ms = mix(old_value.geometry_stage_ms, new_value.geometry_stage_ms);
     out.filament_ms = mix(old_value.filament_ms, new_value.filament_ms);
-    out.stage_b_ms = mix(old_value.stage_b_ms, new_value.stage_b_ms);
+    out.composite_stage_ms = mix(old_value.composite_stage_ms, new_value.composite_stage_ms);
     out.compose_ms = mix(old_value.compose_ms, new_value.compose_ms);
     out.readback_ms = mix(old_value.readback_ms, new_value.readback_ms);
     out.total_ms = mix(old_value.total_ms, new_value.total_ms);
@@ -63,9 +63,9 @@ FrameTimeSummary FrameStatistics::Summarize(int64_t warmup) const {
     summary.p90_ms = Percentile(frames, 0.9);
     rendering::FrameTimes& m = summary.mean_parts;
     for (int64_t i = first; i < n; ++i) {
-        m.stage_a_ms += parts_[i].stage_a_ms / summary.frames;
+        m.geometry_stage_ms += parts_[i].geometry_stage_ms / summary.frames;
         m.filament_ms += parts_[i].filament_ms / summary.frames;
-        m.stage_b_ms += parts_[i].stage_b_ms / summary.frames;
+        m.composite_stage_ms += parts_[i].composite_stage_ms / summary.frames;
         m.compose_ms += parts_[i].compose_ms / summary.frames;
         m.readback_ms += parts_[i].readback_ms / summary.frames;
         m.total_ms += parts_[i].total_ms / summary.frames;
@@ -78,10 +78,10 @@ std::string FormatSummary(const FrameTimeSummary& s) {
     const rendering::FrameTimes& m = s.mean_parts;
     return fmt::format(
         "{} frames: frame time mean {:.2f} ms ({:.1f} fps), median {:.2f} ms, p90 {:.2f} ms; "
-        "renderer mean {:.2f} ms (stage A {:.2f}, Filament {:.2f}, stage B {:.2f}, "
+        "renderer mean {:.2f} ms (geometry stage {:.2f}, Filament {:.2f}, composite stage {:.2f}, "
         "compose + present {:.2f})",
-        s.frames, s.mean_ms, 1000.0 / s.mean_ms, s.median_ms, s.p90_ms, m.total_ms, m.stage_a_ms,
-        m.filament_ms, m.stage_b_ms, m.compose_ms);
+        s.frames, s.mean_ms, 1000.0 / s.mean_ms, s.median_ms, s.p90_ms, m.total_ms,
+        m.geometry_stage_ms, m.filament_ms, m.composite_stage_ms, m.compose_ms);
 }
 
 }  // namespace visualization

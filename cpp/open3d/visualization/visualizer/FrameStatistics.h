@@ -38,7 +38,7 @@ private:
     rendering::FrameTimes smoothed_parts_;
 };
 
-/// One line: "N frames: mean X ms (Y fps), median, p90; renderer: stage A .., Filament ..".
+/// One line: "N frames: mean X ms (Y fps), median, p90; renderer: geometry stage .., Filament ..".
 std::string FormatSummary(const FrameTimeSummary& summary);
 
 }  // namespace visualization

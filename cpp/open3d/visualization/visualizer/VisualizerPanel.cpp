@@ -20,16 +20,16 @@ void FrameSection(const Visualizer& vis) {
     const double frame_ms = stats.GetSmoothedFrameMs();
     ImGui::Text("Frame %.1f ms (%.1f fps)", frame_ms, frame_ms > 0.0 ? 1000.0 / frame_ms : 0.0);
     const rendering::FrameTimes& t = stats.GetSmoothedParts();
-    ImGui::Text("Renderer %.1f ms: stage A %.1f", t.total_ms, t.stage_a_ms);
-    ImGui::Text("  Filament %.1f, stage B %.1f, compose %.1f", t.filament_ms, t.stage_b_ms,
-                t.compose_ms);
+    ImGui::Text("Renderer %.1f ms: geometry stage %.1f", t.total_ms, t.geometry_stage_ms);
+    ImGui::Text("  Filament %.1f, composite stage %.1f, compose %.1f", t.filament_ms,
+                t.composite_stage_ms, t.compose_ms);
     const uint32_t flags = vis.GetLastFrame().splat_stats.error_flags;
     if (flags != 0) ImGui::TextColored(kWarning, "GPU error flags 0x%x (see Splats)", flags);
 }
 
 void GpuSection(const Visualizer& vis) {
     const rendering::RenderStats& s = vis.GetLastFrame().splat_stats;
-    if (s.geometry_reused) ImGui::TextDisabled("stage A reused (nothing moved)");
+    if (s.geometry_reused) ImGui::TextDisabled("Geometry stage reused (nothing moved)");
     ImGui::Text("project %.2f ms", s.gpu_project_ms);
     ImGui::Text("sort %.2f ms (depth %.2f,", s.gpu_sort_ms, s.gpu_depth_sort_ms);
     ImGui::Text("  scan+emit %.2f, tiles %.2f)", s.gpu_scan_emit_ms, s.gpu_tile_sort_ms);

@@ -10,7 +10,7 @@
 #include "open3d/core/Exception.h"
 #include "open3d/core/Logging.h"
 #include "open3d/visualization/rendering/gaussian_splat/DefaultScene.h"
-#include "open3d/visualization/rendering/gaussian_splat/GaussianSplatRenderer.h"
+#include "open3d/visualization/rendering/gaussian_splat/GaussianSplatBackend.h"
 #include "open3d/visualization/rendering/gaussian_splat/cpu/CpuBackend.h"
 
 namespace open3d {

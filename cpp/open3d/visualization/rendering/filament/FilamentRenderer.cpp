@@ -75,7 +75,7 @@ FrameResult FilamentRenderer::Draw(FilamentScene& scene, FilamentView& view,
         config.background = Eigen::Vector3d::Zero();             // the overlay stays premultiplied
         scene.GetBackend().RenderGeometryStage(camera, config);  // submitted, not waited for
     }
-    result.times.stage_a_ms = core::MillisecondsSince(t);
+    result.times.geometry_stage_ms = core::MillisecondsSince(t);
 
     t = Clock::now();
     filament::Renderer::ClearOptions clear;
@@ -117,7 +117,7 @@ FrameResult FilamentRenderer::Draw(FilamentScene& scene, FilamentView& view,
     }
     result.linear_depth = std::move(splats.linear_depth);
     result.normalized_depth = std::move(splats.normalized_depth);
-    result.times.stage_b_ms = core::MillisecondsSince(t);
+    result.times.composite_stage_ms = core::MillisecondsSince(t);
 
     view.SetOverlayVisible(result.splats_drawn);
     if (swap_chain != nullptr) {

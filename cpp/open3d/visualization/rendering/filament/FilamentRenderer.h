@@ -1,8 +1,8 @@
 // The frame schedule of docs/DESIGN.md section 5 (docs/filament.md "Frame"):
-//   flushAndWait -> Stage A submit (no CPU wait) -> Filament draws the meshes (colour +
-//   the shared depth) -> flushAndWait -> Stage B (waits for Stage A's fence, tests splats
-//   against the depth, writes the shared RGBA16F) -> the compose view blits the mesh colour
-//   and blends the splat colour over it on a swap chain, and/or the offscreen readback
+//   flushAndWait -> geometry stage submit (no CPU wait) -> Filament draws the meshes (colour +
+//   the shared depth) -> flushAndWait -> composite stage (waits for the geometry stage's fence,
+//   tests splats against the depth, writes the shared RGBA16F) -> the compose view blits the mesh
+//   colour and blends the splat colour over it on a swap chain, and/or the offscreen readback
 //   blends the two on the host.
 #pragma once
 
@@ -46,9 +46,10 @@ struct FrameRequest {
 
 /// Wall-clock parts of a frame in milliseconds (CPU side, including waits).
 struct FrameTimes {
-    double stage_a_ms = 0.0;   ///< Stage A record + submit (and scene/mask uploads)
-    double filament_ms = 0.0;  ///< mesh view render + flushAndWait
-    double stage_b_ms = 0.0;   ///< Stage A fence wait + Stage B (+ GPU depth merge, readback)
+    double geometry_stage_ms = 0.0;  ///< geometry stage record + submit (and scene/mask uploads)
+    double filament_ms = 0.0;        ///< mesh view render + flushAndWait
+    double composite_stage_ms =
+        0.0;  ///< the geometry stage fence wait + composite stage (+ GPU depth merge, readback)
     double compose_ms = 0.0;   ///< swap chain frame (blit + overlay), when drawn
     double readback_ms = 0.0;  ///< mesh colour readPixels + host blend (offscreen)
     double total_ms = 0.0;
@@ -64,7 +65,8 @@ struct FrameResult {
     /// UInt16 [H, W, 1] normalised, 65535 where nothing is.
     t::geometry::Image normalized_depth;
     RenderStats splat_stats;
-    bool splats_drawn = false;      ///< some splat cloud was visible (Stage A and B ran)
+    bool splats_drawn =
+        false;  ///< some splat cloud was visible (geometry and composite stages ran)
     bool scene_depth_used = false;  ///< a mesh was visible, so splats were depth-tested
     FrameTimes times;
 };
@@ -82,7 +84,7 @@ public:
 
     /// One frame of `scene` through `view`. Draws to `swap_chain` when given (the caller
     /// presents it); reads back what `request` asks for. The splat pipeline always runs
-    /// for visible splats (Stage A is reused by the backend when nothing changed).
+    /// for visible splats (geometry stage is reused by the backend when nothing changed).
     FrameResult Draw(FilamentScene& scene, FilamentView& view, const FrameRequest& request,
                      filament::SwapChain* swap_chain = nullptr);
 

@@ -1,6 +1,7 @@
 // The Open3D-style scene API on top of the Filament layer (docs/filament.md "Scene API"):
 // named splat clouds and meshes, a background, a camera, and offscreen RenderToImage /
-// RenderToDepthImage that run the whole frame (meshes, splat Stage A and B, the blend).
+// RenderToDepthImage that run the whole frame (meshes, splat geometry and composite stages, the
+// blend).
 #pragma once
 
 #include <Eigen/Core>

@@ -14,7 +14,7 @@
 #include <string>
 
 #include "open3d/t/geometry/Image.h"
-#include "open3d/visualization/rendering/gaussian_splat/GaussianSplatRenderer.h"
+#include "open3d/visualization/rendering/gaussian_splat/GaussianSplatBackend.h"
 
 namespace filament {
 class Texture;
@@ -83,7 +83,7 @@ public:
     /// DEPTH32F, the mesh view's depth attachment (Filament writes reversed-Z).
     filament::Texture* GetDepthTexture() const { return depth_texture_; }
 
-    /// Stage B of the backend's last geometry stage into the colour image, after Filament
+    /// Composite stage of the backend's last geometry stage into the colour image, after Filament
     /// drew the mesh view and finished (flushAndWait).
     void Composite(GaussianSplatBackend& backend, const SplatCompositeRequest& request,
                    SplatFrame& frame);

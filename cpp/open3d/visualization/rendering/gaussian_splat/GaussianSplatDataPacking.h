@@ -1,4 +1,4 @@
-// CPU-side packing of what the GPU projection reads (docs/vulkan.md (Stage A)): per-splat
+// CPU-side packing of what the GPU projection reads (docs/vulkan.md (geometry stage)): per-splat
 // attribute buffers from a Gaussian splat cloud (once per scene change) and the per-frame
 // GaussianViewParams. No Vulkan here: the layouts are the contract header's, so the CPU,
 // Vulkan and Metal layers all pack the same bytes.
@@ -68,7 +68,7 @@ struct ViewPackingInputs {
     SplatPrecision precision = SplatPrecision::kExact;
     uint32_t sh_words_per_splat = 0;
     uint32_t entry_capacity = 0;       ///< tile entries the caller allocated
-    bool scene_depth_present = false;  ///< a mesh is visible in this view (Stage B)
+    bool scene_depth_present = false;  ///< a mesh is visible in this view (composite stage)
     /// PackedGaussianSplats::center_min / center_max; only RenderConfig::sort_mode ==
     /// kPackedKey32 reads them (PackedSortKeyFar).
     Eigen::Vector3d center_min = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());

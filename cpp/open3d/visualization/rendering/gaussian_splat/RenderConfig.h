@@ -58,13 +58,14 @@ struct RenderConfig {
     /// `compact` (fp16 scale, rotation, colour and SH; <= 140 B/splat at SH degree 3). GPU
     /// backends re-upload the scene when it changes; the CPU reference ignores it.
     bool compact_storage = false;
-    /// GPU backends skip Stage A when the scene, the camera and this config are unchanged
-    /// since the last frame; benchmarks turn it off to time the whole pipeline every frame.
+    /// GPU backends skip the geometry stage when the scene, the camera and this config are
+    /// unchanged since the last frame; benchmarks turn it off to time the whole pipeline every
+    /// frame.
     bool reuse_geometry = true;
 
     /// Throws core::Open3DError for a near plane that is not a positive finite number (a
     /// negative one would keep splats behind the camera, mirrored, and NaN would cull
-    /// every splat). Every backend calls it before Stage A.
+    /// every splat). Every backend calls it before the geometry stage.
     void Validate() const;
 };
 
@@ -83,13 +84,13 @@ struct RenderStats {
     /// GPU time per pass from timestamp queries (GPU backends only; 0 where not measured).
     double gpu_project_ms = 0.0;    ///< projection (+ dispatch arguments)
     double gpu_sort_ms = 0.0;       ///< depth sort, scan, emission and tile sort
-    double gpu_composite_ms = 0.0;  ///< Stage B composite
+    double gpu_composite_ms = 0.0;  ///< composite stage composite
     double gpu_merge_ms = 0.0;      ///< depth merge (offscreen depth readback only)
     /// Parts of gpu_sort_ms: depth sort, scan + entry emission, tile sort.
     double gpu_depth_sort_ms = 0.0, gpu_scan_emit_ms = 0.0, gpu_tile_sort_ms = 0.0;
     /// Bytes the backend keeps on the GPU for the scene between frames (0 for the CPU).
     int64_t gpu_scene_bytes = 0;
-    /// True when Stage A was reused because neither the scene nor the view changed.
+    /// True when geometry stage was reused because neither the scene nor the view changed.
     bool geometry_reused = false;
 };
 

@@ -121,7 +121,7 @@ protected:
             vulkan::VulkanContext::CreateFromBorrowed(handles), entry_capacity);
     }
 
-    // playbot_31k, view 0 at 64x48, set on a fresh backend with Stage A run.
+    // playbot_31k, view 0 at 64x48, set on a fresh backend with geometry stage run.
     std::unique_ptr<GaussianSplatVulkanBackend> PlaybotBackend() {
         t::geometry::PointCloud cloud;
         t::io::ReadPointCloud(DataPath(kScene), cloud);
@@ -205,7 +205,7 @@ TEST_F(Interop, CompositeEqualsTheReadbackPathWithinHalfPrecision) {
     EXPECT_EQ(backend->GetCounters().composites, 2);
 
     // The overlay is premultiplied on black whatever the config's background: Filament
-    // draws the background. Same Stage A (the background does not change it).
+    // draws the background. Same geometry stage (the background does not change it).
     config_.background = Eigen::Vector3d(0.25, 0.5, 0.75);
     backend->RenderGeometryStage(camera_, config_);
     InteropFrame with_background;

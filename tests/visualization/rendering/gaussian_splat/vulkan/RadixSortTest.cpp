@@ -326,9 +326,9 @@ TEST_F(RadixSortTest, ParamsWrittenByTheProducer) {
 }
 
 TEST_F(RadixSortTest, DropMaxKeysSortsOnlyTheKeptPairs) {
-    // Stage A's depth sort: culled slots carry kRadixSortDroppedKey among the visible ones.
+    // Geometry stage's depth sort: culled slots carry kRadixSortDroppedKey among the visible ones.
     // The first pass leaves them out; the kept pairs come out first, stably sorted, and the
-    // params describe them. Cases: 4 passes (as Stage A), odd pass counts (the copy reads
+    // params describe them. Cases: 4 passes (as geometry stage), odd pass counts (the copy reads
     // the kept params), producer-written params, nothing or everything dropped, runs of
     // dropped keys longer than a block, and pairs past the count that must stay out.
     struct DropCase {
@@ -388,7 +388,7 @@ TEST_F(RadixSortTest, DropMaxKeysSortsOnlyTheKeptPairs) {
 }
 
 TEST_F(RadixSortTest, KeyRangeSkipsThePassesItsSpanDoesNotNeed) {
-    // Stage A's depth sort: the first pass finds the kept keys' (min, max), the sort orders
+    // Geometry stage's depth sort: the first pass finds the kept keys' (min, max), the sort orders
     // by key - base (base = min with its low byte cleared) and runs only the passes that
     // span needs; the others get zero workgroups, and an odd count is copied back. Cases:
     // spans of one to four digits, spans that cross a digit boundary of the keys
@@ -464,7 +464,7 @@ TEST_F(RadixSortTest, KeyRangeSkipsThePassesItsSpanDoesNotNeed) {
             ASSERT_EQ(gpu.keys[i], want_keys[i]) << "key " << i << " of " << kept;
             ASSERT_EQ(gpu.values[i], want_values[i]) << "value " << i << " of " << kept;
         }
-        // As Stage A sorts: the values only. The keys are not checked: the last pass that
+        // As geometry stage sorts: the values only. The keys are not checked: the last pass that
         // runs does not write them.
         GpuSortResult values_only =
             Sort(keys, values, c.count, c.num_bits, c.source, drop ? &kept : nullptr,

@@ -4,7 +4,7 @@
 // quaternions, SH coefficients of 1e4, 1x1 / 4096x2 / 8K images), each rendered by the CPU
 // reference and the "vulkan" backend and compared. Every case checks: no NaN or Inf in any
 // output of either renderer, no validation message (the fixture), no device loss (an
-// exception fails the test), the same culled set and tile lists (Stage A compared splat by
+// exception fails the test), the same culled set and tile lists (geometry stage compared splat by
 // splat), the same coverage and median depth per pixel, and colour / expected depth within
 // a tolerance that the comment beside it justifies by the error measured on lavapipe (an
 // H100 fits the same bounds; docs/vulkan.md "Numerical stress suite" has both, and the
@@ -17,7 +17,7 @@
 #include <string>
 #include <vector>
 
-#include "StageAComparison.h"
+#include "GeometryStageComparison.h"
 #include "StressTestScene.h"
 #include "open3d/t/geometry/ImageMetrics.h"
 #include "open3d/visualization/rendering/gaussian_splat/GaussianSplatDataPacking.h"
@@ -30,8 +30,8 @@ namespace tests {
 namespace {
 
 using namespace visualization::rendering;
+using vulkan::GaussianGeometryStageRunner;
 using vulkan::GaussianSplatVulkanBackend;
-using vulkan::GaussianStageARunner;
 using namespace stress;
 
 /// Acceptance bounds of one case (colour PSNR and max abs error, expected depth relative
@@ -55,7 +55,7 @@ protected:
             vulkan::VulkanContext::CreateFromBorrowed(handles));
     }
 
-    /// Renders `cloud` with both backends, checks finiteness and Stage A (culled set, tile
+    /// Renders `cloud` with both backends, checks finiteness and geometry stage (culled set, tile
     /// lists, order) against the reference, the same coverage and median depth at every
     /// pixel, prints one line of the docs table and checks `bounds`.
     void RenderBoth(const std::string& name, const t::geometry::PointCloud& cloud,
@@ -76,10 +76,11 @@ protected:
         }
         EXPECT_EQ(gpu.stats.error_flags, ref.stats.error_flags);
 
-        // Stage A splat by splat and tile by tile (StageAComparison.h): a cull or tile
-        // rectangle may differ only where float32 lands on the other side of a border.
-        GaussianStageARunner runner(Context(), PackGaussianSplatAttrs(cloud), 1u << 20);
-        const StageAComparison a = CompareStageA(cloud, cam, config, runner.Run(cam, config));
+        // Geometry stage splat by splat and tile by tile (GeometryStageComparison.h): a cull or
+        // tile rectangle may differ only where float32 lands on the other side of a border.
+        GaussianGeometryStageRunner runner(Context(), PackGaussianSplatAttrs(cloud), 1u << 20);
+        const GeometryStageComparison a =
+            CompareGeometryStage(cloud, cam, config, runner.Run(cam, config));
         EXPECT_EQ(a.cull_flips_unexplained, 0) << a.Summary();
         EXPECT_EQ(a.errors.radius_off_more, 0) << a.Summary();
         EXPECT_EQ(a.tiles_misordered, 0) << a.Summary();
@@ -132,7 +133,7 @@ protected:
             name.c_str(), cam.width, cam.height, static_cast<long long>(ref.stats.num_visible),
             static_cast<long long>(ref.stats.num_tile_entries), static_cast<long long>(num_tied),
             m.psnr_db, m.max_abs_error, ref_max, depth_rel);
-        std::printf("[stress]   stage A: %s\n", a.Summary().c_str());
+        std::printf("[stress]   geometry stage: %s\n", a.Summary().c_str());
         EXPECT_GE(m.psnr_db, bounds.min_psnr_db);
         EXPECT_LE(m.max_abs_error, bounds.max_abs);
         EXPECT_LE(depth_rel, bounds.max_depth_rel);
@@ -490,18 +491,18 @@ TEST_F(Stress, Resolution1920x1080) {
     RenderBoth("1920x1080", MakeRawCloud(CornerSplats(cam)), cam, bounds);
 }
 
-TEST_F(Stress, Resolution8KStageA) {
+TEST_F(Stress, Resolution8KGeometryStage) {
     // 7680x4320: 480x270 = 129,600 tiles, 17 bits of tile index in the tile sort; the corner
     // splats reach the last tile (129,599). The large splat covers ~100k tiles, more than
-    // max_tiles_per_splat (65,536): dropped and flagged by both. Stage A only: the composite
+    // max_tiles_per_splat (65,536): dropped and flagged by both. Geometry stage only: the composite
     // of 33M pixels takes ~12 s on lavapipe plus ~2 s for the reference (4.5 GB), see
     // DISABLED_Resolution8KFullFrame.
     const camera::PinholeCamera cam = MakeCamera(7680, 4320, 3840.0);
     const t::geometry::PointCloud cloud = MakeRawCloud(CornerSplats(cam));
-    GaussianStageARunner runner(Context(), PackGaussianSplatAttrs(cloud), 1u << 20);
-    const vulkan::StageAReadback gpu = runner.Run(cam, {});
-    const StageAComparison a = CompareStageA(cloud, cam, {}, gpu);
-    std::printf("[stress] 8K Stage A: %s\n", a.Summary().c_str());
+    GaussianGeometryStageRunner runner(Context(), PackGaussianSplatAttrs(cloud), 1u << 20);
+    const vulkan::GeometryStageReadback gpu = runner.Run(cam, {});
+    const GeometryStageComparison a = CompareGeometryStage(cloud, cam, {}, gpu);
+    std::printf("[stress] 8K geometry stage: %s\n", a.Summary().c_str());
     EXPECT_EQ(a.cull_flips, 0) << a.Summary();
     EXPECT_EQ(a.errors.rect_differs, 0) << a.Summary();
     EXPECT_EQ(a.errors.radius_off_more, 0) << a.Summary();

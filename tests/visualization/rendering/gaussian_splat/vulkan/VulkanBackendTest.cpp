@@ -1,5 +1,5 @@
-// The whole Vulkan renderer ("vulkan" backend: Stage A + Stage B + readback) against the
-// CPU reference on real scenes and analytic cases, and the skips it promises (Stage A
+// The whole Vulkan renderer ("vulkan" backend: geometry stage + composite stage + readback) against
+// the CPU reference on real scenes and analytic cases, and the skips it promises (geometry stage
 // reuse). Runs on the fixture's device through borrowed handles, so the fixture's
 // validation check covers it.
 #include <gtest/gtest.h>
@@ -14,8 +14,8 @@
 #include "open3d/t/io/PointCloudIO.h"
 #include "open3d/visualization/rendering/gaussian_splat/DefaultScene.h"
 #include "open3d/visualization/rendering/gaussian_splat/cpu/CpuBackend.h"
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/GaussianGeometryStage.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/GaussianSplatVulkanBackend.h"
-#include "open3d/visualization/rendering/gaussian_splat/vulkan/GaussianStageA.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/RadixSort.h"
 #include "visualization/rendering/gaussian_splat/vulkan/VulkanTestFixture.h"
 
@@ -74,7 +74,7 @@ TEST_F(VulkanBackend, RealScenesMatchTheReference) {
     }
 }
 
-TEST_F(VulkanBackend, UnchangedViewReusesStageAAndGivesTheSameImage) {
+TEST_F(VulkanBackend, UnchangedViewReusesGeometryStageAndGivesTheSameImage) {
     auto backend = MakeBackend();
     const t::geometry::PointCloud cloud = CreateDefaultGaussianSplatScene();
     backend->SetScene(cloud);
@@ -85,7 +85,7 @@ TEST_F(VulkanBackend, UnchangedViewReusesStageAAndGivesTheSameImage) {
     EXPECT_EQ(backend->GetCounters().geometry_reuses, 1);
     EXPECT_TRUE(second.stats.geometry_reused);
     EXPECT_TRUE(first.color.AsTensor() == second.color.AsTensor());
-    // Another view, or reuse switched off, runs Stage A again.
+    // Another view, or reuse switched off, runs the geometry stage again.
     RenderConfig no_reuse;
     no_reuse.reuse_geometry = false;
     backend->Render(cam, no_reuse);
@@ -176,7 +176,7 @@ TEST_F(VulkanBackend, EntryBuffersGrowInsteadOfDroppingEntries) {
 
 TEST_F(VulkanBackend, EntryCapacityStopsAtTheSortLimit) {
     // The config's limit binds below the sort's; above it, RadixSort::kMaxCount does (the scan
-    // saturates later), and Stage A accepts exactly that capacity.
+    // saturates later), and geometry stage accepts exactly that capacity.
     RenderConfig config;
     config.max_tile_entries_total = 1000;
     EXPECT_EQ(GaussianSplatVulkanBackend::MaxEntryCapacity(config), 1000u);
@@ -188,11 +188,11 @@ TEST_F(VulkanBackend, EntryCapacityStopsAtTheSortLimit) {
                   vulkan::RadixSort::kMaxCount);
     }
     const uint32_t bound = GaussianSplatVulkanBackend::MaxEntryCapacity(config);
-    EXPECT_NO_THROW(vulkan::GaussianStageA::GetStorageRequirements(1000, bound));
+    EXPECT_NO_THROW(vulkan::GaussianGeometryStage::GetStorageRequirements(1000, bound));
     EXPECT_NO_THROW(vulkan::RadixSort::GetStorageRequirements(bound));
-    EXPECT_THROW(vulkan::GaussianStageA::GetStorageRequirements(1000, bound + 1),
+    EXPECT_THROW(vulkan::GaussianGeometryStage::GetStorageRequirements(1000, bound + 1),
                  core::Open3DError);
-    EXPECT_THROW(vulkan::GaussianStageA::GetStorageRequirements(bound + 1, 1000),
+    EXPECT_THROW(vulkan::GaussianGeometryStage::GetStorageRequirements(bound + 1, 1000),
                  core::Open3DError);
 }
 

@@ -1,11 +1,11 @@
-// Stage B of the CPU reference: per-tile front-to-back blending with the 3DGS rules
+// Composite stage of the CPU reference: per-tile front-to-back blending with the 3DGS rules
 // (docs/DESIGN.md section 3): the blended values in double precision, the threshold decisions
 // (alpha >= 1/255, the transmittance stop) in float32 as the original rasterizer takes them.
 #pragma once
 
 #include <vector>
 
-#include "open3d/visualization/rendering/gaussian_splat/GaussianSplatRenderer.h"
+#include "open3d/visualization/rendering/gaussian_splat/GaussianSplatBackend.h"
 #include "open3d/visualization/rendering/gaussian_splat/cpu/Projection.h"
 #include "open3d/visualization/rendering/gaussian_splat/cpu/TileLists.h"
 

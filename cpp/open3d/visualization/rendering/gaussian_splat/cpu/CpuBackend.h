@@ -5,7 +5,7 @@
 #include <optional>
 #include <vector>
 
-#include "open3d/visualization/rendering/gaussian_splat/GaussianSplatRenderer.h"
+#include "open3d/visualization/rendering/gaussian_splat/GaussianSplatBackend.h"
 #include "open3d/visualization/rendering/gaussian_splat/cpu/Projection.h"
 #include "open3d/visualization/rendering/gaussian_splat/cpu/TileLists.h"
 
@@ -23,7 +23,7 @@ public:
                              const RenderConfig& config) override;
     void RenderCompositeStage(RenderOutput& output, const CompositeInputs& inputs = {}) override;
 
-    /// Stage A results of the last RenderGeometryStage (empty before the first).
+    /// Geometry stage results of the last RenderGeometryStage (empty before the first).
     const std::vector<ProjectedSplat>& GetProjectedSplats() const { return projected_; }
     const TileLists& GetTileLists() const { return tile_lists_; }
 

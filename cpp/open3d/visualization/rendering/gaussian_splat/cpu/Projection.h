@@ -1,4 +1,4 @@
-// Stage A, step 1 of the CPU reference: per-splat projection, exactly the 3DGS
+// Geometry stage, step 1 of the CPU reference: per-splat projection, exactly the 3DGS
 // rasterizer's preprocess (docs/DESIGN.md section 3), computed in double precision.
 #pragma once
 

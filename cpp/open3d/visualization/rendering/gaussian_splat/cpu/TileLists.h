@@ -1,4 +1,4 @@
-// Stage A, steps 2-3 of the CPU reference: one entry per (tile, splat) pair, sorted by
+// Geometry stage, steps 2-3 of the CPU reference: one entry per (tile, splat) pair, sorted by
 // tile, then by float32 depth, then by splat index (the order a stable radix sort of
 // 3DGS's 64-bit (tile, depth) keys yields when entries are emitted in splat order).
 #pragma once

@@ -120,7 +120,8 @@ struct InteropTargets::Impl {
     }
     void EnsureDepthReadback() {
         if (merged_linear) return;
-        const StageBStorageRequirements need = GaussianStageB::GetStorageRequirements();
+        const CompositeStageStorageRequirements need =
+            GaussianCompositeStage::GetStorageRequirements();
         const VkImageUsageFlags usage = need.image_usage | VK_IMAGE_USAGE_TRANSFER_SRC_BIT;
         merged_linear = Image(context, Width(), Height(), need.scalar_format, usage);
         merged_normalized = Image(context, Width(), Height(), need.normalized_depth_format, usage);
@@ -269,7 +270,7 @@ private:
         params.min_alpha = 0.5f;
         params.scene_depth = SceneDepth();
         frame.timestamps->RecordBegin(cmd, TimedPass::kDepthMerge);
-        frame.stage_b->RecordDepthMerge(cmd, images, params);
+        frame.composite_stage->RecordDepthMerge(cmd, images, params);
         frame.timestamps->RecordEnd(cmd, TimedPass::kDepthMerge);
         const Buffer* buffers[] = {&targets_.linear_readback, &targets_.normalized_readback};
         for (int i = 0; i < 2; ++i) {

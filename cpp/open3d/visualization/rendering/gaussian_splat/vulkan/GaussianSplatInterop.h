@@ -12,7 +12,7 @@
 #include <memory>
 
 #include "open3d/t/geometry/Image.h"
-#include "open3d/visualization/rendering/gaussian_splat/GaussianSplatRenderer.h"
+#include "open3d/visualization/rendering/gaussian_splat/GaussianSplatBackend.h"
 
 namespace open3d {
 namespace visualization {
@@ -112,7 +112,7 @@ struct InteropFrame {
     RenderStats stats;
 };
 
-/// Stage B of `backend`'s last RenderGeometryStage into `targets`, whose size must equal
+/// Composite stage of `backend`'s last RenderGeometryStage into `targets`, whose size must equal
 /// that camera's. Acquires both images from the external queue family and releases them
 /// back in the same command buffer, waits for the fence, then fills `frame`. Entry-buffer
 /// growth and empty-frame skips behave as in RenderCompositeStage. Throws core::Open3DError

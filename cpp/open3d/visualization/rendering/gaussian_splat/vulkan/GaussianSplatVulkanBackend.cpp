@@ -47,7 +47,7 @@ const char* FlagMessage(uint32_t bit) {
     return bit == kEntriesDropped
                ? "tile entries were dropped (a splat touches more than max_tiles_per_splat "
                  "tiles or the entries exceed max_tile_entries_total)"
-               : "Stage A counts were clamped to the allocated tile-entry capacity";
+               : "Geometry stage counts were clamped to the allocated tile-entry capacity";
 }
 
 }  // namespace
@@ -61,20 +61,20 @@ GaussianSplatVulkanBackend::GaussianSplatVulkanBackend(std::unique_ptr<VulkanCon
                                                        uint32_t initial_entry_capacity)
     : context_(std::move(context)),
       pool_(*context_),
-      stage_a_(*context_),
-      stage_b_(*context_),
-      stage_a_timestamps_(*context_),
-      stage_b_timestamps_(*context_),
+      geometry_stage_(*context_),
+      composite_stage_(*context_),
+      geometry_stage_timestamps_(*context_),
+      composite_stage_timestamps_(*context_),
       initial_entry_capacity_(std::max(1u, initial_entry_capacity)) {}
 
 GaussianSplatVulkanBackend::~GaussianSplatVulkanBackend() {
     // Nothing may still run on buffers we are about to free.
-    if (geometry_.in_flight) Wait(*context_, stage_a_fence_.Get());
+    if (geometry_.in_flight) Wait(*context_, geometry_stage_fence_.Get());
 }
 
 void GaussianSplatVulkanBackend::SetScene(const t::geometry::PointCloud& cloud) {
     cloud.ValidateGaussianSplat();
-    if (geometry_.in_flight) Wait(*context_, stage_a_fence_.Get());
+    if (geometry_.in_flight) Wait(*context_, geometry_stage_fence_.Get());
     geometry_ = GeometryState{};
     cloud_ = cloud;
     visibility_mask_.clear();
@@ -84,25 +84,25 @@ void GaussianSplatVulkanBackend::SetScene(const t::geometry::PointCloud& cloud) 
 void GaussianSplatVulkanBackend::UploadScene(SplatPrecision precision) {
     PackedGaussianSplats packed = PackGaussianSplatAttrs(*cloud_, precision);
     if (!visibility_mask_.empty()) packed.visibility = visibility_mask_;
-    stage_a_resources_.UploadScene(*context_, pool_, packed);
+    geometry_stage_resources_.UploadScene(*context_, pool_, packed);
     ++counters_.scene_uploads;
 }
 
 void GaussianSplatVulkanBackend::SetVisibility(const std::vector<uint32_t>& mask) {
     if (!cloud_) core::ThrowError("Vulkan backend: SetVisibility before SetScene");
-    if (geometry_.in_flight) Wait(*context_, stage_a_fence_.Get());
+    if (geometry_.in_flight) Wait(*context_, geometry_stage_fence_.Get());
     geometry_.in_flight = false;
-    stage_a_resources_.UploadVisibility(*context_, pool_, mask);
+    geometry_stage_resources_.UploadVisibility(*context_, pool_, mask);
     visibility_mask_ = mask;
-    geometry_.valid = false;  // hidden splats change Stage A's output
+    geometry_.valid = false;  // hidden splats change geometry stage's output
 }
 
 void GaussianSplatVulkanBackend::ReleaseResources() {
-    if (geometry_.in_flight) Wait(*context_, stage_a_fence_.Get());
+    if (geometry_.in_flight) Wait(*context_, geometry_stage_fence_.Get());
     geometry_ = GeometryState{};
     cloud_.reset();
     visibility_mask_.clear();
-    stage_a_resources_ = StageAResources();
+    geometry_stage_resources_ = GeometryStageResources();
     for (Buffer* buffer :
          {&counters_readback_, &color_readback_, &depth_readback_, &median_readback_}) {
         *buffer = Buffer();
@@ -112,23 +112,24 @@ void GaussianSplatVulkanBackend::ReleaseResources() {
 }
 
 void GaussianSplatVulkanBackend::EnsureViewBuffers(uint32_t entry_capacity) {
-    if (stage_a_resources_.HasView() && entry_capacity <= stage_a_resources_.EntryCapacity()) {
+    if (geometry_stage_resources_.HasView() &&
+        entry_capacity <= geometry_stage_resources_.EntryCapacity()) {
         return;
     }
-    stage_a_resources_.AllocateView(*context_, entry_capacity);
-    counters_readback_ = Buffer(*context_, sizeof(shader::GaussianStageACounters),
+    geometry_stage_resources_.AllocateView(*context_, entry_capacity);
+    counters_readback_ = Buffer(*context_, sizeof(shader::GaussianGeometryStageCounters),
                                 VK_BUFFER_USAGE_TRANSFER_DST_BIT, MemoryUsage::kHostReadback);
 }
 
 void GaussianSplatVulkanBackend::EnsureTargets(uint32_t width, uint32_t height) {
     if (depth_ && width == width_ && height == height_) return;
-    const StageBStorageRequirements need = GaussianStageB::GetStorageRequirements();
+    const CompositeStageStorageRequirements need = GaussianCompositeStage::GetStorageRequirements();
     const VkImageUsageFlags usage =
         need.image_usage | VK_IMAGE_USAGE_TRANSFER_SRC_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT;
     depth_ = Image(*context_, width, height, need.scalar_format, usage);
     alpha_ = Image(*context_, width, height, need.scalar_format, usage);
     median_ = Image(*context_, width, height, need.scalar_format, usage);
-    composite_state_ = Buffer(*context_, GaussianStageB::StateBytes(width, height),
+    composite_state_ = Buffer(*context_, GaussianCompositeStage::StateBytes(width, height),
                               need.state_usage, MemoryUsage::kDevice);
     width_ = width;
     height_ = height;
@@ -136,7 +137,7 @@ void GaussianSplatVulkanBackend::EnsureTargets(uint32_t width, uint32_t height) 
 
 void GaussianSplatVulkanBackend::EnsureReadback(uint32_t width, uint32_t height) {
     if (color_ && color_.GetWidth() == width && color_.GetHeight() == height) return;
-    const VkImageUsageFlags usage = GaussianStageB::GetStorageRequirements().image_usage |
+    const VkImageUsageFlags usage = GaussianCompositeStage::GetStorageRequirements().image_usage |
                                     VK_IMAGE_USAGE_TRANSFER_SRC_BIT |
                                     VK_IMAGE_USAGE_TRANSFER_DST_BIT;
     const auto readback = [&](uint32_t texel_bytes) {
@@ -157,8 +158,8 @@ void GaussianSplatVulkanBackend::RenderGeometryStage(const camera::PinholeCamera
     const auto start = std::chrono::steady_clock::now();
     const SplatPrecision precision =
         config.compact_storage ? SplatPrecision::kCompact : SplatPrecision::kExact;
-    if (precision != stage_a_resources_.Layout().precision) {
-        if (geometry_.in_flight) Wait(*context_, stage_a_fence_.Get());
+    if (precision != geometry_stage_resources_.Layout().precision) {
+        if (geometry_.in_flight) Wait(*context_, geometry_stage_fence_.Get());
         geometry_.in_flight = false;
         UploadScene(precision);
         geometry_.valid = false;
@@ -169,30 +170,31 @@ void GaussianSplatVulkanBackend::RenderGeometryStage(const camera::PinholeCamera
         ++counters_.geometry_reuses;
         return;
     }
-    if (geometry_.in_flight) Wait(*context_, stage_a_fence_.Get());
+    if (geometry_.in_flight) Wait(*context_, geometry_stage_fence_.Get());
 
     EnsureViewBuffers(static_cast<uint32_t>(
         std::min<uint64_t>(MaxEntryCapacity(config), initial_entry_capacity_)));
 
-    const shader::GaussianViewParams params = stage_a_resources_.ViewParams(camera, config);
+    const shader::GaussianViewParams params = geometry_stage_resources_.ViewParams(camera, config);
 
-    stage_a_cmd_ = pool_.Allocate();
-    VkCommandBuffer cmd = stage_a_cmd_.Get();
-    stage_a_cmd_.Begin();
-    stage_a_timestamps_.RecordReset(cmd);
-    stage_a_.Record(cmd, stage_a_resources_.Scene(), stage_a_resources_.View(), params,
-                    &stage_a_timestamps_);
-    // The counters reach the host with Stage A's fence: Stage B can skip an empty frame.
+    geometry_stage_cmd_ = pool_.Allocate();
+    VkCommandBuffer cmd = geometry_stage_cmd_.Get();
+    geometry_stage_cmd_.Begin();
+    geometry_stage_timestamps_.RecordReset(cmd);
+    geometry_stage_.Record(cmd, geometry_stage_resources_.Scene(), geometry_stage_resources_.View(),
+                           params, &geometry_stage_timestamps_);
+    // The counters reach the host with the geometry stage's fence: composite stage can skip an
+    // empty frame.
     RecordMemoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
                         VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, VK_PIPELINE_STAGE_2_COPY_BIT,
                         VK_ACCESS_2_TRANSFER_READ_BIT);
     const VkBufferCopy counters_region{0, 0, counters_readback_.GetSize()};
-    vkCmdCopyBuffer(cmd, stage_a_resources_.counters.Get(), counters_readback_.Get(), 1,
+    vkCmdCopyBuffer(cmd, geometry_stage_resources_.counters.Get(), counters_readback_.Get(), 1,
                     &counters_region);
-    stage_a_cmd_.End();
-    stage_a_fence_ = CreateFence(*context_);
-    // Fire and forget: Stage B (or the next geometry stage) waits on the fence.
-    Submit(*context_, cmd, stage_a_fence_.Get());
+    geometry_stage_cmd_.End();
+    geometry_stage_fence_ = CreateFence(*context_);
+    // Fire and forget: composite stage (or the next geometry stage) waits on the fence.
+    Submit(*context_, cmd, geometry_stage_fence_.Get());
     ++counters_.geometry_runs;
     geometry_.camera = camera;
     geometry_.config = config;
@@ -309,9 +311,9 @@ void GaussianSplatVulkanBackend::RenderCompositeStage(RenderOutput& output,
 
 void GaussianSplatVulkanBackend::WaitForGeometry() {
     if (!geometry_.in_flight) return;
-    Wait(*context_, stage_a_fence_.Get());
+    Wait(*context_, geometry_stage_fence_.Get());
     geometry_.in_flight = false;
-    const std::vector<double> ms = stage_a_timestamps_.ReadMilliseconds();
+    const std::vector<double> ms = geometry_stage_timestamps_.ReadMilliseconds();
     const auto at = [&](TimedPass pass) { return PassMs(ms, pass); };
     RenderStats& t = geometry_.times;
     t.gpu_project_ms = at(TimedPass::kProject);
@@ -334,7 +336,7 @@ RenderStats GaussianSplatVulkanBackend::RenderComposite(CompositeSink& sink) {
     }
     WaitForGeometry();
     EnsureTargets(w, h);
-    shader::GaussianStageACounters gpu_counters{};
+    shader::GaussianGeometryStageCounters gpu_counters{};
     std::memcpy(&gpu_counters, counters_readback_.GetMapped(), sizeof(gpu_counters));
     // Nothing to blend (everything culled or hidden): no composite dispatch, the images are
     // cleared to the background instead.
@@ -348,8 +350,8 @@ RenderStats GaussianSplatVulkanBackend::RenderComposite(CompositeSink& sink) {
     CommandBuffer cmd_buffer = pool_.Allocate();
     VkCommandBuffer cmd = cmd_buffer.Get();
     cmd_buffer.Begin();
-    stage_b_timestamps_.RecordReset(cmd);
-    // Stage A's results (a previous submission, ordered by the fence wait) to compute reads.
+    composite_stage_timestamps_.RecordReset(cmd);
+    // Geometry stage's results (a previous submission, ordered by the fence wait) to compute reads.
     RecordMemoryBarrier(cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_MEMORY_WRITE_BIT,
                         VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_COPY_BIT,
                         VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_TRANSFER_READ_BIT);
@@ -363,8 +365,8 @@ RenderStats GaussianSplatVulkanBackend::RenderComposite(CompositeSink& sink) {
     frame.depth = &depth_;
     frame.alpha = &alpha_;
     frame.median = &median_;
-    frame.stage_b = &stage_b_;
-    frame.timestamps = &stage_b_timestamps_;
+    frame.composite_stage = &composite_stage_;
+    frame.timestamps = &composite_stage_timestamps_;
     // The last frame copied these (readback) or read them in a depth merge.
     for (const Image* image : {&depth_, &alpha_, &median_}) {
         RecordImageBarrier(cmd, image->Get(), VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
@@ -385,14 +387,14 @@ RenderStats GaussianSplatVulkanBackend::RenderComposite(CompositeSink& sink) {
         }
         ++counters_.skipped_composites;
     } else {
-        StageBInputs inputs;
-        inputs.projected = stage_a_resources_.projected.Range();
-        inputs.entry_keys = stage_a_resources_.entry_keys.Range();
-        inputs.entry_values = stage_a_resources_.entry_values.Range();
-        inputs.entry_count = stage_a_resources_.counters.Range(
-            offsetof(shader::GaussianStageACounters, entry_count), sizeof(uint32_t));
-        inputs.entry_capacity = stage_a_resources_.EntryCapacity();
-        StageBTargets targets;
+        CompositeStageInputs inputs;
+        inputs.projected = geometry_stage_resources_.projected.Range();
+        inputs.entry_keys = geometry_stage_resources_.entry_keys.Range();
+        inputs.entry_values = geometry_stage_resources_.entry_values.Range();
+        inputs.entry_count = geometry_stage_resources_.counters.Range(
+            offsetof(shader::GaussianGeometryStageCounters, entry_count), sizeof(uint32_t));
+        inputs.entry_capacity = geometry_stage_resources_.EntryCapacity();
+        CompositeStageTargets targets;
         targets.width = w;
         targets.height = h;
         targets.color_format = color.GetFormat() == ToVkFormat(CompositeColorFormat::kRgba16f)
@@ -402,9 +404,9 @@ RenderStats GaussianSplatVulkanBackend::RenderComposite(CompositeSink& sink) {
         targets.depth = depth_.GetView();
         targets.alpha = alpha_.GetView();
         targets.median_depth = median_.GetView();
-        stage_b_timestamps_.RecordBegin(cmd, TimedPass::kComposite);
-        stage_b_.RecordComposite(cmd, inputs, targets, composite_state_.Range(), params);
-        stage_b_timestamps_.RecordEnd(cmd, TimedPass::kComposite);
+        composite_stage_timestamps_.RecordBegin(cmd, TimedPass::kComposite);
+        composite_stage_.RecordComposite(cmd, inputs, targets, composite_state_.Range(), params);
+        composite_stage_timestamps_.RecordEnd(cmd, TimedPass::kComposite);
     }
     sink.RecordAfter(frame);
     cmd_buffer.End();
@@ -415,10 +417,10 @@ RenderStats GaussianSplatVulkanBackend::RenderComposite(CompositeSink& sink) {
 
     // The allocation, not the config, cut this frame short: grow the entry buffers to what
     // it asked for (plus a quarter, so a moving camera does not regrow every frame) and
-    // render it again. Stage A reported the full request, so one retry suffices.
+    // render it again. Geometry stage reported the full request, so one retry suffices.
     const uint64_t limit = MaxEntryCapacity(geometry_.config);
-    if ((gpu_counters.error_flags & kCountsClamped) && stage_a_resources_.EntryCapacity() < limit &&
-        !growing_) {
+    if ((gpu_counters.error_flags & kCountsClamped) &&
+        geometry_stage_resources_.EntryCapacity() < limit && !growing_) {
         const uint64_t asked = gpu_counters.requested_entries;
         EnsureViewBuffers(static_cast<uint32_t>(std::min<uint64_t>(limit, asked + asked / 4)));
         ++counters_.capacity_growths;
@@ -439,18 +441,18 @@ RenderStats GaussianSplatVulkanBackend::RenderComposite(CompositeSink& sink) {
     warned_flags_ |= gpu_counters.error_flags;
     sink.ReadBack();
 
-    // A reused Stage A did no work this frame: its times stay 0.
+    // A reused geometry stage did no work this frame: its times stay 0.
     RenderStats s = geometry_.reused ? RenderStats{} : geometry_.times;
-    s.num_splats = stage_a_resources_.Layout().num_splats;
+    s.num_splats = geometry_stage_resources_.Layout().num_splats;
     s.num_visible = gpu_counters.visible_count;
     s.num_tile_entries = gpu_counters.entry_count;
     s.error_flags = gpu_counters.error_flags;
     s.geometry_reused = geometry_.reused;
     s.composite_ms = core::MillisecondsSince(start);
-    const std::vector<double> ms = stage_b_timestamps_.ReadMilliseconds();
+    const std::vector<double> ms = composite_stage_timestamps_.ReadMilliseconds();
     s.gpu_composite_ms = empty ? 0.0 : PassMs(ms, TimedPass::kComposite);
     s.gpu_merge_ms = PassMs(ms, TimedPass::kDepthMerge);
-    s.gpu_scene_bytes = static_cast<int64_t>(stage_a_resources_.SceneBytes());
+    s.gpu_scene_bytes = static_cast<int64_t>(geometry_stage_resources_.SceneBytes());
     return s;
 }
 

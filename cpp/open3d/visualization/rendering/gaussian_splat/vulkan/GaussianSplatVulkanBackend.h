@@ -1,9 +1,9 @@
 // The Vulkan compute backend ("vulkan"): uploads a splat scene once, then renders views
-// headless with Stage A (GaussianStageA) and Stage B (GaussianStageB), reads the images
-// back and reports GPU time per pass. Stage A is skipped when the scene, the camera and the
-// config are unchanged (RenderConfig::reuse_geometry). The Filament integration composites
-// into images shared with GL instead (GaussianSplatInterop.h) through the same frame logic
-// (CompositeSink).
+// headless with geometry stage (GaussianGeometryStage) and composite stage
+// (GaussianCompositeStage), reads the images back and reports GPU time per pass. Geometry stage is
+// skipped when the scene, the camera and the config are unchanged (RenderConfig::reuse_geometry).
+// The Filament integration composites into images shared with GL instead (GaussianSplatInterop.h)
+// through the same frame logic (CompositeSink).
 #pragma once
 
 #include <memory>
@@ -11,12 +11,12 @@
 
 #include "open3d/camera/PinholeCamera.h"
 #include "open3d/visualization/rendering/gaussian_splat/GaussianSplatDataPacking.h"
-#include "open3d/visualization/rendering/gaussian_splat/GaussianSplatRenderer.h"
+#include "open3d/visualization/rendering/gaussian_splat/GaussianSplatBackend.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/Buffer.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/Commands.h"
-#include "open3d/visualization/rendering/gaussian_splat/vulkan/GaussianStageA.h"
-#include "open3d/visualization/rendering/gaussian_splat/vulkan/GaussianStageAResources.h"
-#include "open3d/visualization/rendering/gaussian_splat/vulkan/GaussianStageB.h"
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/GaussianCompositeStage.h"
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/GaussianGeometryStage.h"
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/GaussianGeometryStageResources.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/GpuTimestamps.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/Image.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/VulkanBackendRegistry.h"
@@ -29,7 +29,7 @@ namespace vulkan {
 
 /// Where a composite goes and what is recorded around it: the readback images of
 /// RenderCompositeStage, or the images shared with GL of RenderCompositeToInterop. The
-/// backend runs what both share (Stage A wait, counters, empty-frame skip, entry-buffer
+/// backend runs what both share (geometry stage wait, counters, empty-frame skip, entry-buffer
 /// growth and retry, flag warnings, stats) and calls these hooks; a retried frame calls the
 /// Record* hooks again and ReadBack once.
 class CompositeSink {
@@ -48,8 +48,8 @@ public:
         const Image* depth = nullptr;
         const Image* alpha = nullptr;
         const Image* median = nullptr;
-        GaussianStageB* stage_b = nullptr;
-        /// Stage B's query pool, reset for this frame (time the depth merge with it).
+        GaussianCompositeStage* composite_stage = nullptr;
+        /// Composite stage's query pool, reset for this frame (time the depth merge with it).
         const GpuTimestamps* timestamps = nullptr;
     };
 
@@ -99,18 +99,18 @@ public:
     /// Counters that make the skips visible to tests and benchmarks.
     struct Counters {
         int64_t scene_uploads = 0;       ///< packs + uploads of the scene
-        int64_t geometry_runs = 0;       ///< Stage A recorded
-        int64_t geometry_reuses = 0;     ///< Stage A skipped (nothing changed)
-        int64_t composites = 0;          ///< Stage B recorded
+        int64_t geometry_runs = 0;       ///< geometry stage recorded
+        int64_t geometry_reuses = 0;     ///< geometry stage skipped (nothing changed)
+        int64_t composites = 0;          ///< composite stage recorded
         int64_t capacity_growths = 0;    ///< frames re-rendered with larger entry buffers
         int64_t skipped_composites = 0;  ///< frames with no tile entry: images cleared instead
     };
     const Counters& GetCounters() const { return counters_; }
     const VulkanContext& GetContext() const { return *context_; }
 
-    /// Stage B of the last geometry stage into `sink` (RenderCompositeStage and
+    /// Composite stage of the last geometry stage into `sink` (RenderCompositeStage and
     /// RenderCompositeToInterop); returns the frame's stats. Throws core::Open3DError when no
-    /// geometry stage ran or the sink's colour target is not the camera's size.
+    /// Geometry stage ran or the sink's colour target is not the camera's size.
     RenderStats RenderComposite(CompositeSink& sink);
 
 private:
@@ -124,39 +124,39 @@ private:
 
     std::unique_ptr<VulkanContext> context_;
     CommandPool pool_;
-    GaussianStageA stage_a_;
-    GaussianStageB stage_b_;
-    GpuTimestamps stage_a_timestamps_;
-    GpuTimestamps stage_b_timestamps_;
+    GaussianGeometryStage geometry_stage_;
+    GaussianCompositeStage composite_stage_;
+    GpuTimestamps geometry_stage_timestamps_;
+    GpuTimestamps composite_stage_timestamps_;
     Counters counters_;
 
     // The scene: kept on the CPU to re-pack when the storage precision changes.
     std::optional<t::geometry::PointCloud> cloud_;
     std::vector<uint32_t> visibility_mask_;
-    StageAResources stage_a_resources_;
+    GeometryStageResources geometry_stage_resources_;
     Buffer counters_readback_;
     Buffer composite_state_;
 
-    // Stage B's R32F images (every composite; alpha is for the interop's depth merge),
+    // Composite stage's R32F images (every composite; alpha is for the interop's depth merge),
     // RenderCompositeStage's RGBA32F colour and the readback buffers of what it returns.
     uint32_t width_ = 0, height_ = 0;
     Image depth_, alpha_, median_;
     Image color_;
     Buffer color_readback_, depth_readback_, median_readback_;
 
-    // The last Stage A: what it rendered, and its command buffer while in flight.
+    // The last geometry stage: what it rendered, and its command buffer while in flight.
     struct GeometryState {
         camera::PinholeCamera camera;
         RenderConfig config;
         bool valid = false;
         bool in_flight = false;
         bool reused = false;
-        /// Stage A's times as a frame reports them: geometry_ms, gpu_project_ms,
+        /// Geometry stage's times as a frame reports them: geometry_ms, gpu_project_ms,
         /// gpu_sort_ms and its parts (the rest stays 0).
         RenderStats times;
     } geometry_;
-    CommandBuffer stage_a_cmd_;
-    UniqueFence stage_a_fence_;
+    CommandBuffer geometry_stage_cmd_;
+    UniqueFence geometry_stage_fence_;
     uint32_t warned_flags_ = 0;
     uint32_t initial_entry_capacity_ = 0;
     bool growing_ = false;

@@ -20,11 +20,12 @@ class VulkanContext;
 
 /// The passes the renderer times (indices into GpuTimestamps).
 enum class TimedPass : uint32_t {
-    kProject = 0,  ///< Stage A up to the visible list
-    kSort,         ///< Stage A's sorts, scan and emit
+    kProject = 0,  ///< geometry stage up to the visible list
+    kSort,         ///< geometry stage's sorts, scan and emit
     kComposite,
     kDepthMerge,
-    // Parts of kSort, for profiling (GaussianStageA::Record times them when given timestamps).
+    // Parts of kSort, for profiling (GaussianGeometryStage::Record times them when given
+    // timestamps).
     kDepthSort,  ///< the depth sort of the visible list
     kScanEmit,   ///< tile-count scan, capacity check and entry emission
     kTileSort,   ///< the stable sort of the entries by tile

@@ -85,7 +85,7 @@ public:
     /// Their number is read on the GPU at `kept_count` by a setup dispatch after the first
     /// pass; the caller counts them (it must be the number of other keys among the first
     /// `count` pairs). Afterwards the first kept_count pairs are the sorted kept pairs;
-    /// what lies past them is unspecified. Stage A drops its culled splats this way, so
+    /// what lies past them is unspecified. Geometry stage drops its culled splats this way, so
     /// three of the depth sort's four passes see only the visible ones.
     struct DropMaxKeys {
         BufferRange kept_count;  // uint written on the GPU; 4-byte alignment is enough
@@ -97,7 +97,7 @@ public:
     /// and only the passes up to the highest non-zero digit of max - base run: a setup
     /// dispatch after the first pass gives the others zero workgroups and copies an odd
     /// number of passes back to `keys` and `values`. `scratch.params` then has key_min,
-    /// key_max and range_passes. Stage A's depth keys (float bits) of a frame whose
+    /// key_max and range_passes. Geometry stage's depth keys (float bits) of a frame whose
     /// farthest visible splat is less than 2 to 4 times as far as the nearest span less
     /// than 2^24: three passes instead of four.
     enum class PassCount {
@@ -107,7 +107,7 @@ public:
 
     /// What the caller reads afterwards. kValuesOnly: the keys are left unspecified, and
     /// the last pass that runs and the copy write no keys (but the first pass of a
-    /// kFromKeyRange sort, which runs before the range is known). Stage A's depth sort
+    /// kFromKeyRange sort, which runs before the range is known). Geometry stage's depth sort
     /// reads only the splat indices (docs/vulkan.md has the time).
     enum class Output {
         kKeysAndValues,

@@ -4,7 +4,7 @@
 
 #include <cstdint>
 
-#include "open3d/visualization/rendering/gaussian_splat/GaussianSplatRenderer.h"
+#include "open3d/visualization/rendering/gaussian_splat/GaussianSplatBackend.h"
 
 namespace open3d {
 namespace visualization {

@@ -1,4 +1,4 @@
-#include "open3d/visualization/rendering/gaussian_splat/vulkan/GaussianStageA.h"
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/GaussianGeometryStage.h"
 
 #include <algorithm>
 #include <bit>
@@ -18,8 +18,8 @@ namespace {
 
 using namespace shader;  // the contract's constants and structs
 
-static_assert(offsetof(GaussianStageACounters, emit_dispatch_x) % 4 == 0 &&
-                  offsetof(GaussianStageACounters, scan_levels) % 4 == 0,
+static_assert(offsetof(GaussianGeometryStageCounters, emit_dispatch_x) % 4 == 0 &&
+                  offsetof(GaussianGeometryStageCounters, scan_levels) % 4 == 0,
               "indirect dispatch arguments need 4-byte offsets");
 static_assert(offsetof(GaussianScanLevel, dispatch_x) == offsetof(VkDispatchIndirectCommand, x));
 static_assert(sizeof(GaussianViewParams) <= 65536, "vkCmdUpdateBuffer limit");
@@ -28,7 +28,7 @@ VkDeviceSize Words(uint64_t n) { return VkDeviceSize(std::max<uint64_t>(n, 1)) *
 
 uint32_t DivCeil(uint64_t a, uint64_t b) { return static_cast<uint32_t>((a + b - 1) / b); }
 
-// Everything a Stage A dispatch may read next: storage data and indirect arguments.
+// Everything a geometry stage dispatch may read next: storage data and indirect arguments.
 void ComputeBarrier(VkCommandBuffer cmd) {
     RecordMemoryBarrier(
         cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
@@ -40,8 +40,9 @@ void ComputeBarrier(VkCommandBuffer cmd) {
 
 }  // namespace
 
-GaussianStageA::GaussianStageA(const VulkanContext& context) : context_(context), sort_(context) {
-    set_layout_ = CreateStorageBufferPushLayout(context, kStageANumBindings);
+GaussianGeometryStage::GaussianGeometryStage(const VulkanContext& context)
+    : context_(context), sort_(context) {
+    set_layout_ = CreateStorageBufferPushLayout(context, kGeometryStageNumBindings);
     const uint32_t push_bytes = static_cast<uint32_t>(
         std::max(sizeof(GaussianScanPushConstants), sizeof(GaussianDispatchArgsPushConstants)));
     pipeline_layout_ = CreatePipelineLayout(context, set_layout_.Get(), push_bytes);
@@ -67,16 +68,17 @@ GaussianStageA::GaussianStageA(const VulkanContext& context) : context_(context)
                                          "gaussian_emit (unpack keys)", &unpack_info);
 }
 
-StageAStorageRequirements GaussianStageA::GetStorageRequirements(uint32_t num_splats,
-                                                                 uint32_t entry_capacity) {
+GeometryStageStorageRequirements GaussianGeometryStage::GetStorageRequirements(
+    uint32_t num_splats, uint32_t entry_capacity) {
     if (num_splats > RadixSort::kMaxCount || entry_capacity > RadixSort::kMaxCount) {
-        core::ThrowError("GaussianStageA: {} splats / {} tile entries exceed the sort limit {}",
-                         num_splats, entry_capacity, RadixSort::kMaxCount);
+        core::ThrowError(
+            "GaussianGeometryStage: {} splats / {} tile entries exceed the sort limit {}",
+            num_splats, entry_capacity, RadixSort::kMaxCount);
     }
-    StageAStorageRequirements r;
+    GeometryStageStorageRequirements r;
     r.view_params_bytes = sizeof(GaussianViewParams);
     r.projected_bytes = VkDeviceSize(std::max(num_splats, 1u)) * sizeof(GaussianProjectedSplat);
-    r.counters_bytes = sizeof(GaussianStageACounters);
+    r.counters_bytes = sizeof(GaussianGeometryStageCounters);
     r.depth_keys_bytes = Words(num_splats);
     r.splat_indices_bytes = Words(num_splats);
     r.tile_counts_bytes = Words(num_splats);
@@ -98,8 +100,8 @@ StageAStorageRequirements GaussianStageA::GetStorageRequirements(uint32_t num_sp
     return r;
 }
 
-VkPipeline GaussianStageA::GetProjectPipeline(uint32_t sh_degree, bool antialias,
-                                              SplatPrecision precision, bool indexed_list) {
+VkPipeline GaussianGeometryStage::GetProjectPipeline(uint32_t sh_degree, bool antialias,
+                                                     SplatPrecision precision, bool indexed_list) {
     const uint32_t precision_value =
         precision == SplatPrecision::kExact ? kPrecisionExact : kPrecisionCompact;
     const uint32_t key =
@@ -118,36 +120,39 @@ VkPipeline GaussianStageA::GetProjectPipeline(uint32_t sh_degree, bool antialias
     return project_.emplace(key, std::move(pipeline)).first->second.Get();
 }
 
-void GaussianStageA::PushBindings(VkCommandBuffer cmd, const StageASceneBuffers& scene,
-                                  const StageAViewBuffers& buffers) const {
-    const std::array<const BufferRange*, kStageANumBindings> ranges{&buffers.view_params,
-                                                                    &scene.positions,
-                                                                    &scene.shape,
-                                                                    &scene.sh,
-                                                                    &scene.visibility,
-                                                                    &buffers.projected,
-                                                                    &buffers.counters,
-                                                                    &buffers.depth_keys,
-                                                                    &buffers.splat_indices,
-                                                                    &buffers.scan,
-                                                                    &buffers.entry_keys,
-                                                                    &buffers.entry_values,
-                                                                    &buffers.sort_scratch.params,
-                                                                    &buffers.tile_counts};
-    static_assert(kStageAViewBinding == 0 && kStageAPositionsBinding == 1 &&
-                      kStageAShapeBinding == 2 && kStageAShBinding == 3 &&
-                      kStageAVisibilityBinding == 4 && kStageAProjectedBinding == 5 &&
-                      kStageACountersBinding == 6 && kStageADepthKeysBinding == 7 &&
-                      kStageASplatIndexBinding == 8 && kStageAScanBinding == 9 &&
-                      kStageAEntryKeysBinding == 10 && kStageAEntryValuesBinding == 11 &&
-                      kStageASortParamsBinding == 12 && kStageATileCountsBinding == 13,
-                  "ranges above are listed in binding order");
-    std::array<VkDescriptorBufferInfo, kStageANumBindings> infos{};
-    std::array<VkWriteDescriptorSet, kStageANumBindings> writes{};
-    for (uint32_t i = 0; i < kStageANumBindings; ++i) {
+void GaussianGeometryStage::PushBindings(VkCommandBuffer cmd,
+                                         const GeometryStageSceneBuffers& scene,
+                                         const GeometryStageViewBuffers& buffers) const {
+    const std::array<const BufferRange*, kGeometryStageNumBindings> ranges{
+        &buffers.view_params,
+        &scene.positions,
+        &scene.shape,
+        &scene.sh,
+        &scene.visibility,
+        &buffers.projected,
+        &buffers.counters,
+        &buffers.depth_keys,
+        &buffers.splat_indices,
+        &buffers.scan,
+        &buffers.entry_keys,
+        &buffers.entry_values,
+        &buffers.sort_scratch.params,
+        &buffers.tile_counts};
+    static_assert(
+        kGeometryStageViewBinding == 0 && kGeometryStagePositionsBinding == 1 &&
+            kGeometryStageShapeBinding == 2 && kGeometryStageShBinding == 3 &&
+            kGeometryStageVisibilityBinding == 4 && kGeometryStageProjectedBinding == 5 &&
+            kGeometryStageCountersBinding == 6 && kGeometryStageDepthKeysBinding == 7 &&
+            kGeometryStageSplatIndexBinding == 8 && kGeometryStageScanBinding == 9 &&
+            kGeometryStageEntryKeysBinding == 10 && kGeometryStageEntryValuesBinding == 11 &&
+            kGeometryStageSortParamsBinding == 12 && kGeometryStageTileCountsBinding == 13,
+        "ranges above are listed in binding order");
+    std::array<VkDescriptorBufferInfo, kGeometryStageNumBindings> infos{};
+    std::array<VkWriteDescriptorSet, kGeometryStageNumBindings> writes{};
+    for (uint32_t i = 0; i < kGeometryStageNumBindings; ++i) {
         const BufferRange& range = *ranges[i];
         if (range.buffer == VK_NULL_HANDLE) {
-            core::ThrowError("GaussianStageA: binding {} has no buffer", i);
+            core::ThrowError("GaussianGeometryStage: binding {} has no buffer", i);
         }
         infos[i] = {range.buffer, range.offset, range.size};
         writes[i].sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET;
@@ -157,23 +162,24 @@ void GaussianStageA::PushBindings(VkCommandBuffer cmd, const StageASceneBuffers&
         writes[i].pBufferInfo = &infos[i];
     }
     context_.GetCmdPushDescriptorSet()(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_layout_.Get(),
-                                       0, kStageANumBindings, writes.data());
+                                       0, kGeometryStageNumBindings, writes.data());
 }
 
-void GaussianStageA::Record(VkCommandBuffer cmd, const StageASceneBuffers& scene,
-                            const StageAViewBuffers& buffers, const GaussianViewParams& params,
-                            const GpuTimestamps* timestamps) {
+void GaussianGeometryStage::Record(VkCommandBuffer cmd, const GeometryStageSceneBuffers& scene,
+                                   const GeometryStageViewBuffers& buffers,
+                                   const GaussianViewParams& params,
+                                   const GpuTimestamps* timestamps) {
     if (timestamps) timestamps->RecordBegin(cmd, TimedPass::kProject);
     const uint32_t n = scene.num_splats;
     const uint32_t capacity = params.flags.w;  // entries allocated
     const bool packed_key = UsesPackedSortKey(params);
     if (params.scene.x != n || params.limits.x > capacity) {
         core::ThrowError(
-            "GaussianStageA: view parameters for {} splats / capacity {} do not "
+            "GaussianGeometryStage: view parameters for {} splats / capacity {} do not "
             "match the scene ({} splats)",
             params.scene.x, params.limits.x, n);
     }
-    const StageAStorageRequirements need = GetStorageRequirements(n, capacity);
+    const GeometryStageStorageRequirements need = GetStorageRequirements(n, capacity);
     const VkPipelineLayout layout = pipeline_layout_.Get();
     const VkBuffer counters = buffers.counters.buffer;
     const VkDeviceSize counters_offset = buffers.counters.offset;
@@ -189,7 +195,7 @@ void GaussianStageA::Record(VkCommandBuffer cmd, const StageASceneBuffers& scene
     // run over all N slots of the depth-sorted list (culled splats sort last and count no
     // tiles), so their sizes and the depth sort's parameters are known here: no
     // dispatch-args pass between the projection and the sort.
-    GaussianStageACounters initial_counters{};
+    GaussianGeometryStageCounters initial_counters{};
     initial_counters.num_splats = n;
     if (!packed_key) {
         initial_counters.emit_dispatch_x = DivCeil(n, kEmitWorkgroupSize);
@@ -276,7 +282,8 @@ void GaussianStageA::Record(VkCommandBuffer cmd, const StageASceneBuffers& scene
         scan.write_total = level + 1 == need.num_scan_levels ? 1u : 0u;
         vkCmdPushConstants(cmd, layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(scan), &scan);
         vkCmdDispatchIndirect(cmd, counters,
-                              counters_offset + offsetof(GaussianStageACounters, scan_levels) +
+                              counters_offset +
+                                  offsetof(GaussianGeometryStageCounters, scan_levels) +
                                   level * sizeof(GaussianScanLevel));
         ComputeBarrier(cmd);
     }
@@ -292,7 +299,7 @@ void GaussianStageA::Record(VkCommandBuffer cmd, const StageASceneBuffers& scene
     // 6. Emit (tile, splat) entries in list order at the scanned offsets: tile keys in
     // depth order, or packed (tile, truncated depth) keys.
     const VkDeviceSize emit_args =
-        counters_offset + offsetof(GaussianStageACounters, emit_dispatch_x);
+        counters_offset + offsetof(GaussianGeometryStageCounters, emit_dispatch_x);
     vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE,
                       packed_key ? emit_packed_.Get() : emit_.Get());
     vkCmdDispatchIndirect(cmd, counters, emit_args);

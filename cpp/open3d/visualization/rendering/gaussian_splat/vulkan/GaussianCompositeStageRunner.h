@@ -1,8 +1,8 @@
-// A small synchronous driver around GaussianStageB for tests and tools: it uploads host
+// A small synchronous driver around GaussianCompositeStage for tests and tools: it uploads host
 // arrays (projected splats, tile-sorted entries, an optional reversed-Z scene depth), records
 // the composite (and optionally the depth merge) with GPU timestamps, submits, waits on the
-// fence and reads every image back. Stage B can so be tested without Stage A. Frames of the
-// real backend record into their own command buffers and do not wait.
+// fence and reads every image back. Composite stage can so be tested without geometry stage. Frames
+// of the real backend record into their own command buffers and do not wait.
 #pragma once
 
 #include <array>
@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/Commands.h"
-#include "open3d/visualization/rendering/gaussian_splat/vulkan/GaussianStageB.h"
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/GaussianCompositeStage.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/GpuTimestamps.h"
 #include "shaders/GaussianSplatContract.h"
 
@@ -19,7 +19,7 @@ namespace visualization {
 namespace rendering {
 namespace vulkan {
 
-struct StageBRunInputs {
+struct CompositeStageRunInputs {
     uint32_t width = 0;
     uint32_t height = 0;
     std::vector<shader::GaussianProjectedSplat> projected;  // [N]
@@ -43,7 +43,7 @@ struct StageBRunInputs {
 };
 
 /// What one run produced, row-major, row 0 on top.
-struct StageBReadback {
+struct CompositeStageReadback {
     std::vector<float> color;                 // [H, W, 4] (RGBA16F read back as float)
     std::vector<float> depth;                 // [H, W]
     std::vector<float> alpha;                 // [H, W]
@@ -55,17 +55,17 @@ struct StageBReadback {
     double wall_ms = 0.0;  ///< submit to fence
 };
 
-class GaussianStageBRunner {
+class GaussianCompositeStageRunner {
 public:
-    explicit GaussianStageBRunner(const VulkanContext& context);
+    explicit GaussianCompositeStageRunner(const VulkanContext& context);
 
     /// Allocates, uploads, records, submits, waits and reads back. Throws on bad input.
-    StageBReadback Run(const StageBRunInputs& inputs);
+    CompositeStageReadback Run(const CompositeStageRunInputs& inputs);
 
 private:
     const VulkanContext& context_;
     CommandPool pool_;
-    GaussianStageB stage_b_;
+    GaussianCompositeStage composite_stage_;
     GpuTimestamps timestamps_;
 };
 

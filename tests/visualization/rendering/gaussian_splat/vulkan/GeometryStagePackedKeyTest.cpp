@@ -17,7 +17,7 @@
 #include "open3d/camera/CamerasJson.h"
 #include "open3d/t/io/PointCloudIO.h"
 #include "open3d/visualization/rendering/gaussian_splat/GaussianSplatDataPacking.h"
-#include "open3d/visualization/rendering/gaussian_splat/vulkan/GaussianStageARunner.h"
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/GaussianGeometryStageRunner.h"
 #include "shaders/GaussianSplatContract.h"
 #include "visualization/rendering/gaussian_splat/cpu/SplatTestScene.h"
 #include "visualization/rendering/gaussian_splat/vulkan/VulkanTestFixture.h"
@@ -29,8 +29,8 @@ namespace {
 using namespace visualization::rendering;
 using shader::PackedSortKey;
 using shader::PackedSortKeyDepth;
-using visualization::rendering::vulkan::GaussianStageARunner;
-using visualization::rendering::vulkan::StageAReadback;
+using visualization::rendering::vulkan::GaussianGeometryStageRunner;
+using visualization::rendering::vulkan::GeometryStageReadback;
 
 // Tile bits the view parameters carry for an image size (what the GPU key uses).
 uint32_t TileBitsFor(int width, int height) {
@@ -41,7 +41,7 @@ uint32_t TileBitsFor(int width, int height) {
     return PackGaussianViewParams(MakeTestCamera(width, height), config, inputs).limits.w;
 }
 
-TEST(StageAPackedKey, TileAndDepthBitsAtCommonResolutions) {
+TEST(GeometryStagePackedKey, TileAndDepthBitsAtCommonResolutions) {
     // The seed's table (16x16 tiles): 1080p 8160 tiles, 4K 32400, 8K 129600 (256x256: 256
     // tiles and the filler key need 9 bits). Of the D
     // depth bits, 8 hold the float exponent, so D - 8 mantissa bits resolve depth.
@@ -59,7 +59,7 @@ TEST(StageAPackedKey, TileAndDepthBitsAtCommonResolutions) {
     }
 }
 
-TEST(StageAPackedKey, TileBitsAtExactPowersOfTwo) {
+TEST(GeometryStagePackedKey, TileBitsAtExactPowersOfTwo) {
     // Keys 0 .. n: the n tile indices and the filler key n (gaussian_emit.comp).
     EXPECT_EQ(SortKeyTileBits(0), 1u);  // clamped to kSortKeyMinTileBits
     EXPECT_EQ(SortKeyTileBits(1), 1u);
@@ -74,7 +74,7 @@ TEST(StageAPackedKey, TileBitsAtExactPowersOfTwo) {
     EXPECT_EQ(SortKeyTileBits(uint64_t(1) << 40), 31u);  // clamped to kSortKeyMaxTileBits
 }
 
-TEST(StageAPackedKey, KeyLayoutForEveryTileBitCount) {
+TEST(GeometryStagePackedKey, KeyLayoutForEveryTileBitCount) {
     const float one = 1.0f;
     for (uint32_t t = shader::kSortKeyMinTileBits; t <= shader::kSortKeyMaxTileBits; ++t) {
         const uint32_t d = shader::kSortKeyBits - t;
@@ -101,7 +101,7 @@ TEST(StageAPackedKey, KeyLayoutForEveryTileBitCount) {
     }
 }
 
-TEST(StageAPackedKey, KeysAscendWithDepthAndTieOnlyWithinTheTruncation) {
+TEST(GeometryStagePackedKey, KeysAscendWithDepthAndTieOnlyWithinTheTruncation) {
     std::mt19937 rng(7);
     std::uniform_real_distribution<float> uniform(0.0f, 1.0f);
     std::vector<float> depths(20000);
@@ -128,7 +128,7 @@ TEST(StageAPackedKey, KeysAscendWithDepthAndTieOnlyWithinTheTruncation) {
     }
 }
 
-TEST(StageAPackedKey, NormalisedDepthClampsAndMatchesTheFormula) {
+TEST(GeometryStagePackedKey, NormalisedDepthClampsAndMatchesTheFormula) {
     const float near_plane = 0.2f, scale = 1.0f / 9.8f;
     EXPECT_EQ(PackedSortKeyDepth(0.1f, near_plane, scale), 0.0f);
     EXPECT_EQ(PackedSortKeyDepth(0.2f, near_plane, scale), 0.0f);
@@ -140,7 +140,7 @@ TEST(StageAPackedKey, NormalisedDepthClampsAndMatchesTheFormula) {
     EXPECT_NEAR(expected, (3.7 - 0.2) / 9.8, 1e-6);
 }
 
-TEST(StageAPackedKey, FarPlaneFromTheCentreBox) {
+TEST(GeometryStagePackedKey, FarPlaneFromTheCentreBox) {
     // Camera at the origin looking down +z (MakeTestCamera): view z = world z.
     const auto cam = MakeTestCamera(64, 64);
     const Eigen::Vector3d lo(-1, -2, 3), hi(4, 1, 8);
@@ -192,14 +192,14 @@ int64_t CountInversions(std::vector<uint64_t> ranks) {
     return inversions;
 }
 
-class StageAPackedKeyScene : public VulkanTest {
+class GeometryStagePackedKeyScene : public VulkanTest {
 protected:
     // Runs playbot_31k view 0 at width x height in both modes, checks the packed order
     // against the exact one and reports how far they part.
     void CompareModes(int width, int height);
 };
 
-TEST_F(StageAPackedKeyScene, SameEntriesPerTileAndSwapsOnlyWithinEqualKeys) {
+TEST_F(GeometryStagePackedKeyScene, SameEntriesPerTileAndSwapsOnlyWithinEqualKeys) {
     OPEN3D_REQUIRE_DATA("playbot/playbot_31k.ply");
     OPEN3D_REQUIRE_DATA("playbot/cameras.json");
     CompareModes(256, 256);
@@ -207,20 +207,20 @@ TEST_F(StageAPackedKeyScene, SameEntriesPerTileAndSwapsOnlyWithinEqualKeys) {
 
 // The truncation the option exists to measure: 11 mantissa bits of depth at 1080p.
 // About 7 s on lavapipe (1.6M entries), so run on demand: --gtest_also_run_disabled_tests.
-TEST_F(StageAPackedKeyScene, DISABLED_At1080p) {
+TEST_F(GeometryStagePackedKeyScene, DISABLED_At1080p) {
     OPEN3D_REQUIRE_DATA("playbot/playbot_31k.ply");
     OPEN3D_REQUIRE_DATA("playbot/cameras.json");
     CompareModes(1920, 1080);
 }
 
-void StageAPackedKeyScene::CompareModes(int width, int height) {
+void GeometryStagePackedKeyScene::CompareModes(int width, int height) {
     t::geometry::PointCloud cloud;
     t::io::ReadPointCloud(DataPath("playbot/playbot_31k.ply"), cloud);
     const auto cam = camera::ReadCamerasJson(DataPath("playbot/cameras.json"))
                          .at(0)
                          .camera.Resized(width, height);
     const PackedGaussianSplats packed = PackGaussianSplatAttrs(cloud);
-    GaussianStageARunner runner(Context(), packed, 1u << 22);
+    GaussianGeometryStageRunner runner(Context(), packed, 1u << 22);
 
     // The packed key truncates the record's (camera-relative) view z, so the exact order it
     // is held against is the exact order of that same depth.
@@ -228,8 +228,8 @@ void StageAPackedKeyScene::CompareModes(int width, int height) {
     exact_config.depth_order = DepthOrder::kCameraRelative;
     RenderConfig packed_config = exact_config;
     packed_config.sort_mode = SortMode::kPackedKey32;
-    const StageAReadback exact = runner.Run(cam, exact_config);
-    const StageAReadback gpu = runner.Run(cam, packed_config);
+    const GeometryStageReadback exact = runner.Run(cam, exact_config);
+    const GeometryStageReadback gpu = runner.Run(cam, packed_config);
     ASSERT_EQ(exact.counters.error_flags, 0u);
     ASSERT_EQ(gpu.counters.error_flags, 0u);
     ASSERT_GT(exact.counters.entry_count, 0u);
@@ -337,8 +337,8 @@ void StageAPackedKeyScene::CompareModes(int width, int height) {
               << "[packed key]   out of exact order: " << adjacent_swaps << " adjacent pairs in "
               << tiles_with_swaps << " tiles, " << entries_moved
               << " entries not at their exact position, " << inversions
-              << " inverted pairs | exact " << exact.stage_a_ms << " ms, packed " << gpu.stage_a_ms
-              << " ms\n";
+              << " inverted pairs | exact " << exact.geometry_stage_ms << " ms, packed "
+              << gpu.geometry_stage_ms << " ms\n";
     for (size_t w = 0; w < what_if_bits.size(); ++w) {
         std::cout << "[packed key]   T=" << what_if_bits[w]
                   << ": neighbours (exact order, distinct depths) sharing a key: "

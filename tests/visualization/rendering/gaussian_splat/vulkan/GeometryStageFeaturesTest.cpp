@@ -1,4 +1,4 @@
-// Vulkan Stage A features beyond the plain projection: SH degree as a
+// Vulkan geometry stage features beyond the plain projection: SH degree as a
 // specialisation constant (degree 0 reads no SH), the visibility mask, capacity
 // limits with GPU error flags warned once per view, an empty view, and the
 // compact precision.
@@ -10,14 +10,14 @@
 #include <limits>
 #include <string_view>
 
-#include "StageAComparison.h"
+#include "GeometryStageComparison.h"
 #include "TestUtility.h"
 #include "open3d/camera/CamerasJson.h"
 #include "open3d/core/Logging.h"
 #include "open3d/t/io/PointCloudIO.h"
 #include "open3d/visualization/rendering/gaussian_splat/DefaultScene.h"
 #include "open3d/visualization/rendering/gaussian_splat/GaussianSplatDataPacking.h"
-#include "open3d/visualization/rendering/gaussian_splat/vulkan/GaussianStageARunner.h"
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/GaussianGeometryStageRunner.h"
 #include "shaders/GaussianSplatContract.h"
 #include "visualization/rendering/gaussian_splat/cpu/SplatTestScene.h"
 #include "visualization/rendering/gaussian_splat/vulkan/VulkanTestFixture.h"
@@ -27,19 +27,19 @@ namespace tests {
 namespace {
 
 using namespace visualization::rendering;
-using visualization::rendering::vulkan::GaussianStageARunner;
-using visualization::rendering::vulkan::StageAReadback;
+using visualization::rendering::vulkan::GaussianGeometryStageRunner;
+using visualization::rendering::vulkan::GeometryStageReadback;
 
-class StageAFeatures : public VulkanTest {
+class GeometryStageFeatures : public VulkanTest {
 protected:
-    static void ExpectExact(const StageAComparison& c) {
-        std::cout << "[stage A] " << c.Summary() << "\n";
+    static void ExpectExact(const GeometryStageComparison& c) {
+        std::cout << "[geometry stage] " << c.Summary() << "\n";
         EXPECT_EQ(c.cull_flips, 0) << c.Summary();
         EXPECT_EQ(c.border_splats.size(), 0u) << c.Summary();
         EXPECT_EQ(c.tiles_misordered, 0) << c.Summary();
         EXPECT_EQ(c.gpu_span_mismatches, 0) << c.Summary();
         EXPECT_EQ(c.entries_cpu, c.entries_gpu) << c.Summary();
-        // Colour: measured <= 6.8e-7 with fp32 SH (StageAProjectionTest); 1e-5
+        // Colour: measured <= 6.8e-7 with fp32 SH (GeometryStageProjectionTest); 1e-5
         // bounds it.
         EXPECT_LE(c.errors.color_abs, 1e-5) << c.Summary();
     }
@@ -66,12 +66,12 @@ camera::PinholeCamera LookAtCloud(int width, int height) {
     return camera::PinholeCamera::FromLookAt(look, width, height);
 }
 
-TEST_F(StageAFeatures, ShDegreesZeroToThreeViaSpecialisation) {
+TEST_F(GeometryStageFeatures, ShDegreesZeroToThreeViaSpecialisation) {
     OPEN3D_REQUIRE_DATA("pc_short/pc_short.ply");
     const auto cloud = ReadScene("pc_short/pc_short.ply");  // SH degree 3
     ASSERT_EQ(cloud.GaussianSplatGetSHOrder(), 3);
     const PackedGaussianSplats packed = PackGaussianSplatAttrs(cloud);
-    GaussianStageARunner runner(Context(), packed, 1u << 16);
+    GaussianGeometryStageRunner runner(Context(), packed, 1u << 16);
     // A camera inside the cloud's bounds sees the splats from varied directions.
     const auto cam = camera::PinholeCamera::FromLookAt(
         {Eigen::Vector3d(2.0, 1.0, -2.0), Eigen::Vector3d::Zero(), Eigen::Vector3d(0, -1, 0), 60},
@@ -79,13 +79,13 @@ TEST_F(StageAFeatures, ShDegreesZeroToThreeViaSpecialisation) {
     for (int degree = 0; degree <= 3; ++degree) {
         RenderConfig config;
         config.sh_degree = degree;
-        const StageAReadback gpu = runner.Run(cam, config);
+        const GeometryStageReadback gpu = runner.Run(cam, config);
         ASSERT_GT(gpu.counters.visible_count, 0u);
-        ExpectExact(CompareStageA(cloud, cam, config, gpu));
+        ExpectExact(CompareGeometryStage(cloud, cam, config, gpu));
     }
 }
 
-TEST_F(StageAFeatures, DegreeZeroReadsNoSh) {
+TEST_F(GeometryStageFeatures, DegreeZeroReadsNoSh) {
     OPEN3D_REQUIRE_DATA("pc_short/pc_short.ply");
     const auto cloud = ReadScene("pc_short/pc_short.ply");
     const auto cam = LookAtCloud(64, 48);
@@ -96,23 +96,23 @@ TEST_F(StageAFeatures, DegreeZeroReadsNoSh) {
     PackedGaussianSplats packed = PackGaussianSplatAttrs(cloud);
     ASSERT_EQ(packed.sh_words_per_splat, 45u);
     std::fill(packed.sh.begin(), packed.sh.end(), 0x7FC00000u);  // quiet NaN
-    GaussianStageARunner nan_runner(Context(), packed, 1u << 16);
-    const StageAReadback gpu = nan_runner.Run(cam, config);
+    GaussianGeometryStageRunner nan_runner(Context(), packed, 1u << 16);
+    const GeometryStageReadback gpu = nan_runner.Run(cam, config);
     ASSERT_GT(gpu.counters.visible_count, 0u);
     for (uint32_t i : gpu.visible_in_depth_order) {
         ASSERT_TRUE(std::isfinite(gpu.projected[i].color.x)) << "splat " << i;
     }
-    ExpectExact(CompareStageA(cloud, cam, config, gpu));
+    ExpectExact(CompareGeometryStage(cloud, cam, config, gpu));
     // (b) Packed at degree 0 there is no SH at all: nothing uploaded, a 16-byte
     // placeholder fills the binding.
     const PackedGaussianSplats dc_only = PackGaussianSplatAttrs(cloud, SplatPrecision::kExact, 0);
     EXPECT_TRUE(dc_only.sh.empty());
     EXPECT_EQ(dc_only.sh_words_per_splat, 0u);
-    GaussianStageARunner dc_runner(Context(), dc_only, 1u << 16);
-    ExpectExact(CompareStageA(cloud, cam, config, dc_runner.Run(cam, config)));
+    GaussianGeometryStageRunner dc_runner(Context(), dc_only, 1u << 16);
+    ExpectExact(CompareGeometryStage(cloud, cam, config, dc_runner.Run(cam, config)));
 }
 
-TEST_F(StageAFeatures, HiddenSplatsEmitNothing) {
+TEST_F(GeometryStageFeatures, HiddenSplatsEmitNothing) {
     const auto cloud = CreateDefaultGaussianSplatScene();
     const auto cam = GetDefaultSceneCamera(128, 96);
     PackedGaussianSplats packed = PackGaussianSplatAttrs(cloud);
@@ -125,12 +125,12 @@ TEST_F(StageAFeatures, HiddenSplatsEmitNothing) {
     // would do.
     for (int64_t i = 64; i < 96; ++i) hidden[i] = true;
     SetSplatVisibility(packed.visibility, 64, 96, false);
-    GaussianStageARunner runner(Context(), packed, 1u << 18);
-    const StageAReadback gpu = runner.Run(cam, RenderConfig{});
+    GaussianGeometryStageRunner runner(Context(), packed, 1u << 18);
+    const GeometryStageReadback gpu = runner.Run(cam, RenderConfig{});
     for (uint32_t i : gpu.entry_splats) ASSERT_FALSE(hidden[i]) << "hidden splat " << i;
     for (uint32_t i : gpu.visible_in_depth_order) ASSERT_FALSE(hidden[i]);
-    const StageAComparison c = CompareStageA(cloud, cam, RenderConfig{}, gpu, hidden);
-    std::cout << "[stage A] " << c.Summary() << "\n";
+    const GeometryStageComparison c = CompareGeometryStage(cloud, cam, RenderConfig{}, gpu, hidden);
+    std::cout << "[geometry stage] " << c.Summary() << "\n";
     EXPECT_EQ(c.cull_flips, 0) << c.Summary();
     EXPECT_EQ(c.border_splats.size(), 0u) << c.Summary();
     EXPECT_EQ(c.tiles_misordered, 0) << c.Summary();
@@ -140,13 +140,13 @@ TEST_F(StageAFeatures, HiddenSplatsEmitNothing) {
     // Showing them again (SetVisibility uploads the mask only) brings them back.
     packed.visibility.assign(packed.visibility.size(), ~0u);
     runner.SetVisibility(packed.visibility);
-    const StageAReadback all = runner.Run(cam, RenderConfig{});
+    const GeometryStageReadback all = runner.Run(cam, RenderConfig{});
     EXPECT_GT(all.counters.visible_count, gpu.counters.visible_count);
 }
 
 // Expected lists under the GPU capacity rule: splats emit whole, front to back,
 // until the first one that does not fit; everything behind it is dropped.
-std::vector<std::vector<uint32_t>> PrefixRuleLists(const StageAReadback& gpu,
+std::vector<std::vector<uint32_t>> PrefixRuleLists(const GeometryStageReadback& gpu,
                                                    const std::vector<cpu::ProjectedSplat>& ref,
                                                    const cpu::TileGrid& grid,
                                                    const RenderConfig& config, uint64_t capacity) {
@@ -166,7 +166,8 @@ std::vector<std::vector<uint32_t>> PrefixRuleLists(const StageAReadback& gpu,
     return tiles;
 }
 
-std::vector<std::vector<uint32_t>> GpuLists(const StageAReadback& gpu, const cpu::TileGrid& grid) {
+std::vector<std::vector<uint32_t>> GpuLists(const GeometryStageReadback& gpu,
+                                            const cpu::TileGrid& grid) {
     std::vector<std::vector<uint32_t>> tiles(grid.NumTiles());
     for (size_t k = 0; k < gpu.entry_tiles.size(); ++k) {
         tiles.at(gpu.entry_tiles[k]).push_back(gpu.entry_splats[k]);
@@ -174,7 +175,7 @@ std::vector<std::vector<uint32_t>> GpuLists(const StageAReadback& gpu, const cpu
     return tiles;
 }
 
-TEST_F(StageAFeatures, CapacityOverflowDropsEntriesFlagsAndWarnsOnce) {
+TEST_F(GeometryStageFeatures, CapacityOverflowDropsEntriesFlagsAndWarnsOnce) {
     const auto cloud = CreateDefaultGaussianSplatScene();
     // 9,696 entries (measured; 12,228 tiles in the splats' rectangles before tile culling)
     const auto cam = GetDefaultSceneCamera(160, 120);
@@ -185,7 +186,8 @@ TEST_F(StageAFeatures, CapacityOverflowDropsEntriesFlagsAndWarnsOnce) {
     int warnings = 0;
     core::LogSink previous = core::SetLogSink(nullptr);
     core::SetLogSink([&](core::LogLevel level, std::string_view message) {
-        if (level == core::LogLevel::Warning && message.find("Stage A") != std::string_view::npos) {
+        if (level == core::LogLevel::Warning &&
+            message.find("Geometry stage") != std::string_view::npos) {
             ++warnings;
         }
         if (previous) previous(level, message);
@@ -193,9 +195,9 @@ TEST_F(StageAFeatures, CapacityOverflowDropsEntriesFlagsAndWarnsOnce) {
 
     // (a) The allocation (4,096 entries) is the limit: bits 0 and 1.
     {
-        GaussianStageARunner runner(Context(), packed, 4096);
+        GaussianGeometryStageRunner runner(Context(), packed, 4096);
         for (int frame = 0; frame < 3; ++frame) {
-            const StageAReadback gpu = runner.Run(cam, RenderConfig{});
+            const GeometryStageReadback gpu = runner.Run(cam, RenderConfig{});
             EXPECT_EQ(gpu.counters.error_flags, kEntriesDropped | kCountsClamped);
             EXPECT_LE(gpu.counters.entry_count, 4096u);
             EXPECT_GT(gpu.counters.entry_count, 4000u);
@@ -210,8 +212,8 @@ TEST_F(StageAFeatures, CapacityOverflowDropsEntriesFlagsAndWarnsOnce) {
     {
         RenderConfig config;
         config.max_tile_entries_total = 5000;
-        GaussianStageARunner runner(Context(), packed, 1u << 16);
-        const StageAReadback gpu = runner.Run(cam, config);
+        GaussianGeometryStageRunner runner(Context(), packed, 1u << 16);
+        const GeometryStageReadback gpu = runner.Run(cam, config);
         EXPECT_EQ(gpu.counters.error_flags, kEntriesDropped);
         EXPECT_EQ(GpuLists(gpu, grid), PrefixRuleLists(gpu, ref, grid, config, 5000));
         runner.Run(cam, config);
@@ -223,8 +225,8 @@ TEST_F(StageAFeatures, CapacityOverflowDropsEntriesFlagsAndWarnsOnce) {
     {
         RenderConfig config;
         config.max_tiles_per_splat = 2;
-        GaussianStageARunner runner(Context(), packed, 1u << 16);
-        const StageAReadback gpu = runner.Run(cam, config);
+        GaussianGeometryStageRunner runner(Context(), packed, 1u << 16);
+        const GeometryStageReadback gpu = runner.Run(cam, config);
         EXPECT_EQ(gpu.counters.error_flags, kEntriesDropped);
         const auto lists =
             cpu::BuildTileLists(cpu::ProjectSplats(cloud, cam, config), grid, config);
@@ -234,7 +236,7 @@ TEST_F(StageAFeatures, CapacityOverflowDropsEntriesFlagsAndWarnsOnce) {
     core::SetLogSink(previous);
 }
 
-TEST_F(StageAFeatures, CapacityCutsTheListWhereTheScanSaysAcrossScanLevels) {
+TEST_F(GeometryStageFeatures, CapacityCutsTheListWhereTheScanSaysAcrossScanLevels) {
     // 31,000 list slots are 31 scan blocks under one top level: the offsets that decide
     // where the capacity cuts the list (and where each splat writes) add the block sums
     // (ScanOffset). Expected: the uncut run's lists, keeping the splats that fit whole
@@ -245,8 +247,8 @@ TEST_F(StageAFeatures, CapacityCutsTheListWhereTheScanSaysAcrossScanLevels) {
     const auto cam = PlaybotView0(128, 96);
     const auto grid = cpu::TileGrid::ForImage(cam.width, cam.height);
     const PackedGaussianSplats packed = PackGaussianSplatAttrs(cloud);
-    GaussianStageARunner uncut_runner(Context(), packed, 1u << 20);
-    const StageAReadback uncut = uncut_runner.Run(cam, RenderConfig{});
+    GaussianGeometryStageRunner uncut_runner(Context(), packed, 1u << 20);
+    const GeometryStageReadback uncut = uncut_runner.Run(cam, RenderConfig{});
     ASSERT_EQ(uncut.counters.error_flags, 0u);
     ASSERT_GT(uncut.visible_in_depth_order.size(), 2u * shader::kScanBlockSize);
     std::vector<uint32_t> entries_of(cloud.NumPoints(), 0);
@@ -266,35 +268,36 @@ TEST_F(StageAFeatures, CapacityCutsTheListWhereTheScanSaysAcrossScanLevels) {
     for (auto& tile : want) {
         std::erase_if(tile, [&](uint32_t splat) { return !kept[splat]; });
     }
-    GaussianStageARunner cut_runner(Context(), packed, capacity);
-    const StageAReadback gpu = cut_runner.Run(cam, RenderConfig{});
+    GaussianGeometryStageRunner cut_runner(Context(), packed, capacity);
+    const GeometryStageReadback gpu = cut_runner.Run(cam, RenderConfig{});
     EXPECT_EQ(gpu.counters.error_flags, kEntriesDropped | kCountsClamped);
     EXPECT_EQ(gpu.counters.requested_entries, uncut.counters.entry_count);
     EXPECT_EQ(gpu.counters.entry_count, total);
     EXPECT_EQ(GpuLists(gpu, grid), want);
 }
 
-TEST_F(StageAFeatures, NothingVisible) {
+TEST_F(GeometryStageFeatures, NothingVisible) {
     const auto cloud = CreateDefaultGaussianSplatScene();
     auto cam = GetDefaultSceneCamera(64, 48);
     cam.world_to_camera.topRightCorner<3, 1>() += Eigen::Vector3d(0, 0, -1000);  // all behind
-    GaussianStageARunner runner(Context(), PackGaussianSplatAttrs(cloud), 1024);
-    const StageAReadback gpu = runner.Run(cam, RenderConfig{});
+    GaussianGeometryStageRunner runner(Context(), PackGaussianSplatAttrs(cloud), 1024);
+    const GeometryStageReadback gpu = runner.Run(cam, RenderConfig{});
     EXPECT_EQ(gpu.counters.visible_count, 0u);
     EXPECT_EQ(gpu.counters.entry_count, 0u);
     EXPECT_EQ(gpu.counters.error_flags, 0u);
 }
 
-TEST_F(StageAFeatures, CompactPrecisionStaysClose) {
+TEST_F(GeometryStageFeatures, CompactPrecisionStaysClose) {
     OPEN3D_REQUIRE_DATA("playbot/playbot_31k.ply");
     OPEN3D_REQUIRE_DATA("playbot/cameras.json");
     const auto cloud = ReadScene("playbot/playbot_31k.ply");
     const auto cam = PlaybotView0(128, 96);
     const PackedGaussianSplats compact = PackGaussianSplatAttrs(cloud, SplatPrecision::kCompact);
     EXPECT_LE(compact.BytesPerSplat(), 140u);
-    GaussianStageARunner runner(Context(), compact, 1u << 18);
-    const auto c = CompareStageA(cloud, cam, RenderConfig{}, runner.Run(cam, RenderConfig{}));
-    std::cout << "[stage A compact] " << c.Summary() << "\n";
+    GaussianGeometryStageRunner runner(Context(), compact, 1u << 18);
+    const auto c =
+        CompareGeometryStage(cloud, cam, RenderConfig{}, runner.Run(cam, RenderConfig{}));
+    std::cout << "[geometry stage compact] " << c.Summary() << "\n";
     EXPECT_EQ(c.tiles_misordered, 0) << c.Summary();
     EXPECT_EQ(c.gpu_span_mismatches, 0) << c.Summary();
     EXPECT_EQ(c.visible_list_misordered, 0) << c.Summary();

@@ -1,7 +1,7 @@
-// Stage B of the Vulkan pipeline as a recorder (STYLE.md point 6): the per-tile composite
-// of the tile-sorted entries that Stage A (or a test) produced, and the depth merge for
+// Composite stage of the Vulkan pipeline as a recorder (STYLE.md point 6): the per-tile composite
+// of the tile-sorted entries that geometry stage (or a test) produced, and the depth merge for
 // depth readback. The caller owns every buffer and image; Record*() only records commands
-// (no allocation, no submit). Design, images and measured errors: docs/vulkan.md "Stage B".
+// (no allocation, no submit). Design, images and measured errors: docs/vulkan.md "Composite stage".
 #pragma once
 
 #include <vulkan/vulkan.h>
@@ -32,9 +32,9 @@ enum class CompositeColorFormat {
 
 VkFormat ToVkFormat(CompositeColorFormat format);
 
-/// Formats and usages of what the caller allocates for Stage B.
-struct StageBStorageRequirements {
-    /// Usage of the composite's state buffer (its size: GaussianStageB::StateBytes).
+/// Formats and usages of what the caller allocates for composite stage.
+struct CompositeStageStorageRequirements {
+    /// Usage of the composite's state buffer (its size: GaussianCompositeStage::StateBytes).
     VkBufferUsageFlags state_usage =
         VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
     /// Expected depth, alpha, median depth and the merged linear depth.
@@ -46,19 +46,19 @@ struct StageBStorageRequirements {
     VkImageUsageFlags image_usage = VK_IMAGE_USAGE_STORAGE_BIT;
 };
 
-/// Stage A's results that the composite reads (all written on the GPU).
-struct StageBInputs {
+/// Geometry stage's results that the composite reads (all written on the GPU).
+struct CompositeStageInputs {
     BufferRange projected;     ///< shader::GaussianProjectedSplat [N], indexed by splat
     BufferRange entry_keys;    ///< uint32 [capacity]: tile index, ascending
     BufferRange entry_values;  ///< uint32 [capacity]: splat index, front to back per tile
-    /// uint32 entry count (any 4-byte aligned offset), e.g. GaussianStageACounters::entry_count.
-    /// Counts above `entry_capacity` are clamped.
+    /// uint32 entry count (any 4-byte aligned offset), e.g.
+    /// GaussianGeometryStageCounters::entry_count. Counts above `entry_capacity` are clamped.
     BufferRange entry_count;
     uint32_t entry_capacity = 0;
 };
 
 /// The composite's outputs, width x height, in VK_IMAGE_LAYOUT_GENERAL.
-struct StageBTargets {
+struct CompositeStageTargets {
     uint32_t width = 0;
     uint32_t height = 0;
     CompositeColorFormat color_format = CompositeColorFormat::kRgba32f;
@@ -90,8 +90,8 @@ struct CompositeParams {
     /// Scene depth to test each splat against (a splat farther than the scene at a pixel is
     /// skipped), or nullptr: then the pipeline specialised without it runs and reads no depth.
     const SceneDepthTexture* scene_depth = nullptr;
-    /// The depth images to write (StageBTargets); each is a pipeline specialisation, and one
-    /// not asked for costs nothing per blended splat (the images it leaves keep old values).
+    /// The depth images to write (CompositeStageTargets); each is a pipeline specialisation, and
+    /// one not asked for costs nothing per blended splat (the images it leaves keep old values).
     bool expected_depth = true;  ///< expected depth and alpha
     bool median_depth = true;
     /// Workgroups of the grid (workgroup i does tile i, then steals tiles from a counter):
@@ -119,7 +119,7 @@ struct DepthMergeImages {
     VkImageView linear = VK_NULL_HANDLE;       ///< R32F out: merged view z, 0 where nothing is
 };
 
-class GaussianStageB {
+class GaussianCompositeStage {
 public:
     /// Workgroups of the default work-stealing grid (enough to fill a large GPU; a CPU
     /// device runs them on its threads).
@@ -129,9 +129,9 @@ public:
 
     /// Creates the layouts and a 1x1 placeholder depth texture (bound when no scene depth
     /// is given). Pipelines are made on first use per colour format / scene-depth variant.
-    explicit GaussianStageB(const VulkanContext& context);
+    explicit GaussianCompositeStage(const VulkanContext& context);
 
-    static StageBStorageRequirements GetStorageRequirements();
+    static CompositeStageStorageRequirements GetStorageRequirements();
     /// Bytes of the composite's state for a width x height image: shader::GaussianCompositeState
     /// (the work-stealing tile counter) and each tile's entry range, both rewritten per frame.
     static VkDeviceSize StateBytes(uint32_t width, uint32_t height);
@@ -143,8 +143,8 @@ public:
     /// Synchronisation: before, the caller makes the inputs (and scene depth) visible to
     /// COMPUTE_SHADER reads, has the targets in GENERAL layout, and orders earlier uses of
     /// `state`; after, the images are COMPUTE_SHADER storage writes for the caller to barrier.
-    void RecordComposite(VkCommandBuffer cmd, const StageBInputs& inputs,
-                         const StageBTargets& targets, const BufferRange& state,
+    void RecordComposite(VkCommandBuffer cmd, const CompositeStageInputs& inputs,
+                         const CompositeStageTargets& targets, const BufferRange& state,
                          const CompositeParams& params);
 
     /// Records the depth merge (16x16 pixels per workgroup). Synchronisation as above: the

@@ -1,4 +1,4 @@
-#include "open3d/visualization/rendering/gaussian_splat/vulkan/GaussianStageAResources.h"
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/GaussianGeometryStageResources.h"
 
 #include <algorithm>
 #include <cstring>
@@ -33,8 +33,8 @@ Buffer UploadStorageBuffer(const VulkanContext& context, const CommandPool& pool
     return device;
 }
 
-void StageAResources::UploadScene(const VulkanContext& context, const CommandPool& pool,
-                                  const PackedGaussianSplats& packed) {
+void GeometryStageResources::UploadScene(const VulkanContext& context, const CommandPool& pool,
+                                         const PackedGaussianSplats& packed) {
     positions = UploadStorageBuffer(context, pool, packed.positions.data(),
                                     packed.positions.size() * sizeof(float));
     shape = UploadStorageBuffer(context, pool, packed.shape.data(), packed.shape.size() * 4);
@@ -56,8 +56,8 @@ void StageAResources::UploadScene(const VulkanContext& context, const CommandPoo
     entry_capacity_ = 0;
 }
 
-void StageAResources::UploadVisibility(const VulkanContext& context, const CommandPool& pool,
-                                       const std::vector<uint32_t>& mask) {
+void GeometryStageResources::UploadVisibility(const VulkanContext& context, const CommandPool& pool,
+                                              const std::vector<uint32_t>& mask) {
     const size_t words = (static_cast<size_t>(layout_.num_splats) + 31) / 32;
     if (mask.size() != words) {
         core::ThrowError("visibility mask has {} words, the scene of {} splats needs {}",
@@ -66,10 +66,10 @@ void StageAResources::UploadVisibility(const VulkanContext& context, const Comma
     visibility = UploadStorageBuffer(context, pool, mask.data(), mask.size() * 4);
 }
 
-void StageAResources::AllocateView(const VulkanContext& context, uint32_t entry_capacity) {
+void GeometryStageResources::AllocateView(const VulkanContext& context, uint32_t entry_capacity) {
     const uint32_t n = static_cast<uint32_t>(layout_.num_splats);
-    const StageAStorageRequirements need =
-        GaussianStageA::GetStorageRequirements(n, entry_capacity);
+    const GeometryStageStorageRequirements need =
+        GaussianGeometryStage::GetStorageRequirements(n, entry_capacity);
     const auto make = [&](VkDeviceSize bytes, VkBufferUsageFlags usage) {
         return Buffer(context, std::max<VkDeviceSize>(bytes, 16), usage | kTransfer,
                       MemoryUsage::kDevice);
@@ -90,8 +90,8 @@ void StageAResources::AllocateView(const VulkanContext& context, uint32_t entry_
     entry_capacity_ = entry_capacity;
 }
 
-StageASceneBuffers StageAResources::Scene() const {
-    StageASceneBuffers scene;
+GeometryStageSceneBuffers GeometryStageResources::Scene() const {
+    GeometryStageSceneBuffers scene;
     scene.positions = positions.Range();
     scene.shape = shape.Range();
     scene.sh = sh.Range();
@@ -103,8 +103,8 @@ StageASceneBuffers StageAResources::Scene() const {
     return scene;
 }
 
-StageAViewBuffers StageAResources::View() const {
-    StageAViewBuffers view;
+GeometryStageViewBuffers GeometryStageResources::View() const {
+    GeometryStageViewBuffers view;
     view.view_params = view_params.Range();
     view.projected = projected.Range();
     view.counters = counters.Range();
@@ -119,8 +119,8 @@ StageAViewBuffers StageAResources::View() const {
     return view;
 }
 
-shader::GaussianViewParams StageAResources::ViewParams(const camera::PinholeCamera& camera,
-                                                       const RenderConfig& config) const {
+shader::GaussianViewParams GeometryStageResources::ViewParams(const camera::PinholeCamera& camera,
+                                                              const RenderConfig& config) const {
     ViewPackingInputs inputs;
     inputs.num_splats = layout_.num_splats;
     inputs.packed_sh_degree = layout_.sh_degree;

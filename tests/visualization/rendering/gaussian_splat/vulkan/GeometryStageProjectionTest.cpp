@@ -1,6 +1,6 @@
-// Vulkan Stage A (projection, depth order, tile entries) against the CPU
+// Vulkan geometry stage (projection, depth order, tile entries) against the CPU
 // reference, on analytic splats and on small renders of real scenes. See
-// StageAComparison.h for what must match exactly and which float32-vs-double
+// GeometryStageComparison.h for what must match exactly and which float32-vs-double
 // differences are allowed and counted.
 #include <gtest/gtest.h>
 
@@ -8,13 +8,13 @@
 #include <cmath>
 #include <iostream>
 
-#include "StageAComparison.h"
+#include "GeometryStageComparison.h"
 #include "TestUtility.h"
 #include "open3d/camera/CamerasJson.h"
 #include "open3d/t/io/PointCloudIO.h"
 #include "open3d/visualization/rendering/gaussian_splat/DefaultScene.h"
 #include "open3d/visualization/rendering/gaussian_splat/GaussianSplatDataPacking.h"
-#include "open3d/visualization/rendering/gaussian_splat/vulkan/GaussianStageARunner.h"
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/GaussianGeometryStageRunner.h"
 #include "visualization/rendering/gaussian_splat/cpu/SplatTestScene.h"
 #include "visualization/rendering/gaussian_splat/vulkan/VulkanTestFixture.h"
 
@@ -23,8 +23,8 @@ namespace tests {
 namespace {
 
 using namespace visualization::rendering;
-using visualization::rendering::vulkan::GaussianStageARunner;
-using visualization::rendering::vulkan::StageAReadback;
+using visualization::rendering::vulkan::GaussianGeometryStageRunner;
+using visualization::rendering::vulkan::GeometryStageReadback;
 
 // Measured maxima (float32 GPU vs double reference) over every exact-precision
 // case in this file on lavapipe: centre 1.9e-5 px, depth 1.3e-7 relative,
@@ -38,25 +38,25 @@ constexpr double kConicTolRel = 2e-4;
 constexpr double kOpacityTol = 1e-5;
 constexpr double kColorTol = 1e-5;
 
-class StageAProjection : public VulkanTest {
+class GeometryStageProjection : public VulkanTest {
 protected:
-    StageAComparison RunAndCompare(const t::geometry::PointCloud& cloud,
-                                   const camera::PinholeCamera& cam,
-                                   const RenderConfig& config = {},
-                                   SplatPrecision precision = SplatPrecision::kExact,
-                                   uint32_t capacity = 1u << 22) {
+    GeometryStageComparison RunAndCompare(const t::geometry::PointCloud& cloud,
+                                          const camera::PinholeCamera& cam,
+                                          const RenderConfig& config = {},
+                                          SplatPrecision precision = SplatPrecision::kExact,
+                                          uint32_t capacity = 1u << 22) {
         const PackedGaussianSplats packed = PackGaussianSplatAttrs(cloud, precision);
-        GaussianStageARunner runner(Context(), packed, capacity);
-        const StageAReadback gpu = runner.Run(cam, config);
-        const StageAComparison c = CompareStageA(cloud, cam, config, gpu);
-        std::cout << "[stage A] " << cam.width << "x" << cam.height << ": " << c.Summary() << " | "
-                  << gpu.stage_a_ms << " ms\n";
+        GaussianGeometryStageRunner runner(Context(), packed, capacity);
+        const GeometryStageReadback gpu = runner.Run(cam, config);
+        const GeometryStageComparison c = CompareGeometryStage(cloud, cam, config, gpu);
+        std::cout << "[geometry stage] " << cam.width << "x" << cam.height << ": " << c.Summary()
+                  << " | " << gpu.geometry_stage_ms << " ms\n";
         return c;
     }
 
     // What every comparison must satisfy; border effects are bounded by the
     // caller.
-    static void ExpectMatches(const StageAComparison& c, double max_border_fraction) {
+    static void ExpectMatches(const GeometryStageComparison& c, double max_border_fraction) {
         EXPECT_EQ(c.cull_flips_unexplained, 0) << c.Summary();
         EXPECT_EQ(c.errors.radius_off_more, 0) << c.Summary();
         EXPECT_EQ(c.tiles_misordered, 0) << c.Summary();
@@ -75,7 +75,7 @@ protected:
     }
 };
 
-TEST_F(StageAProjection, AnalyticSplatsMatchExactly) {
+TEST_F(GeometryStageProjection, AnalyticSplatsMatchExactly) {
     // Splats placed away from tile borders: nothing may differ, not even at a
     // border.
     std::vector<TestSplat> splats(6);
@@ -97,7 +97,7 @@ TEST_F(StageAProjection, AnalyticSplatsMatchExactly) {
     EXPECT_EQ(c.depth_rounding_swaps, 0);
 }
 
-TEST_F(StageAProjection, DefaultSceneMatches) {
+TEST_F(GeometryStageProjection, DefaultSceneMatches) {
     const auto cloud = CreateDefaultGaussianSplatScene();
     ExpectMatches(RunAndCompare(cloud, GetDefaultSceneCamera(160, 120)), 0.01);
     RenderConfig antialias;
@@ -110,7 +110,8 @@ struct SceneCase {
     const char* cameras;  // nullptr: a look-at camera towards the cloud
 };
 
-class StageAScenes : public StageAProjection, public ::testing::WithParamInterface<SceneCase> {};
+class GeometryStageScenes : public GeometryStageProjection,
+                            public ::testing::WithParamInterface<SceneCase> {};
 
 camera::PinholeCamera CameraFor(const SceneCase& c, const t::geometry::PointCloud& cloud, int view,
                                 int width, int height) {
@@ -135,7 +136,7 @@ camera::PinholeCamera CameraFor(const SceneCase& c, const t::geometry::PointClou
     return camera::PinholeCamera::FromLookAt(camera::OrbitLookAt(look, 40.0 * view), width, height);
 }
 
-TEST_P(StageAScenes, MatchesReferenceAtSmallSizes) {
+TEST_P(GeometryStageScenes, MatchesReferenceAtSmallSizes) {
     const SceneCase& sc = GetParam();
     OPEN3D_REQUIRE_DATA(sc.scene);
     if (sc.cameras) OPEN3D_REQUIRE_DATA(sc.cameras);
@@ -150,7 +151,7 @@ TEST_P(StageAScenes, MatchesReferenceAtSmallSizes) {
     }
 }
 
-INSTANTIATE_TEST_SUITE_P(RealScenes, StageAScenes,
+INSTANTIATE_TEST_SUITE_P(RealScenes, GeometryStageScenes,
                          ::testing::Values(SceneCase{"playbot/playbot_31k.ply",
                                                      "playbot/cameras.json"},
                                            SceneCase{"train3/train_3points.ply", nullptr},

@@ -1,4 +1,4 @@
-// Compares a Vulkan Stage A readback with the CPU reference (cpu/Projection,
+// Compares a Vulkan geometry stage readback with the CPU reference (cpu/Projection,
 // cpu/TileLists) splat by splat and tile by tile, and says where float32 (GPU)
 // and double (reference) legitimately part: a cull or tile-rectangle decision
 // that flips at a border, and the order of two splats whose depths are within
@@ -15,7 +15,7 @@
 #include "open3d/visualization/rendering/gaussian_splat/RenderConfig.h"
 #include "open3d/visualization/rendering/gaussian_splat/cpu/Projection.h"
 #include "open3d/visualization/rendering/gaussian_splat/cpu/TileLists.h"
-#include "open3d/visualization/rendering/gaussian_splat/vulkan/GaussianStageARunner.h"
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/GaussianGeometryStageRunner.h"
 
 namespace open3d {
 namespace tests {
@@ -36,7 +36,7 @@ struct ProjectionErrors {
     int64_t span_differs = 0;
 };
 
-struct StageAComparison {
+struct GeometryStageComparison {
     int64_t num_splats = 0;
     int64_t visible_cpu = 0;
     int64_t visible_gpu = 0;
@@ -70,11 +70,11 @@ struct StageAComparison {
 /// Runs the CPU reference and compares. `hidden` marks splats hidden by the
 /// visibility mask (they must be absent from the GPU output; the reference
 /// ignores them).
-StageAComparison CompareStageA(const t::geometry::PointCloud& cloud,
-                               const camera::PinholeCamera& camera,
-                               const visualization::rendering::RenderConfig& config,
-                               const visualization::rendering::vulkan::StageAReadback& gpu,
-                               const std::vector<bool>& hidden = {});
+GeometryStageComparison CompareGeometryStage(
+    const t::geometry::PointCloud& cloud, const camera::PinholeCamera& camera,
+    const visualization::rendering::RenderConfig& config,
+    const visualization::rendering::vulkan::GeometryStageReadback& gpu,
+    const std::vector<bool>& hidden = {});
 
 }  // namespace tests
 }  // namespace open3d

@@ -1,4 +1,4 @@
-#include "open3d/visualization/rendering/gaussian_splat/vulkan/GaussianStageBRunner.h"
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/GaussianCompositeStageRunner.h"
 #include "open3d/core/Timer.h"
 
 #include <chrono>
@@ -55,19 +55,20 @@ std::vector<T> Read(const Target& target) {
 
 }  // namespace
 
-GaussianStageBRunner::GaussianStageBRunner(const VulkanContext& context)
-    : context_(context), pool_(context), stage_b_(context), timestamps_(context) {}
+GaussianCompositeStageRunner::GaussianCompositeStageRunner(const VulkanContext& context)
+    : context_(context), pool_(context), composite_stage_(context), timestamps_(context) {}
 
-StageBReadback GaussianStageBRunner::Run(const StageBRunInputs& in) {
+CompositeStageReadback GaussianCompositeStageRunner::Run(const CompositeStageRunInputs& in) {
     const uint32_t w = in.width, h = in.height;
-    if (w == 0 || h == 0) core::ThrowError("GaussianStageBRunner: the image is {}x{}", w, h);
+    if (w == 0 || h == 0)
+        core::ThrowError("GaussianCompositeStageRunner: the image is {}x{}", w, h);
     if (in.entry_tiles.size() != in.entry_splats.size()) {
-        core::ThrowError("GaussianStageBRunner: {} entry tiles but {} entry splats",
+        core::ThrowError("GaussianCompositeStageRunner: {} entry tiles but {} entry splats",
                          in.entry_tiles.size(), in.entry_splats.size());
     }
     const bool has_scene_depth = !in.scene_depth.empty();
     if (has_scene_depth && in.scene_depth.size() != size_t(w) * h) {
-        core::ThrowError("GaussianStageBRunner: scene depth has {} values, {}x{} expected",
+        core::ThrowError("GaussianCompositeStageRunner: scene depth has {} values, {}x{} expected",
                          in.scene_depth.size(), w, h);
     }
     const VkBufferUsageFlags storage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
@@ -79,8 +80,8 @@ StageBReadback GaussianStageBRunner::Run(const StageBRunInputs& in) {
     // The count at uint index 1, as a producer's counter block would hold it.
     const uint32_t count_words[4] = {0xDEADBEEFu, num_entries, 0u, 0u};
     Buffer count = UploadBuffer(context_, count_words, sizeof(count_words), storage);
-    const StageBStorageRequirements need = GaussianStageB::GetStorageRequirements();
-    Buffer state(context_, GaussianStageB::StateBytes(w, h), need.state_usage,
+    const CompositeStageStorageRequirements need = GaussianCompositeStage::GetStorageRequirements();
+    Buffer state(context_, GaussianCompositeStage::StateBytes(w, h), need.state_usage,
                  MemoryUsage::kDevice);
 
     const VkFormat color_format = ToVkFormat(in.color_format);
@@ -114,13 +115,13 @@ StageBReadback GaussianStageBRunner::Run(const StageBRunInputs& in) {
     const SceneDepthTexture* scene_used =
         has_scene_depth && !in.scene_depth_unused ? &scene : nullptr;
 
-    StageBInputs inputs;
+    CompositeStageInputs inputs;
     inputs.projected = projected.Range();
     inputs.entry_keys = keys.Range();
     inputs.entry_values = values.Range();
     inputs.entry_count = count.Range(4, 4);
     inputs.entry_capacity = num_entries;
-    StageBTargets targets;
+    CompositeStageTargets targets;
     targets.width = w;
     targets.height = h;
     targets.color_format = in.color_format;
@@ -151,7 +152,7 @@ StageBReadback GaussianStageBRunner::Run(const StageBRunInputs& in) {
     }
     if (has_scene_depth) RecordDepthTextureUpload(c, scene_image, scene_upload.Get());
     timestamps_.RecordBegin(c, TimedPass::kComposite);
-    stage_b_.RecordComposite(c, inputs, targets, state.Range(), params);
+    composite_stage_.RecordComposite(c, inputs, targets, state.Range(), params);
     timestamps_.RecordEnd(c, TimedPass::kComposite);
     if (in.depth_merge) {
         RecordMemoryBarrier(
@@ -167,7 +168,7 @@ StageBReadback GaussianStageBRunner::Run(const StageBRunInputs& in) {
         DepthMergeParams merge = in.merge;
         merge.scene_depth = scene_used;
         timestamps_.RecordBegin(c, TimedPass::kDepthMerge);
-        stage_b_.RecordDepthMerge(c, images, merge);
+        composite_stage_.RecordDepthMerge(c, images, merge);
         timestamps_.RecordEnd(c, TimedPass::kDepthMerge);
     }
     for (const Target* target : outputs) {
@@ -185,7 +186,7 @@ StageBReadback GaussianStageBRunner::Run(const StageBRunInputs& in) {
     Submit(context_, c, fence.Get());
     Wait(context_, fence.Get());
 
-    StageBReadback out;
+    CompositeStageReadback out;
     out.wall_ms = core::MillisecondsSince(start);
     const std::vector<double> ms = timestamps_.ReadMilliseconds();
     out.composite_ms = ms[static_cast<uint32_t>(TimedPass::kComposite)];

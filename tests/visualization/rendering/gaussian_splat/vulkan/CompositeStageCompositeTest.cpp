@@ -1,5 +1,5 @@
-// Stage B (composite, scene-depth test, depth merge) on analytic splats, in isolation from
-// Stage A: the inputs are the CPU reference's tile lists (StageBTestUtil.h).
+// Composite stage (composite, scene-depth test, depth merge) on analytic splats, in isolation from
+// Geometry stage: the inputs are the CPU reference's tile lists (CompositeStageTestUtil.h).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "StageBTestUtil.h"
+#include "CompositeStageTestUtil.h"
 #include "VulkanTestFixture.h"
 
 namespace open3d {
@@ -25,23 +25,24 @@ using rendering::cpu::TileGrid;
 // which shows as >= 1/255.
 constexpr double kAnalyticTolerance = 1e-6;
 
-class StageBComposite : public VulkanTest {
+class CompositeStageComposite : public VulkanTest {
 protected:
-    gpu::StageBReadback Run(const gpu::StageBRunInputs& in) {
-        gpu::GaussianStageBRunner runner(Context());
+    gpu::CompositeStageReadback Run(const gpu::CompositeStageRunInputs& in) {
+        gpu::GaussianCompositeStageRunner runner(Context());
         return runner.Run(in);
     }
 
     // Composites `splats` on the GPU and on the CPU and checks colour, expected depth, alpha
     // and median depth agree within `tolerance`.
-    gpu::StageBReadback RunAndCompare(const std::vector<ProjectedSplat>& splats, int width,
-                                      int height, const rendering::RenderConfig& config = {},
-                                      double tolerance = kAnalyticTolerance) {
+    gpu::CompositeStageReadback RunAndCompare(const std::vector<ProjectedSplat>& splats, int width,
+                                              int height,
+                                              const rendering::RenderConfig& config = {},
+                                              double tolerance = kAnalyticTolerance) {
         const auto lists = BuildTileLists(splats, TileGrid::ForImage(width, height), config);
-        gpu::StageBRunInputs in = ToStageBInputs(splats, lists, width, height);
+        gpu::CompositeStageRunInputs in = ToCompositeStageInputs(splats, lists, width, height);
         in.background = {float(config.background[0]), float(config.background[1]),
                          float(config.background[2])};
-        const gpu::StageBReadback gpu_out = Run(in);
+        const gpu::CompositeStageReadback gpu_out = Run(in);
         const auto ref = ReferenceComposite(splats, lists, width, height, config);
         EXPECT_LE(CompareImage(gpu_out.color, ref.color).max_abs, tolerance) << "colour";
         EXPECT_LE(CompareImage(gpu_out.depth, ref.depth_expected).max_abs, tolerance * 10)
@@ -59,11 +60,11 @@ protected:
     }
 };
 
-const float* Pixel(const gpu::StageBReadback& out, int width, int x, int y) {
+const float* Pixel(const gpu::CompositeStageReadback& out, int width, int x, int y) {
     return &out.color[(size_t(y) * width + x) * 4];
 }
 
-TEST_F(StageBComposite, SingleSplatHeadOn) {
+TEST_F(CompositeStageComposite, SingleSplatHeadOn) {
     const std::vector<ProjectedSplat> splats{
         MakeSplat(7.0, 9.0, 2.0, 3.0, 0.8, {1.0, 0.5, 0.25}, 16, 16)};
     const auto out = RunAndCompare(splats, 16, 16);
@@ -74,14 +75,14 @@ TEST_F(StageBComposite, SingleSplatHeadOn) {
     EXPECT_EQ(out.median_depth[9 * 16 + 7], 2.0f);  // alpha 0.8 >= 0.5 at the first splat
 }
 
-TEST_F(StageBComposite, AlphaClampsAt099) {
+TEST_F(CompositeStageComposite, AlphaClampsAt099) {
     const std::vector<ProjectedSplat> splats{
         MakeSplat(8.0, 8.0, 1.0, 2.0, 1.0, {1.0, 1.0, 1.0}, 16, 16)};
     const auto out = RunAndCompare(splats, 16, 16);
     EXPECT_EQ(Pixel(out, 16, 8, 8)[3], 0.99f);  // 1 - T = 1 - (1 - 0.99f), exact in float
 }
 
-TEST_F(StageBComposite, AlphaBelowOneOver255IsSkipped) {
+TEST_F(CompositeStageComposite, AlphaBelowOneOver255IsSkipped) {
     // Alpha at the centre is the opacity: 0.0039 < 1/255 = 0.0039216 is skipped everywhere,
     // 0.0040 contributes at the centre pixel only (exp(-0.5 / 4) * 0.004 < 1/255 next door).
     for (const double opacity : {0.0039, 0.0040}) {
@@ -94,7 +95,7 @@ TEST_F(StageBComposite, AlphaBelowOneOver255IsSkipped) {
     }
 }
 
-TEST_F(StageBComposite, TransmittanceStopsBeforeBlending) {
+TEST_F(CompositeStageComposite, TransmittanceStopsBeforeBlending) {
     // Opacity 0.95 at the centre: T = 0.05, 0.0025, 1.25e-4, then 6.25e-6 < 1e-4, so the
     // fourth splat is NOT blended there (and neither is anything behind it).
     std::vector<ProjectedSplat> splats;
@@ -120,7 +121,7 @@ TEST_F(StageBComposite, TransmittanceStopsBeforeBlending) {
     EXPECT_NEAR(Pixel(out2, 16, 8, 8)[1], 0.99f, 1e-7);
 }
 
-TEST_F(StageBComposite, BackgroundRule) {
+TEST_F(CompositeStageComposite, BackgroundRule) {
     rendering::RenderConfig config;
     config.background = Eigen::Vector3d(0.2, 0.4, 0.6);
     const std::vector<ProjectedSplat> splats{
@@ -139,7 +140,7 @@ TEST_F(StageBComposite, BackgroundRule) {
 // Many overlapping splats over several tiles and batches (> 256 per tile), at sizes that are
 // not multiples of 16, tiny, very wide and very tall: the GPU must match the reference
 // everywhere, whatever the work-stealing grid.
-TEST_F(StageBComposite, ShapesAndBatches) {
+TEST_F(CompositeStageComposite, ShapesAndBatches) {
     struct Size {
         int width, height;
     };
@@ -162,7 +163,8 @@ TEST_F(StageBComposite, ShapesAndBatches) {
         // (colour and alpha, lavapipe), 1e-5 allowed (still 400x below 1/255).
         RunAndCompare(splats, size.width, size.height, {}, 1e-5);
         const auto lists = BuildTileLists(splats, TileGrid::ForImage(size.width, size.height), {});
-        gpu::StageBRunInputs in = ToStageBInputs(splats, lists, size.width, size.height);
+        gpu::CompositeStageRunInputs in =
+            ToCompositeStageInputs(splats, lists, size.width, size.height);
         const auto many = Run(in);
         // One workgroup steals every tile in turn; three interleave their claims, each
         // holding the claim of its next tile while it composites the current one.
@@ -178,7 +180,7 @@ TEST_F(StageBComposite, ShapesAndBatches) {
 // One tile with more than 65535 entries: 100,000 splats below the 1/255 alpha threshold, then
 // one visible splat behind them. The GPU must walk the whole list (llvmpipe stops any loop of
 // an invocation after 65535 back-edges in total; the composite unrolls its blending loop).
-TEST_F(StageBComposite, DenseTileReachesItsLastEntry) {
+TEST_F(CompositeStageComposite, DenseTileReachesItsLastEntry) {
     std::vector<ProjectedSplat> splats;
     for (int i = 0; i < 100000; ++i) {
         splats.push_back(MakeSplat(8.0, 8.0, 1.0 + i * 1e-5, 3.0, 0.003, {1.0, 0.0, 0.0}, 16, 16));
@@ -187,12 +189,12 @@ TEST_F(StageBComposite, DenseTileReachesItsLastEntry) {
     const auto out = RunAndCompare(splats, 16, 16);
     EXPECT_NEAR(Pixel(out, 16, 8, 8)[1], 0.5f, 1e-7);
     EXPECT_EQ(Pixel(out, 16, 8, 8)[0], 0.f);
-    std::cout << "[ Stage B ] 100,001 entries in one tile: composite " << out.composite_ms
+    std::cout << "[ composite stage ] 100,001 entries in one tile: composite " << out.composite_ms
               << " ms GPU\n";
 }
 
-TEST_F(StageBComposite, EmptyEntryListGivesBackground) {
-    gpu::StageBRunInputs in;
+TEST_F(CompositeStageComposite, EmptyEntryListGivesBackground) {
+    gpu::CompositeStageRunInputs in;
     in.width = 35;
     in.height = 20;
     in.background = {0.25f, 0.5f, 1.0f};
@@ -206,14 +208,14 @@ TEST_F(StageBComposite, EmptyEntryListGivesBackground) {
     }
 }
 
-TEST_F(StageBComposite, Rgba16fIsTheRgba32fResultRounded) {
+TEST_F(CompositeStageComposite, Rgba16fIsTheRgba32fResultRounded) {
     std::vector<ProjectedSplat> splats;
     for (int i = 0; i < 40; ++i) {
         splats.push_back(MakeSplat(3.0 + i, 2.0 + 0.5 * i, 1.0 + 0.1 * i, 2.5, 0.6,
                                    {0.1 * (i % 10), 0.5, 1.2}, 48, 32));
     }
     const auto lists = BuildTileLists(splats, TileGrid::ForImage(48, 32), {});
-    gpu::StageBRunInputs in = ToStageBInputs(splats, lists, 48, 32);
+    gpu::CompositeStageRunInputs in = ToCompositeStageInputs(splats, lists, 48, 32);
     const auto full = Run(in);
     in.color_format = gpu::CompositeColorFormat::kRgba16f;
     const auto half = Run(in);

@@ -1,9 +1,9 @@
-// Stage A of the Vulkan pipeline as a recorder (STYLE.md point 6): project the splats,
+// Geometry stage of the Vulkan pipeline as a recorder (STYLE.md point 6): project the splats,
 // order the visible ones by exact float32 depth (ties by splat index), emit one entry
 // per touched tile in that order and stably sort the entries by tile. The seed's packed
 // 32-bit (tile, truncated depth) key is an option (RenderConfig::sort_mode). The caller
 // allocates from GetStorageRequirements; Record() only records commands (no allocation,
-// no submit). Pass sequence and buffers: docs/vulkan.md (Stage A).
+// no submit). Pass sequence and buffers: docs/vulkan.md (geometry stage).
 #pragma once
 
 #include <vulkan/vulkan.h>
@@ -26,14 +26,14 @@ namespace vulkan {
 
 class VulkanContext;
 
-/// Bytes of every buffer Stage A needs for up to `num_splats` splats and
+/// Bytes of every buffer geometry stage needs for up to `num_splats` splats and
 /// `entry_capacity` tile entries. All are storage buffers; `counters` is also read by
 /// indirect dispatches and copied (TRANSFER_SRC / TRANSFER_DST), `view_params` is written
 /// with vkCmdUpdateBuffer (TRANSFER_DST).
-struct StageAStorageRequirements {
+struct GeometryStageStorageRequirements {
     VkDeviceSize view_params_bytes = 0;    ///< shader::GaussianViewParams
     VkDeviceSize projected_bytes = 0;      ///< shader::GaussianProjectedSplat [N]
-    VkDeviceSize counters_bytes = 0;       ///< shader::GaussianStageACounters
+    VkDeviceSize counters_bytes = 0;       ///< shader::GaussianGeometryStageCounters
     VkDeviceSize depth_keys_bytes = 0;     ///< uint32 [N]
     VkDeviceSize splat_indices_bytes = 0;  ///< uint32 [N]
     VkDeviceSize tile_counts_bytes = 0;    ///< uint32 [N]
@@ -53,7 +53,7 @@ struct StageAStorageRequirements {
 };
 
 /// The packed scene (PackGaussianSplatAttrs) on the GPU.
-struct StageASceneBuffers {
+struct GeometryStageSceneBuffers {
     BufferRange positions;  ///< vec4 [N]
     BufferRange shape;      ///< uint32 [N, shape words]
     /// uint32 [N, sh words]. At SH degree 0 nothing is read from it; any small buffer
@@ -66,9 +66,9 @@ struct StageASceneBuffers {
     SplatPrecision precision = SplatPrecision::kExact;
 };
 
-/// Per-view buffers, sized from StageAStorageRequirements (offsets aligned to
+/// Per-view buffers, sized from GeometryStageStorageRequirements (offsets aligned to
 /// minStorageBufferOffsetAlignment).
-struct StageAViewBuffers {
+struct GeometryStageViewBuffers {
     BufferRange view_params;
     BufferRange projected;
     BufferRange counters;
@@ -81,18 +81,18 @@ struct StageAViewBuffers {
     BufferRange tile_counts;  ///< scratch: each visible splat's tile count, by splat index
 };
 
-class GaussianStageA {
+class GaussianGeometryStage {
 public:
     /// Creates the pipelines that do not depend on the scene (the projection pipelines,
     /// specialised on SH degree / antialias / precision, are made on first use).
-    explicit GaussianStageA(const VulkanContext& context);
+    explicit GaussianGeometryStage(const VulkanContext& context);
 
     /// Sizes for up to `num_splats` splats and `entry_capacity` tile entries. Throws
     /// core::Open3DError when a count exceeds what the sorts support.
-    static StageAStorageRequirements GetStorageRequirements(uint32_t num_splats,
-                                                            uint32_t entry_capacity);
+    static GeometryStageStorageRequirements GetStorageRequirements(uint32_t num_splats,
+                                                                   uint32_t entry_capacity);
 
-    /// Records Stage A for one view: writes `params` into buffers.view_params, zeroes the
+    /// Records geometry stage for one view: writes `params` into buffers.view_params, zeroes the
     /// counters (and, from N, the scan and emit sizes and the depth sort's parameters), then
     /// project (slot i = splat i) -> one stable sort of all
     /// N slots by depth (culled splats last, ties by index) -> scan tile counts of the N slots
@@ -111,15 +111,15 @@ public:
     /// COMPUTE_SHADER storage writes (the counters also) for the caller to barrier.
     /// With `timestamps` (reset by the caller in this command buffer), the projection and
     /// its dispatch arguments are timed as TimedPass::kProject and everything after as kSort.
-    void Record(VkCommandBuffer cmd, const StageASceneBuffers& scene,
-                const StageAViewBuffers& buffers, const shader::GaussianViewParams& params,
+    void Record(VkCommandBuffer cmd, const GeometryStageSceneBuffers& scene,
+                const GeometryStageViewBuffers& buffers, const shader::GaussianViewParams& params,
                 const GpuTimestamps* timestamps = nullptr);
 
 private:
     VkPipeline GetProjectPipeline(uint32_t sh_degree, bool antialias, SplatPrecision precision,
                                   bool indexed_list);
-    void PushBindings(VkCommandBuffer cmd, const StageASceneBuffers& scene,
-                      const StageAViewBuffers& buffers) const;
+    void PushBindings(VkCommandBuffer cmd, const GeometryStageSceneBuffers& scene,
+                      const GeometryStageViewBuffers& buffers) const;
 
     const VulkanContext& context_;
     RadixSort sort_;

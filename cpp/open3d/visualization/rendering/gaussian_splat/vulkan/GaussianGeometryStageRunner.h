@@ -1,5 +1,5 @@
-// A small synchronous driver around GaussianStageA for tests, tools and benchmarks: it
-// uploads a packed scene once, then per Run() records Stage A, submits, waits on the
+// A small synchronous driver around GaussianGeometryStage for tests, tools and benchmarks: it
+// uploads a packed scene once, then per Run() records geometry stage, submits, waits on the
 // fence and reads back the projected splats, the depth-ordered visible list, the sorted
 // tile entries and the counters. Frames of the real backend submit without waiting.
 #pragma once
@@ -12,8 +12,8 @@
 #include "open3d/visualization/rendering/gaussian_splat/RenderConfig.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/Buffer.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/Commands.h"
-#include "open3d/visualization/rendering/gaussian_splat/vulkan/GaussianStageA.h"
-#include "open3d/visualization/rendering/gaussian_splat/vulkan/GaussianStageAResources.h"
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/GaussianGeometryStage.h"
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/GaussianGeometryStageResources.h"
 #include "shaders/GaussianSplatContract.h"
 
 namespace open3d {
@@ -21,9 +21,9 @@ namespace visualization {
 namespace rendering {
 namespace vulkan {
 
-/// What one Stage A run produced, copied to the host after the fence.
-struct StageAReadback {
-    shader::GaussianStageACounters counters{};
+/// What one geometry stage run produced, copied to the host after the fence.
+struct GeometryStageReadback {
+    shader::GaussianGeometryStageCounters counters{};
     int64_t num_splats = 0;
     /// [N] (empty unless asked for); only entries of visible splats were written this run (others
     /// hold stale data).
@@ -36,26 +36,26 @@ struct StageAReadback {
     /// [entry_count]: splat index per entry; front to back within each tile (kPackedKey32:
     /// by truncated depth, ties in append order).
     std::vector<uint32_t> entry_splats;
-    /// Wall-clock time from submit to fence of the Stage A command buffer.
-    double stage_a_ms = 0.0;
+    /// Wall-clock time from submit to fence of the geometry stage command buffer.
+    double geometry_stage_ms = 0.0;
 
     RenderStats ToStats() const;
 };
 
-class GaussianStageARunner {
+class GaussianGeometryStageRunner {
 public:
     /// Uploads `packed` and allocates per-view buffers for up to `entry_capacity` tile
     /// entries. A degree-0 scene gets a 16-byte placeholder for the SH binding.
-    GaussianStageARunner(const VulkanContext& context, const PackedGaussianSplats& packed,
-                         uint32_t entry_capacity);
+    GaussianGeometryStageRunner(const VulkanContext& context, const PackedGaussianSplats& packed,
+                                uint32_t entry_capacity);
 
     /// Replaces the visibility mask ([ceil(N / 32)] words, as in PackedGaussianSplats).
     void SetVisibility(const std::vector<uint32_t>& mask);
 
-    /// Records, submits and waits for Stage A of one view, then reads everything back.
+    /// Records, submits and waits for geometry stage of one view, then reads everything back.
     /// Each error flag is logged as a warning the first time this runner (one view) sees it.
-    StageAReadback Run(const camera::PinholeCamera& camera, const RenderConfig& config,
-                       bool read_projected = true);
+    GeometryStageReadback Run(const camera::PinholeCamera& camera, const RenderConfig& config,
+                              bool read_projected = true);
 
     /// Bytes of the scene buffers on the GPU (positions + shape + SH + mask).
     uint64_t GetSceneBytes() const { return resources_.SceneBytes(); }
@@ -63,8 +63,8 @@ public:
 private:
     const VulkanContext& context_;
     CommandPool pool_;
-    GaussianStageA stage_a_;
-    StageAResources resources_;
+    GaussianGeometryStage geometry_stage_;
+    GeometryStageResources resources_;
     uint32_t warned_flags_ = 0;
 };
 

@@ -1,7 +1,8 @@
 // The backend interface at stage granularity (docs/DESIGN.md section 2): a backend holds a
-// scene, runs Stage A (RenderGeometryStage: project + per-tile entries + depth sort) for a
-// view, then Stage B (RenderCompositeStage: per-tile front-to-back blending). Backends are
-// made by name ("cpu", "placeholder", later "vulkan"/"metal" registered by their layers).
+// scene, runs the geometry stage (RenderGeometryStage: project + per-tile entries + depth sort) for
+// a view, then the composite stage (RenderCompositeStage: per-tile front-to-back blending).
+// Backends are made by name ("cpu", "placeholder", later "vulkan"/"metal" registered by their
+// layers).
 #pragma once
 
 #include <functional>
@@ -62,10 +63,10 @@ public:
     /// Lifecycle: drops the scene and every per-view buffer.
     virtual void ReleaseResources() = 0;
 
-    /// Stage A for one view: project, emit per-tile entries, sort by (tile, depth).
+    /// Geometry stage for one view: project, emit per-tile entries, sort by (tile, depth).
     virtual void RenderGeometryStage(const camera::PinholeCamera& camera,
                                      const RenderConfig& config) = 0;
-    /// Stage B: composite the sorted tiles of the last geometry stage into `output`
+    /// Composite stage: composite the sorted tiles of the last geometry stage into `output`
     /// (images are (re)allocated to the view size). Throws when no geometry stage ran.
     virtual void RenderCompositeStage(RenderOutput& output, const CompositeInputs& inputs = {}) = 0;
 

@@ -1,12 +1,12 @@
-// Stage B's scene-depth test and depth merge against synthetic depth textures in Filament's
-// convention (reversed-Z, d = near / z_view, 0 = nothing drawn), in isolation from Stage A.
+// Composite stage's scene-depth test and depth merge against synthetic depth textures in Filament's
+// convention (reversed-Z, d = near / z_view, 0 = nothing drawn), in isolation from geometry stage.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <limits>
 #include <vector>
 
-#include "StageBTestUtil.h"
+#include "CompositeStageTestUtil.h"
 #include "VulkanTestFixture.h"
 
 namespace open3d {
@@ -45,27 +45,27 @@ std::vector<float> LinearZ(const std::vector<float>& reversed) {
     return z;
 }
 
-class StageBDepth : public VulkanTest {
+class CompositeStageDepth : public VulkanTest {
 protected:
-    gpu::StageBReadback Run(const gpu::StageBRunInputs& in) {
-        gpu::GaussianStageBRunner runner(Context());
+    gpu::CompositeStageReadback Run(const gpu::CompositeStageRunInputs& in) {
+        gpu::GaussianCompositeStageRunner runner(Context());
         return runner.Run(in);
     }
 };
 
-TEST_F(StageBDepth, SplatsBehindTheSceneVanishPixelExactly) {
+TEST_F(CompositeStageDepth, SplatsBehindTheSceneVanishPixelExactly) {
     const auto splats = TwoLayers();
     const auto lists = BuildTileLists(splats, TileGrid::ForImage(kWidth, kHeight), {});
     for (const bool flip_y : {false, true}) {
         SCOPED_TRACE(flip_y ? "texture stored bottom row first" : "top row first");
-        gpu::StageBRunInputs in = ToStageBInputs(splats, lists, kWidth, kHeight);
+        gpu::CompositeStageRunInputs in = ToCompositeStageInputs(splats, lists, kWidth, kHeight);
         in.scene_depth = ReversedZ();
         in.scene_near = kNear;
         in.scene_depth_flip_y = flip_y;
         const auto out = Run(in);
         const auto ref =
             ReferenceComposite(splats, lists, kWidth, kHeight, {}, LinearZ(in.scene_depth));
-        // Same float32 rules as the analytic cases (StageBCompositeTest.cpp): <= 1e-6.
+        // Same float32 rules as the analytic cases (CompositeStageCompositeTest.cpp): <= 1e-6.
         EXPECT_LE(CompareImage(out.color, ref.color).max_abs, 1e-6);
         EXPECT_LE(CompareImage(out.depth, ref.depth_expected).max_abs, 1e-5);
         for (int y = 0; y < kHeight; ++y) {
@@ -84,10 +84,10 @@ TEST_F(StageBDepth, SplatsBehindTheSceneVanishPixelExactly) {
     }
 }
 
-TEST_F(StageBDepth, WithoutTheSpecialisationNoDepthIsRead) {
+TEST_F(CompositeStageDepth, WithoutTheSpecialisationNoDepthIsRead) {
     const auto splats = TwoLayers();
     const auto lists = BuildTileLists(splats, TileGrid::ForImage(kWidth, kHeight), {});
-    gpu::StageBRunInputs in = ToStageBInputs(splats, lists, kWidth, kHeight);
+    gpu::CompositeStageRunInputs in = ToCompositeStageInputs(splats, lists, kWidth, kHeight);
     const auto without = Run(in);
     // A texture that would hide everything (mesh at z = 1), bound but not tested.
     in.scene_depth.assign(size_t(kWidth) * kHeight, kNear / 1.0f);
@@ -102,13 +102,13 @@ TEST_F(StageBDepth, WithoutTheSpecialisationNoDepthIsRead) {
     for (float a : tested.alpha) ASSERT_EQ(a, 0.f);
 }
 
-TEST_F(StageBDepth, MergeTakesTheNearerDepth) {
+TEST_F(CompositeStageDepth, MergeTakesTheNearerDepth) {
     // A splat (opacity 0.9, sigma 4 px, z = 3) centred at (8, 12); a mesh at z = 5 on rows
     // 0..11.
     const std::vector<ProjectedSplat> splats{
         MakeSplat(8.0, 12.0, 3.0, 4.0, 0.9, {1.0, 1.0, 1.0}, kWidth, kHeight)};
     const auto lists = BuildTileLists(splats, TileGrid::ForImage(kWidth, kHeight), {});
-    gpu::StageBRunInputs in = ToStageBInputs(splats, lists, kWidth, kHeight);
+    gpu::CompositeStageRunInputs in = ToCompositeStageInputs(splats, lists, kWidth, kHeight);
     in.scene_depth.assign(size_t(kWidth) * kHeight, 0.f);
     for (int y = 0; y < 12; ++y) {
         for (int x = 0; x < kWidth; ++x) in.scene_depth[size_t(y) * kWidth + x] = kNear / 5.0f;

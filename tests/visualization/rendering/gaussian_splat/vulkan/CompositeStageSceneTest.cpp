@@ -1,5 +1,5 @@
-// Stage B on real scenes (cameras.json views at small sizes), in isolation from Stage A: the
-// CPU reference's projection and tile lists are composited on the GPU and compared with
+// Composite stage on real scenes (cameras.json views at small sizes), in isolation from geometry
+// stage: the CPU reference's projection and tile lists are composited on the GPU and compared with
 // cpu::CompositeTiles, with and without a synthetic scene depth.
 #include <gtest/gtest.h>
 
@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "StageBTestUtil.h"
+#include "CompositeStageTestUtil.h"
 #include "TestUtility.h"
 #include "VulkanTestFixture.h"
 #include "open3d/camera/CamerasJson.h"
@@ -56,9 +56,9 @@ constexpr double kMinPsnrDb = 80.0;
 constexpr double kMaxFractionOverLsb = 1e-4;
 constexpr double kMaxP999 = 0.1 / 255.0;
 
-class StageBScene : public VulkanTest, public ::testing::WithParamInterface<SceneCase> {};
+class CompositeStageScene : public VulkanTest, public ::testing::WithParamInterface<SceneCase> {};
 
-TEST_P(StageBScene, MatchesReference) {
+TEST_P(CompositeStageScene, MatchesReference) {
     const SceneCase& c = GetParam();
     OPEN3D_REQUIRE_DATA(c.scene);
     OPEN3D_REQUIRE_DATA(c.cameras);
@@ -70,13 +70,13 @@ TEST_P(StageBScene, MatchesReference) {
     const auto lists = BuildTileLists(splats, TileGrid::ForImage(c.width, c.height), config);
     ASSERT_GT(lists.NumEntries(), 100);
 
-    gpu::GaussianStageBRunner runner(Context());
-    gpu::StageBRunInputs in = ToStageBInputs(splats, lists, c.width, c.height);
+    gpu::GaussianCompositeStageRunner runner(Context());
+    gpu::CompositeStageRunInputs in = ToCompositeStageInputs(splats, lists, c.width, c.height);
     const auto out = runner.Run(in);
     const auto ref = ReferenceComposite(splats, lists, c.width, c.height, config);
     const ErrorStats color = CompareImage(out.color, ref.color);
     const ErrorStats depth = CompareImage(out.depth, ref.depth_expected);
-    std::cout << "[ Stage B ] " << c.scene << " view " << c.view << " " << c.width << "x"
+    std::cout << "[ composite stage ] " << c.scene << " view " << c.view << " " << c.width << "x"
               << c.height << ": " << lists.NumEntries() << " entries, colour PSNR " << color.psnr_db
               << " dB, max " << color.max_abs * 255 << "/255, p99.9 " << color.p999_abs * 255
               << "/255, over 1/255 " << color.fraction_over_lsb << "; depth max " << depth.max_abs
@@ -87,7 +87,7 @@ TEST_P(StageBScene, MatchesReference) {
     EXPECT_LE(color.p999_abs, kMaxP999);
 }
 
-TEST_P(StageBScene, SceneDepthMatchesReference) {
+TEST_P(CompositeStageScene, SceneDepthMatchesReference) {
     const SceneCase& c = GetParam();
     OPEN3D_REQUIRE_DATA(c.scene);
     OPEN3D_REQUIRE_DATA(c.cameras);
@@ -105,7 +105,7 @@ TEST_P(StageBScene, SceneDepthMatchesReference) {
     std::nth_element(depths.begin(), depths.begin() + depths.size() / 2, depths.end());
     const double middle = depths[depths.size() / 2];
     const float near = 0.05f;
-    gpu::StageBRunInputs in = ToStageBInputs(splats, lists, c.width, c.height);
+    gpu::CompositeStageRunInputs in = ToCompositeStageInputs(splats, lists, c.width, c.height);
     in.scene_near = near;
     in.scene_depth_flip_y = true;
     in.scene_depth.resize(size_t(c.width) * c.height);
@@ -119,11 +119,11 @@ TEST_P(StageBScene, SceneDepthMatchesReference) {
             linear[i] = x < 3 ? std::numeric_limits<float>::infinity() : near / in.scene_depth[i];
         }
     }
-    gpu::GaussianStageBRunner runner(Context());
+    gpu::GaussianCompositeStageRunner runner(Context());
     const auto out = runner.Run(in);
     const auto ref = ReferenceComposite(splats, lists, c.width, c.height, config, linear);
     const ErrorStats color = CompareImage(out.color, ref.color);
-    std::cout << "[ Stage B ] scene depth " << c.scene << " " << c.width << "x" << c.height
+    std::cout << "[ composite stage ] scene depth " << c.scene << " " << c.width << "x" << c.height
               << ": colour PSNR " << color.psnr_db << " dB, max " << color.max_abs * 255
               << "/255\n";
     // The same targets: a splat within float rounding of the plane may flip, none did.
@@ -133,7 +133,7 @@ TEST_P(StageBScene, SceneDepthMatchesReference) {
 }
 
 INSTANTIATE_TEST_SUITE_P(
-    Scenes, StageBScene,
+    Scenes, CompositeStageScene,
     ::testing::Values(SceneCase{"playbot/playbot_31k.ply", "playbot/cameras.json", 0, 96, 96},
                       SceneCase{"playbot/playbot_31k.ply", "playbot/cameras.json", 7, 100, 75},
                       SceneCase{"chair/chair.splat", "chair/cameras.json", 0, 96, 96},

@@ -1,6 +1,6 @@
-// The GPU buffers Stage A runs on: one packed scene (uploaded once) and one view's outputs
-// and scratch, sized from GaussianStageA::GetStorageRequirements. The backend and the test
-// runner share it, so both allocate, upload and bind Stage A the same way.
+// The GPU buffers geometry stage runs on: one packed scene (uploaded once) and one view's outputs
+// and scratch, sized from GaussianGeometryStage::GetStorageRequirements. The backend and the test
+// runner share it, so both allocate, upload and bind geometry stage the same way.
 #pragma once
 
 #include <cstdint>
@@ -11,7 +11,7 @@
 #include "open3d/visualization/rendering/gaussian_splat/RenderConfig.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/Buffer.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/Commands.h"
-#include "open3d/visualization/rendering/gaussian_splat/vulkan/GaussianStageA.h"
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/GaussianGeometryStage.h"
 
 namespace open3d {
 namespace visualization {
@@ -23,7 +23,7 @@ namespace vulkan {
 Buffer UploadStorageBuffer(const VulkanContext& context, const CommandPool& pool, const void* data,
                            VkDeviceSize bytes);
 
-class StageAResources {
+class GeometryStageResources {
 public:
     /// Uploads the packed attributes (a degree-0 scene gets a 16-byte SH placeholder: the
     /// binding must name a buffer) and keeps the packing's sizes.
@@ -35,9 +35,9 @@ public:
     /// (Re)allocates the per-view buffers for the scene's splats and `entry_capacity` entries.
     void AllocateView(const VulkanContext& context, uint32_t entry_capacity);
 
-    /// Bindings of the uploaded scene and of the view buffers for GaussianStageA::Record.
-    StageASceneBuffers Scene() const;
-    StageAViewBuffers View() const;
+    /// Bindings of the uploaded scene and of the view buffers for GaussianGeometryStage::Record.
+    GeometryStageSceneBuffers Scene() const;
+    GeometryStageViewBuffers View() const;
     /// The view parameters of `camera` for this scene and view allocation.
     shader::GaussianViewParams ViewParams(const camera::PinholeCamera& camera,
                                           const RenderConfig& config) const;
@@ -51,7 +51,7 @@ public:
 
     // Scene.
     Buffer positions, shape, sh, visibility;
-    // View: Stage A's outputs (projected splats, counters, sorted entries) and scratch.
+    // View: geometry stage's outputs (projected splats, counters, sorted entries) and scratch.
     Buffer view_params, projected, counters, depth_keys, splat_indices, tile_counts, scan;
     Buffer entry_keys, entry_values, keys_alt, values_alt, histogram, sort_params;
 

@@ -1,4 +1,4 @@
-#include "open3d/visualization/rendering/gaussian_splat/vulkan/GaussianStageARunner.h"
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/GaussianGeometryStageRunner.h"
 #include "open3d/core/Timer.h"
 
 #include <chrono>
@@ -49,46 +49,47 @@ const char* FlagMessage(uint32_t bit) {
     return bit == kEntriesDropped
                ? "tile entries were dropped (a splat touches more than max_tiles_per_splat "
                  "tiles or the entries exceed max_tile_entries_total / the allocation)"
-               : "Stage A counts were clamped to the allocated tile-entry capacity";
+               : "Geometry stage counts were clamped to the allocated tile-entry capacity";
 }
 
 }  // namespace
 
-RenderStats StageAReadback::ToStats() const {
+RenderStats GeometryStageReadback::ToStats() const {
     RenderStats stats;
     stats.num_splats = num_splats;
     stats.num_visible = counters.visible_count;
     stats.num_tile_entries = counters.entry_count;
     stats.error_flags = counters.error_flags;
-    stats.geometry_ms = stage_a_ms;
+    stats.geometry_ms = geometry_stage_ms;
     return stats;
 }
 
-GaussianStageARunner::GaussianStageARunner(const VulkanContext& context,
-                                           const PackedGaussianSplats& packed,
-                                           uint32_t entry_capacity)
-    : context_(context), pool_(context), stage_a_(context) {
+GaussianGeometryStageRunner::GaussianGeometryStageRunner(const VulkanContext& context,
+                                                         const PackedGaussianSplats& packed,
+                                                         uint32_t entry_capacity)
+    : context_(context), pool_(context), geometry_stage_(context) {
     resources_.UploadScene(context, pool_, packed);
     resources_.AllocateView(context, entry_capacity);
 }
 
-void GaussianStageARunner::SetVisibility(const std::vector<uint32_t>& mask) {
+void GaussianGeometryStageRunner::SetVisibility(const std::vector<uint32_t>& mask) {
     resources_.UploadVisibility(context_, pool_, mask);
 }
 
-StageAReadback GaussianStageARunner::Run(const camera::PinholeCamera& camera,
-                                         const RenderConfig& config, bool read_projected) {
+GeometryStageReadback GaussianGeometryStageRunner::Run(const camera::PinholeCamera& camera,
+                                                       const RenderConfig& config,
+                                                       bool read_projected) {
     const shader::GaussianViewParams params = resources_.ViewParams(camera, config);
-    const StageASceneBuffers scene = resources_.Scene();
-    const StageAViewBuffers view = resources_.View();
+    const GeometryStageSceneBuffers scene = resources_.Scene();
+    const GeometryStageViewBuffers view = resources_.View();
 
-    StageAReadback out;
+    GeometryStageReadback out;
     out.num_splats = resources_.Layout().num_splats;
     std::vector<PendingCopy> pending;
     {
         CommandBuffer cmd = pool_.Allocate();
         cmd.Begin();
-        stage_a_.Record(cmd.Get(), scene, view, params);
+        geometry_stage_.Record(cmd.Get(), scene, view, params);
         ComputeToTransferBarrier(cmd.Get());
         RecordCopy(context_, cmd.Get(), resources_.counters, sizeof(out.counters), &out.counters,
                    pending);
@@ -97,7 +98,7 @@ StageAReadback GaussianStageARunner::Run(const camera::PinholeCamera& camera,
         const auto start = std::chrono::steady_clock::now();
         Submit(context_, cmd.Get(), fence.Get());
         Wait(context_, fence.Get());
-        out.stage_a_ms = core::MillisecondsSince(start);
+        out.geometry_stage_ms = core::MillisecondsSince(start);
         FinishCopies(pending);
     }
 
@@ -105,7 +106,7 @@ StageAReadback GaussianStageARunner::Run(const camera::PinholeCamera& camera,
     const uint32_t new_flags = out.counters.error_flags & ~warned_flags_;
     for (uint32_t bit : {kEntriesDropped, kCountsClamped}) {
         if (new_flags & bit)
-            core::LogWarning("Gaussian splat Stage A (Vulkan): {}", FlagMessage(bit));
+            core::LogWarning("Gaussian splat geometry stage (Vulkan): {}", FlagMessage(bit));
     }
     warned_flags_ |= out.counters.error_flags;
 

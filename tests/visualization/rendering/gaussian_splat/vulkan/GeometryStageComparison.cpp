@@ -1,4 +1,4 @@
-#include "StageAComparison.h"
+#include "GeometryStageComparison.h"
 
 #include <fmt/format.h>
 
@@ -65,7 +65,7 @@ using OrderKey = std::pair<float, uint32_t>;  // (float32 depth, splat index)
 
 }  // namespace
 
-std::string StageAComparison::Summary() const {
+std::string GeometryStageComparison::Summary() const {
     return fmt::format(
         "splats {} visible cpu/gpu {}/{} cull flips {} (unexplained {}) | max err: centre "
         "{:.3g} px, depth {:.3g} rel, conic {:.3g} rel, opacity {:.3g}, colour {:.3g}; radius "
@@ -80,11 +80,11 @@ std::string StageAComparison::Summary() const {
         visible_list_misordered);
 }
 
-StageAComparison CompareStageA(const t::geometry::PointCloud& cloud,
-                               const camera::PinholeCamera& camera, const RenderConfig& config,
-                               const visualization::rendering::vulkan::StageAReadback& gpu,
-                               const std::vector<bool>& hidden) {
-    StageAComparison c;
+GeometryStageComparison CompareGeometryStage(
+    const t::geometry::PointCloud& cloud, const camera::PinholeCamera& camera,
+    const RenderConfig& config, const visualization::rendering::vulkan::GeometryStageReadback& gpu,
+    const std::vector<bool>& hidden) {
+    GeometryStageComparison c;
     std::vector<ProjectedSplat> ref = ProjectSplats(cloud, camera, config);
     const size_t n = ref.size();
     c.num_splats = static_cast<int64_t>(n);

@@ -1,6 +1,6 @@
-// Helpers of the Stage B tests: Stage B is tested in isolation from Stage A. The CPU
-// reference's projection and tile lists are turned into exactly what Stage A hands over
-// (GaussianProjectedSplat records rounded to float32, (tile, splat) entries sorted by tile in
+// Helpers of the composite stage tests: composite stage is tested in isolation from geometry stage.
+// The CPU reference's projection and tile lists are turned into exactly what geometry stage hands
+// over (GaussianProjectedSplat records rounded to float32, (tile, splat) entries sorted by tile in
 // depth order), composited on the GPU and compared with cpu::CompositeTiles.
 #pragma once
 
@@ -12,7 +12,7 @@
 #include "open3d/visualization/rendering/gaussian_splat/cpu/Composite.h"
 #include "open3d/visualization/rendering/gaussian_splat/cpu/Projection.h"
 #include "open3d/visualization/rendering/gaussian_splat/cpu/TileLists.h"
-#include "open3d/visualization/rendering/gaussian_splat/vulkan/GaussianStageBRunner.h"
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/GaussianCompositeStageRunner.h"
 
 namespace open3d {
 namespace tests {
@@ -20,11 +20,11 @@ namespace tests {
 namespace rendering = visualization::rendering;
 namespace gpu = visualization::rendering::vulkan;
 
-/// The Stage A hand-over for the reference's splats and lists.
-inline gpu::StageBRunInputs ToStageBInputs(
+/// The geometry stage hand-over for the reference's splats and lists.
+inline gpu::CompositeStageRunInputs ToCompositeStageInputs(
     const std::vector<rendering::cpu::ProjectedSplat>& splats,
     const rendering::cpu::TileLists& lists, int width, int height) {
-    gpu::StageBRunInputs in;
+    gpu::CompositeStageRunInputs in;
     in.width = static_cast<uint32_t>(width);
     in.height = static_cast<uint32_t>(height);
     in.projected.resize(splats.size());

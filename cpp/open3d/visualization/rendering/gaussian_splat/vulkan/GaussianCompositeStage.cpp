@@ -1,4 +1,4 @@
-#include "open3d/visualization/rendering/gaussian_splat/vulkan/GaussianStageB.h"
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/GaussianCompositeStage.h"
 
 #include <algorithm>
 #include <vector>
@@ -87,7 +87,8 @@ UniquePipeline CreateSpecialised(const VulkanContext& context, VkPipelineLayout 
 }
 
 void RequireView(VkImageView view, const char* what) {
-    if (view == VK_NULL_HANDLE) core::ThrowError("GaussianStageB: {} has no image view", what);
+    if (view == VK_NULL_HANDLE)
+        core::ThrowError("GaussianCompositeStage: {} has no image view", what);
 }
 
 }  // namespace
@@ -97,7 +98,7 @@ VkFormat ToVkFormat(CompositeColorFormat format) {
                                                     : VK_FORMAT_R32G32B32A32_SFLOAT;
 }
 
-GaussianStageB::GaussianStageB(const VulkanContext& context) : context_(context) {
+GaussianCompositeStage::GaussianCompositeStage(const VulkanContext& context) : context_(context) {
     const VkDescriptorType kBuffer = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
     const VkDescriptorType kStorage = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
     const VkDescriptorType kSampled = VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE;
@@ -121,18 +122,18 @@ GaussianStageB::GaussianStageB(const VulkanContext& context) : context_(context)
     placeholder_depth_ = Image(context, 1, 1, VK_FORMAT_R32_SFLOAT, VK_IMAGE_USAGE_SAMPLED_BIT);
 }
 
-StageBStorageRequirements GaussianStageB::GetStorageRequirements() {
-    return StageBStorageRequirements{};
+CompositeStageStorageRequirements GaussianCompositeStage::GetStorageRequirements() {
+    return CompositeStageStorageRequirements{};
 }
 
-VkDeviceSize GaussianStageB::StateBytes(uint32_t width, uint32_t height) {
+VkDeviceSize GaussianCompositeStage::StateBytes(uint32_t width, uint32_t height) {
     const uint64_t tiles_x = (uint64_t(width) + kCompositeTileSize - 1) / kCompositeTileSize;
     const uint64_t tiles_y = (uint64_t(height) + kCompositeTileSize - 1) / kCompositeTileSize;
     return sizeof(GaussianCompositeState) + sizeof(uint32_t) * 2 * tiles_x * tiles_y;
 }
 
-VkPipeline GaussianStageB::GetCompositePipeline(CompositeColorFormat format,
-                                                const CompositeParams& params) {
+VkPipeline GaussianCompositeStage::GetCompositePipeline(CompositeColorFormat format,
+                                                        const CompositeParams& params) {
     const bool half = format == CompositeColorFormat::kRgba16f;
     const bool scene_depth = params.scene_depth != nullptr;
     const uint32_t depth_outputs = (params.expected_depth ? kCompositeExpectedDepthBit : 0u) |
@@ -149,7 +150,7 @@ VkPipeline GaussianStageB::GetCompositePipeline(CompositeColorFormat format,
     return pipeline.Get();
 }
 
-VkPipeline GaussianStageB::GetDepthMergePipeline(bool scene_depth) {
+VkPipeline GaussianCompositeStage::GetDepthMergePipeline(bool scene_depth) {
     UniquePipeline& pipeline = merge_[scene_depth ? 1 : 0];
     if (!pipeline) {
         pipeline = CreateSpecialised(context_, merge_layout_.Get(), spirv::kGaussianDepthMerge,
@@ -158,7 +159,7 @@ VkPipeline GaussianStageB::GetDepthMergePipeline(bool scene_depth) {
     return pipeline.Get();
 }
 
-VkDescriptorImageInfo GaussianStageB::SceneDepthDescriptor(
+VkDescriptorImageInfo GaussianCompositeStage::SceneDepthDescriptor(
     VkCommandBuffer cmd, const SceneDepthTexture* scene_depth) const {
     if (scene_depth) {
         RequireView(scene_depth->view, "scene_depth");
@@ -174,11 +175,14 @@ VkDescriptorImageInfo GaussianStageB::SceneDepthDescriptor(
     return {VK_NULL_HANDLE, placeholder_depth_.GetView(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
 }
 
-void GaussianStageB::RecordComposite(VkCommandBuffer cmd, const StageBInputs& inputs,
-                                     const StageBTargets& targets, const BufferRange& state,
-                                     const CompositeParams& params) {
+void GaussianCompositeStage::RecordComposite(VkCommandBuffer cmd,
+                                             const CompositeStageInputs& inputs,
+                                             const CompositeStageTargets& targets,
+                                             const BufferRange& state,
+                                             const CompositeParams& params) {
     if (targets.width == 0 || targets.height == 0) {
-        core::ThrowError("GaussianStageB: the image is {}x{}", targets.width, targets.height);
+        core::ThrowError("GaussianCompositeStage: the image is {}x{}", targets.width,
+                         targets.height);
     }
     RequireView(targets.color, "color");
     RequireView(targets.depth, "depth");
@@ -189,18 +193,19 @@ void GaussianStageB::RecordComposite(VkCommandBuffer cmd, const StageBInputs& in
          {&inputs.projected, &inputs.entry_keys, &inputs.entry_values, &state}) {
         if (range->buffer == VK_NULL_HANDLE || range->offset % alignment != 0) {
             core::ThrowError(
-                "GaussianStageB: every input buffer needs a buffer and an offset that is a "
+                "GaussianCompositeStage: every input buffer needs a buffer and an offset that is a "
                 "multiple of minStorageBufferOffsetAlignment {}",
                 alignment);
         }
     }
     if (inputs.entry_count.buffer == VK_NULL_HANDLE || inputs.entry_count.offset % 4 != 0) {
-        core::ThrowError("GaussianStageB: entry_count needs a buffer and a 4-byte aligned offset");
+        core::ThrowError(
+            "GaussianCompositeStage: entry_count needs a buffer and a 4-byte aligned offset");
     }
     const VkDeviceSize state_bytes = StateBytes(targets.width, targets.height);
     if (state.size != VK_WHOLE_SIZE && state.size < state_bytes) {
-        core::ThrowError("GaussianStageB: state holds {} bytes, a {}x{} image needs {}", state.size,
-                         targets.width, targets.height, state_bytes);
+        core::ThrowError("GaussianCompositeStage: state holds {} bytes, a {}x{} image needs {}",
+                         state.size, targets.width, targets.height, state_bytes);
     }
 
     const uint32_t tiles_x = (targets.width + kCompositeTileSize - 1) / kCompositeTileSize;
@@ -281,17 +286,17 @@ void GaussianStageB::RecordComposite(VkCommandBuffer cmd, const StageBInputs& in
     vkCmdDispatch(cmd, workgroups, 1, 1);
 }
 
-void GaussianStageB::RecordDepthMerge(VkCommandBuffer cmd, const DepthMergeImages& images,
-                                      const DepthMergeParams& params) {
+void GaussianCompositeStage::RecordDepthMerge(VkCommandBuffer cmd, const DepthMergeImages& images,
+                                              const DepthMergeParams& params) {
     if (images.width == 0 || images.height == 0) {
-        core::ThrowError("GaussianStageB: the image is {}x{}", images.width, images.height);
+        core::ThrowError("GaussianCompositeStage: the image is {}x{}", images.width, images.height);
     }
     RequireView(images.splat_depth, "splat_depth");
     RequireView(images.splat_alpha, "splat_alpha");
     RequireView(images.normalized, "normalized");
     RequireView(images.linear, "linear");
     if (!(params.far > params.near)) {
-        core::ThrowError("GaussianStageB: depth merge range [{}, {}] is empty", params.near,
+        core::ThrowError("GaussianCompositeStage: depth merge range [{}, {}] is empty", params.near,
                          params.far);
     }
     GaussianDepthMergePushConstants push{};

@@ -1,4 +1,4 @@
-// CPU-side Stage A pieces: the contract layouts, attribute and view-parameter
+// CPU-side geometry stage pieces: the contract layouts, attribute and view-parameter
 // packing, fp16 conversion and the tile bits of the sort key. No Vulkan device
 // needed.
 #include <gtest/gtest.h>
@@ -18,7 +18,7 @@ namespace {
 using namespace visualization::rendering;
 namespace shader = visualization::rendering::shader;
 
-TEST(StageAPacking, ContractLayoutsArePinned) {
+TEST(GeometryStagePacking, ContractLayoutsArePinned) {
     // The same numbers as the static_asserts in the contract header, checked at
     // run time too so a layout change shows up as a named test failure.
     EXPECT_EQ(sizeof(shader::GaussianViewParams), 192u);
@@ -27,14 +27,14 @@ TEST(StageAPacking, ContractLayoutsArePinned) {
     EXPECT_EQ(offsetof(shader::GaussianViewParams, depth_order), 176u);
     EXPECT_EQ(sizeof(shader::GaussianProjectedSplat), 64u);
     EXPECT_EQ(offsetof(shader::GaussianProjectedSplat, tiles), 48u);
-    EXPECT_EQ(sizeof(shader::GaussianStageACounters), 32u + 16u * shader::kScanMaxLevels);
-    EXPECT_EQ(offsetof(shader::GaussianStageACounters, entry_count),
+    EXPECT_EQ(sizeof(shader::GaussianGeometryStageCounters), 32u + 16u * shader::kScanMaxLevels);
+    EXPECT_EQ(offsetof(shader::GaussianGeometryStageCounters, entry_count),
               4u * shader::kCounterEntriesIndex);
     EXPECT_EQ(sizeof(shader::GaussianScanPushConstants), 32u);
     EXPECT_EQ(shader::kGaussianTileSize, static_cast<uint32_t>(kTileSize));
 }
 
-TEST(StageAPacking, SortKeyTileBits) {
+TEST(GeometryStagePacking, SortKeyTileBits) {
     // Real viewports (16x16 tiles): 1080p 120x68, 4K 240x135, 8K 480x270.
     EXPECT_EQ(SortKeyTileBits(120 * 68), 13u);   // 8,160 tiles
     EXPECT_EQ(SortKeyTileBits(240 * 135), 15u);  // 32,400
@@ -49,7 +49,7 @@ TEST(StageAPacking, SortKeyTileBits) {
     EXPECT_EQ(SortKeyTileBits(uint64_t(1) << 40), shader::kSortKeyMaxTileBits);
 }
 
-TEST(StageAPacking, HalfConversion) {
+TEST(GeometryStagePacking, HalfConversion) {
     for (float v : {0.0f, 1.0f, -2.5f, 65504.0f, 6.1035156e-05f, 5.9604645e-08f, 0.1f}) {
         const float back = HalfToFloat(FloatToHalf(v));
         EXPECT_NEAR(back, v, std::abs(v) * 1e-3 + 1e-8) << v;
@@ -67,7 +67,7 @@ TEST(StageAPacking, HalfConversion) {
     }
 }
 
-TEST(StageAPacking, ExactAttributes) {
+TEST(GeometryStagePacking, ExactAttributes) {
     TestSplat s;
     s.position = {1, 2, 3};
     s.scale = {0.1, 0.2, 0.3};
@@ -98,7 +98,7 @@ TEST(StageAPacking, ExactAttributes) {
     EXPECT_FLOAT_EQ(std::bit_cast<float>(d1.sh[9 + 8]), float(0.08));
 }
 
-TEST(StageAPacking, CompactAttributesFitTheBudget) {
+TEST(GeometryStagePacking, CompactAttributesFitTheBudget) {
     TestSplat s;
     s.f_rest.assign(45, 0.5);
     const PackedGaussianSplats p =
@@ -110,7 +110,7 @@ TEST(StageAPacking, CompactAttributesFitTheBudget) {
     EXPECT_FLOAT_EQ(HalfToFloat(uint16_t(p.sh[0] & 0xFFFF)), 0.5f);
 }
 
-TEST(StageAPacking, ViewParams) {
+TEST(GeometryStagePacking, ViewParams) {
     const auto cam = MakeTestCamera(100, 75);  // fx = fy = 100, principal point (32, 32)
     RenderConfig config;
     config.sh_degree = 2;

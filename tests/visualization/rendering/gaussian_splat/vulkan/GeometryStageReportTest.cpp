@@ -1,5 +1,5 @@
 // Issue 8's cross-device report (not a regular test: DISABLED_ unless asked for with
-// --gtest_also_run_disabled_tests). Renders Stage A of playbot_125k view 0 at 1920x1080
+// --gtest_also_run_disabled_tests). Renders geometry stage of playbot_125k view 0 at 1920x1080
 // (fx = fy = fx_json * 1080 / 800), compares it with the CPU reference, and, when
 // OPEN3D_STAGE_A_DUMP names a file, writes the sorted entries there ((tile, splat) uint32
 // pairs) so two devices' lists can be compared entry by entry.
@@ -9,12 +9,12 @@
 #include <cstdlib>
 #include <iostream>
 
-#include "StageAComparison.h"
+#include "GeometryStageComparison.h"
 #include "TestUtility.h"
 #include "open3d/camera/CamerasJson.h"
 #include "open3d/t/io/PointCloudIO.h"
 #include "open3d/visualization/rendering/gaussian_splat/GaussianSplatDataPacking.h"
-#include "open3d/visualization/rendering/gaussian_splat/vulkan/GaussianStageARunner.h"
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/GaussianGeometryStageRunner.h"
 #include "visualization/rendering/gaussian_splat/vulkan/VulkanTestFixture.h"
 
 namespace open3d {
@@ -23,9 +23,9 @@ namespace {
 
 using namespace visualization::rendering;
 
-class StageAReport : public VulkanTest {};
+class GeometryStageReport : public VulkanTest {};
 
-TEST_F(StageAReport, DISABLED_Playbot125kView0At1080p) {
+TEST_F(GeometryStageReport, DISABLED_Playbot125kView0At1080p) {
     OPEN3D_REQUIRE_DATA("playbot/playbot_125k.ply");
     t::geometry::PointCloud cloud;
     t::io::ReadPointCloud(DataPath("playbot/playbot_125k.ply"), cloud);
@@ -38,11 +38,11 @@ TEST_F(StageAReport, DISABLED_Playbot125kView0At1080p) {
     cam.cx = (cam.width - 1) / 2.0;
     cam.cy = (cam.height - 1) / 2.0;
     const RenderConfig config;
-    vulkan::GaussianStageARunner runner(Context(), PackGaussianSplatAttrs(cloud), 1u << 24);
-    const vulkan::StageAReadback gpu = runner.Run(cam, config);
-    const StageAComparison c = CompareStageA(cloud, cam, config, gpu);
-    std::cout << "[stage A report] playbot_125k view 0 1920x1080: " << c.Summary()
-              << " | submit-to-fence " << gpu.stage_a_ms << " ms\n";
+    vulkan::GaussianGeometryStageRunner runner(Context(), PackGaussianSplatAttrs(cloud), 1u << 24);
+    const vulkan::GeometryStageReadback gpu = runner.Run(cam, config);
+    const GeometryStageComparison c = CompareGeometryStage(cloud, cam, config, gpu);
+    std::cout << "[geometry stage report] playbot_125k view 0 1920x1080: " << c.Summary()
+              << " | submit-to-fence " << gpu.geometry_stage_ms << " ms\n";
     EXPECT_EQ(c.tiles_misordered, 0);
     EXPECT_EQ(c.gpu_span_mismatches, 0);
     EXPECT_EQ(c.cull_flips_unexplained, 0);
