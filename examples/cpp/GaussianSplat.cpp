@@ -98,9 +98,9 @@ int Run(const Options& opt) {
         if (opt.sphere_radius > 0.0) radius = opt.sphere_radius;
         t::geometry::TriangleMesh sphere = t::geometry::TriangleMesh::CreateSphere(radius, 40);
         sphere.Translate(center);
-        rendering::MeshMaterial red;
+        rendering::MaterialRecord red;
+        red.shader = rendering::kShaderDefaultLit;
         red.base_color = Eigen::Vector4f(1.0f, 0.0f, 0.0f, 1.0f);
-        red.shading = 0.35f;
         viewer.AddGeometry("sphere", sphere, red);
     }
     viewer.GetSplatConfig().sh_degree = opt.sh_degree;

@@ -25,9 +25,9 @@ void RenderWithFilament(const t::geometry::PointCloud& cloud, const camera::Pinh
         t::geometry::TriangleMesh sphere =
             t::geometry::TriangleMesh::CreateSphere(options.sphere_radius, 40);
         sphere.Translate(options.sphere_center);
-        rendering::MeshMaterial red;
+        rendering::MaterialRecord red;
+        red.shader = rendering::kShaderDefaultLit;
         red.base_color = Eigen::Vector4f(1, 0, 0, 1);
-        red.shading = 0.6f;
         scene.AddGeometry("sphere", sphere, red);
     }
     const Eigen::Vector3f bg = options.background.cast<float>();

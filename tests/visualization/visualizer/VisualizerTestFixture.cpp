@@ -80,7 +80,7 @@ void VisualizerTest::AddWallAndSphere(visualization::Visualizer& vis) {
     vis.AddGeometry("wall", MakeCloud(splats));
     t::geometry::TriangleMesh sphere = t::geometry::TriangleMesh::CreateSphere(0.5, 30);
     sphere.Translate(Eigen::Vector3d(0, 0, 2));
-    rendering::MeshMaterial red;
+    rendering::MaterialRecord red;
     red.base_color = Eigen::Vector4f(1, 0, 0, 1);
     vis.AddGeometry("sphere", sphere, red);
     vis.SetBackground(Eigen::Vector4f(0.2f, 0.3f, 0.4f, 1.0f));

@@ -9,6 +9,7 @@
 
 #include "open3d/core/Exception.h"
 #include "open3d/core/Logging.h"
+#include "open3d/core/Timer.h"
 #include "open3d/t/io/ImageIO.h"
 #include "open3d/visualization/rendering/filament/FilamentEngine.h"
 #include "open3d/visualization/rendering/filament/FilamentRenderer.h"
@@ -81,8 +82,15 @@ void Visualizer::AddGeometry(const std::string& name, const t::geometry::PointCl
     PostRedraw();
 }
 
+void Visualizer::AddGeometry(const std::string& name, const t::geometry::PointCloud& cloud,
+                             const rendering::MaterialRecord& material) {
+    scene_->AddGeometry(name, cloud, material);
+    names_.push_back(name);
+    PostRedraw();
+}
+
 void Visualizer::AddGeometry(const std::string& name, const t::geometry::TriangleMesh& mesh,
-                             const rendering::MeshMaterial& material) {
+                             const rendering::MaterialRecord& material) {
     scene_->AddGeometry(name, mesh, material);
     names_.push_back(name);
     PostRedraw();
@@ -184,10 +192,23 @@ bool Visualizer::BuildOverlay() {
 rendering::FrameResult Visualizer::DrawToWindow(bool read_screen) {
     scene_->SetupCamera(view_control_.GetCamera());
     rendering::FrameRequest request;
-    request.splat_config = scene_->GetSplatConfig();
     request.read_screen = read_screen;
     if (show_settings_) request.overlay_views.push_back(overlay_->GetView());
-    return renderer_->Draw(scene_->GetScene(), scene_->GetView(), request, window_->GetSwapChain());
+    // The seed's frame: the geometry stage of every view, Filament's draw and the
+    // composite, then the compose and overlay views presented.
+    renderer_->BeginFrame(window_->GetSwapChain());
+    rendering::FrameResult result;
+    try {
+        result = renderer_->Draw(scene_->GetView(), request);
+    } catch (...) {
+        renderer_->EndFrame();
+        throw;
+    }
+    const auto compose_start = std::chrono::steady_clock::now();
+    result.screen = renderer_->EndFrame();
+    result.times.compose_ms = core::MillisecondsSince(compose_start);
+    result.times.total_ms += result.times.compose_ms;
+    return result;
 }
 
 bool Visualizer::RenderFrame() {
@@ -262,9 +283,11 @@ t::geometry::Image Visualizer::RenderToImage(bool with_alpha) {
     return image;
 }
 
-t::geometry::Image Visualizer::RenderToDepthImage(bool normalized, float near, float far) {
+t::geometry::Image Visualizer::RenderToDepthImage(rendering::DepthFormat format,
+                                                  std::optional<float> near,
+                                                  std::optional<float> far) {
     scene_->SetupCamera(view_control_.GetCamera());
-    t::geometry::Image image = scene_->RenderToDepthImage(normalized, near, far);
+    t::geometry::Image image = scene_->RenderToDepthImage(format, near, far);
     last_frame_ = scene_->GetLastFrame();
     return image;
 }
@@ -393,10 +416,14 @@ void Draw(const std::vector<DrawObject>& objects, const VisualizerOptions& optio
     Visualizer vis(options);
     for (const DrawObject& object : objects) {
         if (const auto* cloud = std::get_if<t::geometry::PointCloud>(&object.geometry)) {
-            vis.AddGeometry(object.name, *cloud);
+            if (object.material) {
+                vis.AddGeometry(object.name, *cloud, *object.material);
+            } else {
+                vis.AddGeometry(object.name, *cloud);
+            }
         } else {
             vis.AddGeometry(object.name, std::get<t::geometry::TriangleMesh>(object.geometry),
-                            object.material);
+                            object.material.value_or(rendering::MaterialRecord{}));
         }
         if (!object.visible) vis.ShowGeometry(object.name, false);
     }

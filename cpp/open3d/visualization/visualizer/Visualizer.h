@@ -16,6 +16,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <variant>
 #include <vector>
@@ -86,8 +87,10 @@ public:
     // Geometry, by name (names are unique across clouds and meshes; errors throw
     // core::Open3DError and leave the scene unchanged).
     void AddGeometry(const std::string& name, const t::geometry::PointCloud& cloud);
+    void AddGeometry(const std::string& name, const t::geometry::PointCloud& cloud,
+                     const rendering::MaterialRecord& material);
     void AddGeometry(const std::string& name, const t::geometry::TriangleMesh& mesh,
-                     const rendering::MeshMaterial& material = {});
+                     const rendering::MaterialRecord& material = {});
     void UpdateGeometry(const std::string& name, const t::geometry::PointCloud& cloud);
     void UpdateGeometry(const std::string& name, const t::geometry::TriangleMesh& mesh);
     /// False when the name is unknown.
@@ -160,9 +163,10 @@ public:
     const std::string& GetLastScreenshotPath() const { return last_screenshot_; }
     /// Offscreen render of the same scene and camera: UInt8 [H, W, 3] (or 4 with alpha).
     t::geometry::Image RenderToImage(bool with_alpha = false);
-    /// Offscreen depth: Float32 view z (0 = nothing) or normalised UInt16.
-    t::geometry::Image RenderToDepthImage(bool normalized = false, float near = 0.2f,
-                                          float far = 100.0f);
+    /// Offscreen depth (Open3DScene::RenderToDepthImage: near / far default to the view's).
+    t::geometry::Image RenderToDepthImage(
+            rendering::DepthFormat format = rendering::DepthFormat::kViewZ,
+            std::optional<float> near = std::nullopt, std::optional<float> far = std::nullopt);
 
     // Window.
     /// Requests a window size; the new size is used from the next frame on.
@@ -247,7 +251,9 @@ private:
 struct DrawObject {
     std::string name;
     std::variant<t::geometry::PointCloud, t::geometry::TriangleMesh> geometry;
-    rendering::MeshMaterial material;  ///< meshes only
+    /// How it is drawn (rendering::MaterialRecord); none: point clouds with the Gaussian
+    /// attributes are splats, other point clouds points, meshes "defaultUnlit".
+    std::optional<rendering::MaterialRecord> material;
     bool visible = true;
 };
 

@@ -24,8 +24,9 @@ TEST_F(DepthImage, MergesSphereAndSplatDepth) {
     AddRedSphere(scene.GetScene());
     scene.SetupCamera(camera);
     const float near = 0.5f, far = 10.0f;
-    const t::geometry::Image z = scene.RenderToDepthImage(false);
-    const t::geometry::Image u = scene.RenderToDepthImage(true, near, far);
+    const t::geometry::Image z = scene.RenderToDepthImage(rendering::DepthFormat::kViewZ);
+    const t::geometry::Image u =
+            scene.RenderToDepthImage(rendering::DepthFormat::kNormalized16, near, far);
     ASSERT_EQ(z.GetDtype(), core::Dtype::Float32);
     ASSERT_EQ(u.GetDtype(), core::Dtype::UInt16);
     EXPECT_TRUE(scene.GetLastFrame().scene_depth_used);
@@ -62,7 +63,55 @@ TEST_F(DepthImage, MergesSphereAndSplatDepth) {
     EXPECT_GT(sphere, 100);
     EXPECT_GT(splat, 100);
     EXPECT_GT(empty, 50);
-    EXPECT_THROW(scene.RenderToDepthImage(true, 1.0f, 1.0f), core::Open3DError);
+    EXPECT_THROW(scene.RenderToDepthImage(rendering::DepthFormat::kNormalized16, 1.0f, 1.0f),
+                 core::Open3DError);
+}
+
+// Without near / far the depth images use the view's planes, and the reversed-Z image is
+// Filament's convention near / z, checked where the splat wall (z = 4) alone is seen.
+TEST_F(FilamentTest, DepthDefaultsFollowTheViewAndReversedZIsNearOverZ) {
+    if (!skip_reason_.empty()) GTEST_SKIP() << skip_reason_;
+    const camera::PinholeCamera camera = MakeFilamentTestCamera(96, 64);
+    rendering::Open3DScene& scene = MakeOpen3DScene();
+    scene.AddGeometry("wall", MakeSplatWall(4.0, 2.0, 24, Eigen::Vector3d(0.2, 0.6, 0.9)));
+    AddRedSphere(scene.GetScene());
+    scene.SetupCamera(camera);
+    const float near = 0.25f, far = 8.0f;
+    scene.SetClipPlanes(near, far);
+    const t::geometry::Image z = scene.RenderToDepthImage(rendering::DepthFormat::kViewZ);
+    const t::geometry::Image u_default =
+            scene.RenderToDepthImage(rendering::DepthFormat::kNormalized16);
+    const t::geometry::Image u_given =
+            scene.RenderToDepthImage(rendering::DepthFormat::kNormalized16, near, far);
+    const t::geometry::Image d = scene.RenderToDepthImage(rendering::DepthFormat::kReversedZ);
+    // A different far plane must change the normalised image (the defaults are not ignored).
+    const t::geometry::Image u_other =
+            scene.RenderToDepthImage(rendering::DepthFormat::kNormalized16, near, 2.0f * far);
+    ASSERT_EQ(d.GetDtype(), core::Dtype::Float32);
+    int wall = 0, sphere = 0, differing = 0;
+    for (int64_t i = 0; i < z.NumPixels(); ++i) {
+        const float zi = z.Data<float>()[i];
+        EXPECT_EQ(u_default.Data<uint16_t>()[i], u_given.Data<uint16_t>()[i]) << i;
+        differing += u_other.Data<uint16_t>()[i] != u_given.Data<uint16_t>()[i];
+        const float di = d.Data<float>()[i];
+        if (zi <= 0.0f) {
+            EXPECT_EQ(di, 0.0f) << i;
+            continue;
+        }
+        // One float32 division: within 1 ulp of near / z.
+        EXPECT_NEAR(di, near / zi, 1e-7f) << i;
+        const int px = int(i % camera.width), py = int(i / camera.width);
+        if (SphereDepthAt(camera, px, py, nullptr) > 0.0) {
+            ++sphere;
+        } else if (std::abs(zi - 4.0f) < 1e-4f) {
+            // The wall's expected depth is 4 within float sums: d = 0.25 / 4.
+            EXPECT_NEAR(di, 0.0625f, 2e-6f) << px << "," << py;
+            ++wall;
+        }
+    }
+    EXPECT_GT(wall, 500);
+    EXPECT_GT(sphere, 100);
+    EXPECT_GT(differing, 500);
 }
 
 }  // namespace

@@ -155,7 +155,7 @@ std::array<int, 4> ExpectedOver(const float* s, const Eigen::Vector4f& backgroun
 void AddRedSphere(rendering::FilamentScene& scene, const std::string& name) {
     t::geometry::TriangleMesh sphere = t::geometry::TriangleMesh::CreateSphere(kSphereRadius, 40);
     sphere.Translate(Eigen::Vector3d(0, 0, kSphereZ));
-    rendering::MeshMaterial material;
+    rendering::MaterialRecord material;
     material.base_color = Eigen::Vector4f(1, 0, 0, 1);
     scene.AddGeometry(name, sphere, material);
 }

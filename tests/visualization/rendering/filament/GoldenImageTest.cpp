@@ -26,7 +26,7 @@ TEST_F(FilamentGolden, SplatsAndSphereAt36x20) {
     scene.AddGeometry("blob", MakeSplatBlob(-0.3, -0.2, 1.3, 0.1, Eigen::Vector3d(0.1, 0.9, 0.2)));
     t::geometry::TriangleMesh sphere = t::geometry::TriangleMesh::CreateSphere(0.4, 24);
     sphere.Translate(Eigen::Vector3d(-0.5, -0.3, 2.0));  // image left and up (y is down)
-    rendering::MeshMaterial red;
+    rendering::MaterialRecord red;
     red.base_color = Eigen::Vector4f(1, 0, 0, 1);
     scene.AddGeometry("sphere", sphere, red);
     scene.SetBackground(Eigen::Vector4f(0.3f, 0.3f, 0.3f, 1.0f));

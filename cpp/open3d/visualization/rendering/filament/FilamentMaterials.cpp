@@ -32,7 +32,8 @@ const uint16_t kQuadTriangles[] = {0, 1, 2, 0, 2, 3};
 }  // namespace
 
 FilamentMaterials::FilamentMaterials(filament::Engine& engine) : engine_(engine) {
-    mesh_unlit_ = LoadMaterial(engine, materials::kMeshUnlit, "mesh_unlit");
+    default_unlit_ = LoadMaterial(engine, materials::kDefaultUnlit, "default_unlit");
+    default_lit_ = LoadMaterial(engine, materials::kDefaultLit, "default_lit");
     scene_blit_ = LoadMaterial(engine, materials::kSceneBlit, "scene_blit");
     splat_overlay_ = LoadMaterial(engine, materials::kSplatOverlay, "splat_overlay");
     using filament::VertexBuffer;
@@ -55,7 +56,8 @@ FilamentMaterials::FilamentMaterials(filament::Engine& engine) : engine_(engine)
 FilamentMaterials::~FilamentMaterials() {
     engine_.destroy(quad_vertices_);
     engine_.destroy(quad_indices_);
-    engine_.destroy(mesh_unlit_);
+    engine_.destroy(default_unlit_);
+    engine_.destroy(default_lit_);
     engine_.destroy(scene_blit_);
     engine_.destroy(splat_overlay_);
 }

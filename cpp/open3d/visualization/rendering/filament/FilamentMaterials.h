@@ -21,8 +21,11 @@ public:
     FilamentMaterials(const FilamentMaterials&) = delete;
     FilamentMaterials& operator=(const FilamentMaterials&) = delete;
 
-    /// Unlit mesh colour (parameters baseColor: float4, shading: float).
-    filament::Material* MeshUnlit() const { return mesh_unlit_; }
+    /// MaterialRecord "defaultUnlit" (parameters baseColor: float4, pointSize: float).
+    filament::Material* DefaultUnlit() const { return default_unlit_; }
+    /// MaterialRecord "defaultLit" (baseColor: float4, lightDirection: float3, ambient:
+    /// float; the vertex normal in CUSTOM0).
+    filament::Material* DefaultLit() const { return default_lit_; }
     /// Copies a same-size texture to the screen texel for texel (parameter image).
     filament::Material* SceneBlit() const { return scene_blit_; }
     /// Blends a premultiplied RGBA16F image "over", flipping y (parameter image).
@@ -34,7 +37,8 @@ public:
 
 private:
     filament::Engine& engine_;
-    filament::Material* mesh_unlit_ = nullptr;
+    filament::Material* default_unlit_ = nullptr;
+    filament::Material* default_lit_ = nullptr;
     filament::Material* scene_blit_ = nullptr;
     filament::Material* splat_overlay_ = nullptr;
     filament::VertexBuffer* quad_vertices_ = nullptr;

@@ -7,6 +7,7 @@
 #include <filament/View.h>
 #include <filament/Viewport.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstring>
@@ -43,6 +44,9 @@ t::geometry::Image BlendOver(const t::geometry::Image* splats, const std::vector
     return out;
 }
 
+// The key a view's state has in its scene's GaussianSplatRenderer.
+uint64_t ViewKey(const FilamentView& view) { return reinterpret_cast<uintptr_t>(&view); }
+
 }  // namespace
 
 FilamentRenderer::FilamentRenderer(FilamentEngine& engine)
@@ -55,29 +59,84 @@ FilamentRenderer::~FilamentRenderer() {
     materials_.reset();
 }
 
-FrameResult FilamentRenderer::Draw(FilamentScene& scene, FilamentView& view,
-                                   const FrameRequest& request, filament::SwapChain* swap_chain) {
-    const Clock::time_point start = Clock::now();
-    filament::Engine& engine = engine_.GetEngine();
-    FrameResult result;
-    // The previous frame's GL work on the shared images is done before Vulkan reuses them.
-    engine.flushAndWait();
+void FilamentRenderer::AddView(FilamentScene& scene, FilamentView& view) {
+    if (frame_begun_) core::ThrowError("FilamentRenderer::AddView: not inside a frame");
+    if (ViewEntry* entry = FindView(view)) {
+        entry->scene = &scene;
+        return;
+    }
+    ViewEntry entry;
+    entry.scene = &scene;
+    entry.view = &view;
+    views_.push_back(entry);
+}
 
-    Clock::time_point t = Clock::now();
+void FilamentRenderer::RemoveView(const FilamentView& view) {
+    if (frame_begun_) core::ThrowError("FilamentRenderer::RemoveView: not inside a frame");
+    std::erase_if(views_, [&](const ViewEntry& e) { return e.view == &view; });
+}
+
+FilamentRenderer::ViewEntry* FilamentRenderer::FindView(const FilamentView& view) {
+    for (ViewEntry& entry : views_) {
+        if (entry.view == &view) return &entry;
+    }
+    if (temporary_.view == &view) return &temporary_;
+    return nullptr;
+}
+
+void FilamentRenderer::StartFrame(filament::SwapChain* swap_chain) {
+    if (frame_begun_) core::ThrowError("FilamentRenderer::BeginFrame: the frame is begun");
+    frame_begun_ = true;
+    swap_chain_ = swap_chain;
+    drawn_.clear();
+    // The previous frame's GL work on the shared images is done before Vulkan reuses them.
+    engine_.GetEngine().flushAndWait();
+    Report(FrameEvent::kBeginFrame, nullptr);
+}
+
+void FilamentRenderer::SubmitGeometryStage(ViewEntry& entry) {
+    const Clock::time_point t = Clock::now();
+    FilamentScene& scene = *entry.scene;
+    FilamentView& view = *entry.view;
     scene.PrepareSplats();
     view.PrepareTargets(scene);
+    entry.geometry_submitted = true;
+    if (scene.HasVisibleGaussianSplats()) {
+        RenderConfig config = view.GetSplatConfig();
+        config.background = Eigen::Vector3d::Zero();  // the overlay stays premultiplied
+        // Submitted, not waited for: it runs while Filament draws.
+        scene.GetSplatRenderer().RenderGeometryStage(ViewKey(view), view.GetCamera(), config);
+        Report(FrameEvent::kGeometryStage, &view);
+    }
+    entry.geometry_stage_ms = core::MillisecondsSince(t);
+}
+
+void FilamentRenderer::BeginFrame(filament::SwapChain* swap_chain) {
+    StartFrame(swap_chain);
+    for (ViewEntry& entry : views_) {
+        entry.geometry_submitted = false;
+        entry.drawn = false;
+        SubmitGeometryStage(entry);
+    }
+}
+
+FrameResult FilamentRenderer::Draw(FilamentView& view, const FrameRequest& request) {
+    if (!frame_begun_) core::ThrowError("FilamentRenderer::Draw: call BeginFrame first");
+    ViewEntry* entry = FindView(view);
+    if (entry == nullptr) core::ThrowError("FilamentRenderer::Draw: the view was not added");
+    const Clock::time_point start = Clock::now();
+    filament::Engine& engine = engine_.GetEngine();
+    FilamentScene& scene = *entry->scene;
+    FrameResult result;
+    if (!entry->geometry_submitted) SubmitGeometryStage(*entry);
+    result.times.geometry_stage_ms = entry->geometry_stage_ms;
+
     const camera::PinholeCamera& camera = view.GetCamera();
     const int64_t w = camera.width, h = camera.height;
     result.splats_drawn = scene.HasVisibleGaussianSplats();
     result.scene_depth_used = result.splats_drawn && scene.HasNonGaussianVisibleGeometry();
-    if (result.splats_drawn) {
-        RenderConfig config = request.splat_config;
-        config.background = Eigen::Vector3d::Zero();             // the overlay stays premultiplied
-        scene.GetBackend().RenderGeometryStage(camera, config);  // submitted, not waited for
-    }
-    result.times.geometry_stage_ms = core::MillisecondsSince(t);
 
-    t = Clock::now();
+    Clock::time_point t = Clock::now();
     filament::Renderer::ClearOptions clear;
     const Eigen::Vector4f& bg = view.GetBackground();
     clear.clearColor = {bg[0], bg[1], bg[2], bg[3]};
@@ -97,6 +156,7 @@ FrameResult FilamentRenderer::Draw(FilamentScene& scene, FilamentView& view,
     }
     engine.flushAndWait();
     result.times.filament_ms = core::MillisecondsSince(t);
+    Report(FrameEvent::kFilamentDraw, &view);
 
     t = Clock::now();
     SplatFrame splats;
@@ -109,8 +169,11 @@ FrameResult FilamentRenderer::Draw(FilamentScene& scene, FilamentView& view,
         composite.read_depth = request.read_depth;
         composite.depth_near = request.depth_near;
         composite.depth_far = request.depth_far;
+        // Another view of the same scene may have replaced this view's sorted entries.
+        scene.GetSplatRenderer().EnsureGeometryStage(ViewKey(view));
         targets.Composite(scene.GetBackend(), composite, splats);
         result.splat_stats = splats.stats;
+        Report(FrameEvent::kComposite, &view);
     } else if (request.read_depth) {
         targets.ReadMeshDepth(static_cast<float>(view.GetMeshNearPlane()), request.depth_near,
                               request.depth_far, splats);
@@ -120,14 +183,37 @@ FrameResult FilamentRenderer::Draw(FilamentScene& scene, FilamentView& view,
     result.times.composite_stage_ms = core::MillisecondsSince(t);
 
     view.SetOverlayVisible(result.splats_drawn);
-    if (swap_chain != nullptr) {
+    if (request.read_color) {
         t = Clock::now();
+        result.color = BlendOver(result.splats_drawn ? &splats.color : nullptr, mesh_rgba, h, w);
+        result.times.readback_ms = core::MillisecondsSince(t);
+    }
+    entry->drawn = true;
+    entry->request = request;
+    drawn_.push_back(entry);
+    result.times.total_ms = result.times.geometry_stage_ms + core::MillisecondsSince(start);
+    return result;
+}
+
+t::geometry::Image FilamentRenderer::EndFrame() {
+    if (!frame_begun_) core::ThrowError("FilamentRenderer::EndFrame: call BeginFrame first");
+    frame_begun_ = false;
+    t::geometry::Image screen_image;
+    if (swap_chain_ != nullptr && !drawn_.empty()) {
         // A frame Filament wants to skip is drawn anyway: the caller asked for this one.
-        renderer_->beginFrame(swap_chain);
-        renderer_->render(view.GetComposeView());
-        for (filament::View* overlay : request.overlay_views) renderer_->render(overlay);
+        renderer_->beginFrame(swap_chain_);
         std::vector<uint8_t> screen;
-        if (request.read_screen) {
+        int64_t w = 0, h = 0;
+        for (ViewEntry* entry : drawn_) {
+            renderer_->render(entry->view->GetComposeView());
+            for (filament::View* overlay : entry->request.overlay_views) renderer_->render(overlay);
+            Report(FrameEvent::kOverlay, entry->view);
+            if (entry->request.read_screen) {
+                w = entry->view->GetCamera().width;
+                h = entry->view->GetCamera().height;
+            }
+        }
+        if (w > 0) {
             screen.resize(size_t(w) * h * 4);
             renderer_->readPixels(
                 0, 0, uint32_t(w), uint32_t(h),
@@ -136,18 +222,48 @@ FrameResult FilamentRenderer::Draw(FilamentScene& scene, FilamentView& view,
                                                          filament::backend::PixelDataType::UBYTE));
         }
         renderer_->endFrame();
-        if (request.read_screen) {
-            engine.flushAndWait();
-            result.screen = t::geometry::Image(h, w, 4, core::Dtype::UInt8);
-            std::memcpy(result.screen.Data<uint8_t>(), screen.data(), screen.size());
+        if (w > 0) {
+            engine_.GetEngine().flushAndWait();
+            screen_image = t::geometry::Image(h, w, 4, core::Dtype::UInt8);
+            std::memcpy(screen_image.Data<uint8_t>(), screen.data(), screen.size());
         }
-        result.times.compose_ms = core::MillisecondsSince(t);
     }
-    if (request.read_color) {
-        t = Clock::now();
-        result.color = BlendOver(result.splats_drawn ? &splats.color : nullptr, mesh_rgba, h, w);
-        result.times.readback_ms = core::MillisecondsSince(t);
+    for (ViewEntry* entry : drawn_) entry->request = FrameRequest{};
+    drawn_.clear();
+    swap_chain_ = nullptr;
+    Report(FrameEvent::kEndFrame, nullptr);
+    return screen_image;
+}
+
+FrameResult FilamentRenderer::Draw(FilamentScene& scene, FilamentView& view,
+                                   const FrameRequest& request, filament::SwapChain* swap_chain) {
+    const Clock::time_point start = Clock::now();
+    ViewEntry* entry = FindView(view);
+    if (entry == nullptr || entry == &temporary_) {
+        temporary_ = ViewEntry{};
+        temporary_.scene = &scene;
+        temporary_.view = &view;
+        entry = &temporary_;
     }
+    entry->scene = &scene;
+    // Only this view's geometry stage: a one-view frame.
+    StartFrame(swap_chain);
+    entry->geometry_submitted = false;
+    entry->drawn = false;
+    FrameResult result;
+    try {
+        SubmitGeometryStage(*entry);
+        result = Draw(view, request);
+    } catch (...) {
+        frame_begun_ = false;
+        drawn_.clear();
+        temporary_ = ViewEntry{};
+        throw;
+    }
+    const Clock::time_point t = Clock::now();
+    result.screen = EndFrame();
+    if (swap_chain != nullptr) result.times.compose_ms = core::MillisecondsSince(t);
+    temporary_ = ViewEntry{};
     result.times.total_ms = core::MillisecondsSince(start);
     return result;
 }

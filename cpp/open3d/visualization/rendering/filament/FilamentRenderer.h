@@ -1,11 +1,17 @@
-// The frame schedule of docs/DESIGN.md section 5 (docs/filament.md "Frame"):
-//   flushAndWait -> geometry stage submit (no CPU wait) -> Filament draws the meshes (colour +
-//   the shared depth) -> flushAndWait -> composite stage (waits for the geometry stage's fence,
-//   tests splats against the depth, writes the shared RGBA16F) -> the compose view blits the mesh
-//   colour and blends the splat colour over it on a swap chain, and/or the offscreen readback
-//   blends the two on the host.
+// The frame of docs/DESIGN.md "Frame" in three calls (docs/filament.md "Frame"):
+//   BeginFrame: flushAndWait (the previous frame's GL work on the shared images is done),
+//               then the splat geometry stage of every added view with splats is submitted
+//               without a CPU wait, so it overlaps Filament's draw;
+//   Draw(view): Filament draws the view's meshes and points (colour + the shared depth),
+//               flushAndWait, then the composite stage tests the splats against that depth
+//               and writes the shared RGBA16F (and the offscreen readbacks);
+//   EndFrame:   on a swap chain, each drawn view's compose view (mesh colour blit + splat
+//               overlay) and the overlay views (ImGui) are drawn and presented. They wait
+//               until here because Filament allows no standalone render (the mesh views)
+//               between its beginFrame and endFrame.
 #pragma once
 
+#include <functional>
 #include <memory>
 #include <vector>
 
@@ -27,22 +33,35 @@ class FilamentMaterials;
 class FilamentScene;
 class FilamentView;
 
+/// What Draw produces for one view. The splat settings are the view's
+/// (FilamentView::GetSplatConfig).
 struct FrameRequest {
-    /// Splat settings; `background` is ignored (the view's background shows through).
-    RenderConfig splat_config;
     /// Read the composed colour back (FrameResult::color).
     bool read_color = false;
-    /// Read the swap chain's pixels after the compose view (FrameResult::screen); needs a
-    /// swap chain made with CONFIG_READABLE.
+    /// Read the swap chain's pixels after the compose view (EndFrame's return value, or
+    /// FrameResult::screen of the one-call Draw); needs a swap chain made with
+    /// CONFIG_READABLE.
     bool read_screen = false;
     /// Views drawn on the swap chain after the compose view, in order (e.g. an ImGui
     /// overlay); read_screen includes them. Ignored without a swap chain.
     std::vector<filament::View*> overlay_views;
     /// Merge and read the depth back (FrameResult::linear_depth / normalized_depth).
     bool read_depth = false;
-    float depth_near = 0.2f;  ///< normalisation of normalized_depth
-    float depth_far = 100.0f;
+    float depth_near = 0.01f;  ///< normalisation of normalized_depth
+    float depth_far = 1000.0f;
 };
+
+/// The steps of a frame, in the order the seed's design fixes (reported to a listener).
+enum class FrameEvent {
+    kBeginFrame,     ///< previous GL work drained
+    kGeometryStage,  ///< a view's splat geometry stage submitted
+    kFilamentDraw,   ///< a view's meshes and points drawn, depth ready
+    kComposite,      ///< a view's splats composited against that depth
+    kOverlay,        ///< a view's compose view (and overlay views) drawn on the swap chain
+    kEndFrame        ///< presented
+};
+/// Called with each step and the view it concerns (null for kBeginFrame / kEndFrame).
+using FrameEventListener = std::function<void(FrameEvent, const FilamentView*)>;
 
 /// Wall-clock parts of a frame in milliseconds (CPU side, including waits).
 struct FrameTimes {
@@ -82,16 +101,56 @@ public:
     const FilamentMaterials& GetMaterials() const { return *materials_; }
     filament::Renderer* GetFilamentRenderer() const { return renderer_; }
 
-    /// One frame of `scene` through `view`. Draws to `swap_chain` when given (the caller
-    /// presents it); reads back what `request` asks for. The splat pipeline always runs
-    /// for visible splats (geometry stage is reused by the backend when nothing changed).
+    /// Views BeginFrame runs the geometry stage for; `scene` must outlive the entry.
+    void AddView(FilamentScene& scene, FilamentView& view);
+    void RemoveView(const FilamentView& view);
+
+    /// Starts a frame that Draw calls fill and EndFrame presents on `swap_chain` (none:
+    /// offscreen). Submits the geometry stage of every added view that has visible splats.
+    /// Throws core::Open3DError when a frame is already begun.
+    void BeginFrame(filament::SwapChain* swap_chain = nullptr);
+    /// Draws one added view: meshes and points, then the splat composite; reads back what
+    /// `request` asks for. A view whose geometry stage BeginFrame did not run gets it here.
+    FrameResult Draw(FilamentView& view, const FrameRequest& request);
+    /// Draws the drawn views' compose views and overlays on the swap chain and presents.
+    /// Returns the screen pixels when a Draw asked for read_screen (else an empty image).
+    t::geometry::Image EndFrame();
+    bool IsFrameBegun() const { return frame_begun_; }
+
+    /// One frame of one view in one call (BeginFrame, Draw, EndFrame), added or not; only
+    /// this view's geometry stage runs. FrameResult::screen holds the screen pixels when
+    /// asked for.
     FrameResult Draw(FilamentScene& scene, FilamentView& view, const FrameRequest& request,
                      filament::SwapChain* swap_chain = nullptr);
 
+    /// Reports each step of every frame (tests of the frame order); empty to stop.
+    void SetFrameEventListener(FrameEventListener listener) { listener_ = std::move(listener); }
+
 private:
+    struct ViewEntry {
+        FilamentScene* scene = nullptr;
+        FilamentView* view = nullptr;
+        bool geometry_submitted = false;  // this frame
+        bool drawn = false;               // this frame
+        double geometry_stage_ms = 0.0;
+        FrameRequest request;  // of this frame's Draw (overlays, read_screen)
+    };
+    void StartFrame(filament::SwapChain* swap_chain);
+    void SubmitGeometryStage(ViewEntry& entry);
+    ViewEntry* FindView(const FilamentView& view);
+    void Report(FrameEvent event, const FilamentView* view) const {
+        if (listener_) listener_(event, view);
+    }
+
     FilamentEngine& engine_;
     std::unique_ptr<FilamentMaterials> materials_;
     filament::Renderer* renderer_ = nullptr;
+    std::vector<ViewEntry> views_;
+    ViewEntry temporary_;  // the one-call Draw's view when it was not added
+    bool frame_begun_ = false;
+    filament::SwapChain* swap_chain_ = nullptr;
+    std::vector<ViewEntry*> drawn_;  // this frame, in Draw order
+    FrameEventListener listener_;
 };
 
 }  // namespace rendering

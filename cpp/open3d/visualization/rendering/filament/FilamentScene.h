@@ -1,7 +1,6 @@
-// What a Filament view draws (docs/filament.md "Scene"): named meshes as Filament
-// renderables and named Gaussian splat clouds merged into one backend scene. Adding,
-// removing or updating a cloud rebuilds the merged scene; showing or hiding one patches
-// the backend's visibility mask only (no rebuild, see GetCounters).
+// What a Filament view draws (docs/filament.md "Scene"): named meshes and plain point clouds
+// as Filament renderables, and named Gaussian splat clouds held by a GaussianSplatRenderer
+// (merged into one backend scene; showing or hiding one patches the visibility mask only).
 #pragma once
 
 #include <Eigen/Core>
@@ -14,7 +13,8 @@
 
 #include "open3d/t/geometry/PointCloud.h"
 #include "open3d/t/geometry/TriangleMesh.h"
-#include "open3d/visualization/rendering/gaussian_splat/GaussianSplatBackend.h"
+#include "open3d/visualization/rendering/filament/MaterialRecord.h"
+#include "open3d/visualization/rendering/gaussian_splat/GaussianSplatRenderer.h"
 
 namespace filament {
 class Engine;
@@ -30,31 +30,29 @@ namespace rendering {
 
 class FilamentMaterials;
 
-/// How a mesh is drawn (materials/mesh_unlit.mat).
-struct MeshMaterial {
-    /// Linear RGBA multiplied with the vertex colours (white when the mesh has none).
-    Eigen::Vector4f base_color{0.8f, 0.8f, 0.8f, 1.0f};
-    /// 0 = flat colour; up to 1 darkens surfaces turned away from the viewer.
-    float shading = 0.0f;
-};
-
 class FilamentScene {
 public:
-    /// Draws meshes with `materials` and splats with `backend` (owned).
+    /// Draws meshes and points with `materials` and splats with `backend` (owned).
     FilamentScene(filament::Engine& engine, const FilamentMaterials& materials,
                   std::unique_ptr<GaussianSplatBackend> backend);
     ~FilamentScene();
     FilamentScene(const FilamentScene&) = delete;
     FilamentScene& operator=(const FilamentScene&) = delete;
 
-    /// Adds a Gaussian splat cloud. Throws core::Open3DError when the name is taken or the
-    /// cloud is not a valid splat cloud (the scene is unchanged then).
+    /// Adds a point cloud: through the splat pipeline when `material.shader` is
+    /// "gaussianSplat", else as Filament points. Without a material, clouds with the
+    /// Gaussian attributes are splats and others points. Throws core::Open3DError when the
+    /// name is taken, the shader is unknown, or a "gaussianSplat" cloud lacks the Gaussian
+    /// attributes (the scene is unchanged then).
     void AddGeometry(const std::string& name, const t::geometry::PointCloud& cloud);
-    /// Adds a triangle mesh. Throws when the name is taken or the mesh is invalid.
+    void AddGeometry(const std::string& name, const t::geometry::PointCloud& cloud,
+                     const MaterialRecord& material);
+    /// Adds a triangle mesh ("defaultUnlit" or "defaultLit"). Throws when the name is taken,
+    /// the shader does not draw meshes, or the mesh is invalid.
     void AddGeometry(const std::string& name, const t::geometry::TriangleMesh& mesh,
-                     const MeshMaterial& material = {});
-    /// Replaces a geometry of the same kind (its visibility is kept). Throws when the name
-    /// is unknown or the kind differs.
+                     const MaterialRecord& material = {});
+    /// Replaces a geometry of the same kind with its material and visibility. Throws when
+    /// the name is unknown or the kind differs.
     void UpdateGeometry(const std::string& name, const t::geometry::PointCloud& cloud);
     void UpdateGeometry(const std::string& name, const t::geometry::TriangleMesh& mesh);
     /// Removes a geometry; false when the name is unknown.
@@ -66,55 +64,57 @@ public:
     std::vector<std::string> GetGeometryNames() const;
     void ClearGeometry();
 
-    /// A visible mesh exists: the splat composite must test against the scene depth.
+    /// A visible mesh or point cloud exists: the splat composite must test against the
+    /// scene depth.
     bool HasNonGaussianVisibleGeometry() const;
+    /// The material a geometry was added with; throws when the name is unknown.
+    const MaterialRecord& GetMaterial(const std::string& name) const;
+
+    /// The directional light of "defaultLit" meshes: `direction` points from the light into
+    /// the scene (world frame); `ambient` in [0, 1] is the light every surface gets.
+    void SetLighting(const Eigen::Vector3f& direction, float ambient);
     /// A visible splat cloud exists: the splat stages must run.
     bool HasVisibleGaussianSplats() const;
     /// Axis-aligned bounds of the visible geometry; false when there is none.
     bool GetBounds(Eigen::Vector3d& min_bound, Eigen::Vector3d& max_bound) const;
 
     filament::Scene* GetFilamentScene() const { return scene_; }
+    /// The splat half of the scene.
+    GaussianSplatRenderer& GetSplatRenderer() { return splats_; }
     /// The splat backend, with the merged scene uploaded (call PrepareSplats first).
-    GaussianSplatBackend& GetBackend() const { return *backend_; }
+    GaussianSplatBackend& GetBackend() const { return splats_.GetBackend(); }
     /// Uploads the merged scene or the visibility mask when they changed.
-    void PrepareSplats();
+    void PrepareSplats() { splats_.Prepare(); }
 
-    struct Counters {
-        int64_t merged_rebuilds = 0;  ///< merged scenes built and uploaded
-        int64_t mask_updates = 0;     ///< visibility masks sent without a rebuild
-    };
-    const Counters& GetCounters() const { return counters_; }
+    using Counters = GaussianSplatRenderer::Counters;
+    const Counters& GetCounters() const { return splats_.GetCounters(); }
 
 private:
+    // A Filament renderable: a triangle mesh or a plain point cloud.
     struct Mesh {
         uint32_t entity = 0;  // utils::Entity id
+        bool points = false;
         filament::VertexBuffer* vertices = nullptr;
         filament::IndexBuffer* indices = nullptr;
         filament::MaterialInstance* material = nullptr;
-        MeshMaterial look;
+        MaterialRecord look;
         Eigen::Vector3d min_bound, max_bound;
         bool visible = true;
     };
-    struct Cloud {
-        t::geometry::PointCloud cloud;
-        int64_t first = 0;  ///< index of its first splat in the merged scene
-        bool visible = true;
-    };
-
-    Mesh BuildMesh(const t::geometry::TriangleMesh& mesh, const MeshMaterial& material);
+    Mesh BuildMesh(const t::geometry::TriangleMesh& mesh, const MaterialRecord& material);
+    Mesh BuildPoints(const t::geometry::PointCloud& cloud, const MaterialRecord& material);
+    void Finish(Mesh& out, int primitive, size_t num_indices);
+    void AddMesh(const std::string& name, Mesh built);
     void DestroyMesh(Mesh& mesh);
-    std::vector<uint32_t> VisibilityMask() const;
 
     filament::Engine& engine_;
     const FilamentMaterials& materials_;
-    std::unique_ptr<GaussianSplatBackend> backend_;
+    GaussianSplatRenderer splats_;
     filament::Scene* scene_ = nullptr;
     std::map<std::string, Mesh> meshes_;
-    std::map<std::string, Cloud> clouds_;
-    bool merged_dirty_ = false;     // clouds added, removed or replaced
-    bool mask_dirty_ = false;       // a cloud shown or hidden
-    bool merged_uses_mask_ = true;  // false: the backend has no mask; hidden clouds left out
-    Counters counters_;
+    std::map<std::string, MaterialRecord> cloud_materials_;  // "gaussianSplat" clouds
+    Eigen::Vector3f light_direction_{0.3f, 0.5f, 1.0f};
+    float ambient_ = 0.25f;
 };
 
 }  // namespace rendering

@@ -11,6 +11,7 @@
 
 #include "open3d/camera/PinholeCamera.h"
 #include "open3d/visualization/rendering/filament/SplatTargets.h"
+#include "open3d/visualization/rendering/gaussian_splat/RenderConfig.h"
 
 namespace filament {
 class Camera;
@@ -40,9 +41,18 @@ public:
     /// the size-dependent targets first.
     void SetCamera(const camera::PinholeCamera& camera);
     const camera::PinholeCamera& GetCamera() const { return camera_; }
-    /// Near plane of the mesh projection (meshes closer are clipped); default 0.01.
+    /// Near plane of the mesh projection (meshes closer are clipped); default 0.01. The
+    /// projection has no far plane (Filament's depth is near / z).
     void SetMeshNearPlane(double near) { mesh_near_ = near; }
     double GetMeshNearPlane() const { return mesh_near_; }
+    /// Far end of the normalised depth images (default 1000; Open3DScene::ResetCamera sets
+    /// it to just past the scene's bounds). Nothing is clipped there.
+    void SetFarPlane(double far) { far_ = far; }
+    double GetFarPlane() const { return far_; }
+    /// Splat settings of this view (SH degree cap, antialias, sort mode...); `background`
+    /// is not used: the view's background shows through.
+    RenderConfig& GetSplatConfig() { return splat_config_; }
+    const RenderConfig& GetSplatConfig() const { return splat_config_; }
     /// Linear RGBA where nothing is drawn.
     void SetBackground(const Eigen::Vector4f& rgba) { background_ = rgba; }
     const Eigen::Vector4f& GetBackground() const { return background_; }
@@ -69,6 +79,8 @@ private:
     SplatSharing sharing_;
     camera::PinholeCamera camera_;
     double mesh_near_ = 0.01;
+    double far_ = 1000.0;
+    RenderConfig splat_config_;
     Eigen::Vector4f background_{0.0f, 0.0f, 0.0f, 1.0f};
 
     filament::View* mesh_view_ = nullptr;

@@ -17,14 +17,7 @@ namespace {
 
 std::unique_ptr<GaussianSplatBackend> MakeBackend(const std::string& name) {
     vulkan::RegisterVulkanBackend();
-    if (name != "auto") return CreateGaussianSplatBackend(name);
-    try {
-        return CreateGaussianSplatBackend("vulkan");
-    } catch (const core::Open3DError& e) {
-        core::LogWarning("No Vulkan device for Gaussian splats ({}); splats are not drawn",
-                         e.what());
-        return CreateGaussianSplatBackend("placeholder");
-    }
+    return ResolveGaussianSplatBackend(name);
 }
 
 SplatSharing SharingFromEnvironment(SplatSharing requested) {
@@ -41,9 +34,11 @@ Open3DScene::Open3DScene(FilamentRenderer& renderer, const Open3DSceneOptions& o
                                              renderer.GetMaterials(), MakeBackend(options.backend));
     view_ = std::make_unique<FilamentView>(renderer.GetEngine(), renderer.GetMaterials(),
                                            SharingFromEnvironment(options.sharing));
+    renderer_.AddView(*scene_, *view_);
 }
 
 Open3DScene::~Open3DScene() {
+    renderer_.RemoveView(*view_);
     // The view's targets belong to the scene's backend: they go first.
     view_.reset();
     scene_.reset();
@@ -52,9 +47,36 @@ Open3DScene::~Open3DScene() {
 void Open3DScene::AddGeometry(const std::string& name, const t::geometry::PointCloud& cloud) {
     scene_->AddGeometry(name, cloud);
 }
+void Open3DScene::AddGeometry(const std::string& name, const t::geometry::PointCloud& cloud,
+                              const MaterialRecord& material) {
+    scene_->AddGeometry(name, cloud, material);
+    if (material.shader != kShaderGaussianSplat) return;
+    RenderConfig& config = view_->GetSplatConfig();
+    const bool differs = config.sh_degree != material.gaussian_splat_sh_degree ||
+                         config.antialias != material.gaussian_splat_antialias;
+    if (differs && scene_->GetSplatRenderer().GetCloudNames().size() > 1) {
+        // The merged scene renders with one setting.
+        core::LogWarning(
+                "'{}': gaussianSplat SH degree {} / antialias {} now apply to every splat cloud "
+                "of the scene",
+                name, material.gaussian_splat_sh_degree, material.gaussian_splat_antialias);
+    }
+    config.sh_degree = material.gaussian_splat_sh_degree;
+    config.antialias = material.gaussian_splat_antialias;
+}
 void Open3DScene::AddGeometry(const std::string& name, const t::geometry::TriangleMesh& mesh,
-                              const MeshMaterial& material) {
+                              const MaterialRecord& material) {
     scene_->AddGeometry(name, mesh, material);
+}
+void Open3DScene::SetLighting(const Eigen::Vector3f& direction, float ambient) {
+    scene_->SetLighting(direction, ambient);
+}
+void Open3DScene::SetClipPlanes(double near, double far) {
+    if (!(near > 0.0) || !(far > near)) {
+        core::ThrowError("SetClipPlanes: need 0 < near < far (got {}, {})", near, far);
+    }
+    view_->SetMeshNearPlane(near);
+    view_->SetFarPlane(far);
 }
 void Open3DScene::UpdateGeometry(const std::string& name, const t::geometry::PointCloud& cloud) {
     scene_->UpdateGeometry(name, cloud);
@@ -104,26 +126,37 @@ void Open3DScene::ResetCamera(int width, int height, double vertical_fov_deg) {
     look_at.up = Eigen::Vector3d(0, -1, 0);  // OpenCV: y down in the image
     look_at.vertical_fov_deg = vertical_fov_deg;
     view_->SetCamera(camera::PinholeCamera::FromLookAt(look_at, width, height));
+    view_->SetFarPlane(radius / std::sin(half_fov) + radius);
 }
 
 t::geometry::Image Open3DScene::RenderToImage(bool with_alpha) {
     FrameRequest request;
-    request.splat_config = splat_config_;
     request.read_color = true;
     last_frame_ = renderer_.Draw(*scene_, *view_, request);
     return with_alpha ? last_frame_.color : last_frame_.color.SelectChannels(0, 3);
 }
 
-t::geometry::Image Open3DScene::RenderToDepthImage(bool normalized, float near, float far) {
-    if (!(far > near))
-        core::ThrowError("RenderToDepthImage: far ({}) must exceed near ({})", far, near);
+t::geometry::Image Open3DScene::RenderToDepthImage(DepthFormat format, std::optional<float> near,
+                                                   std::optional<float> far) {
+    const float n = near.value_or(static_cast<float>(view_->GetMeshNearPlane()));
+    const float f = far.value_or(static_cast<float>(view_->GetFarPlane()));
+    if (!(n > 0.0f) || !(f > n)) {
+        core::ThrowError("RenderToDepthImage: need 0 < near < far (got near {}, far {})", n, f);
+    }
     FrameRequest request;
-    request.splat_config = splat_config_;
     request.read_depth = true;
-    request.depth_near = near;
-    request.depth_far = far;
+    request.depth_near = n;
+    request.depth_far = f;
     last_frame_ = renderer_.Draw(*scene_, *view_, request);
-    return normalized ? last_frame_.normalized_depth : last_frame_.linear_depth;
+    if (format == DepthFormat::kNormalized16) return last_frame_.normalized_depth;
+    if (format == DepthFormat::kViewZ) return last_frame_.linear_depth;
+    // Filament's convention for its infinite reversed-Z projection: d = near / z.
+    const t::geometry::Image& z = last_frame_.linear_depth;
+    t::geometry::Image reversed(z.GetRows(), z.GetCols(), 1, core::Dtype::Float32);
+    const float* in = z.Data<float>();
+    float* out = reversed.Data<float>();
+    for (int64_t i = 0; i < z.GetRows() * z.GetCols(); ++i) out[i] = in[i] > 0.0f ? n / in[i] : 0.0f;
+    return reversed;
 }
 
 }  // namespace rendering

@@ -1,12 +1,15 @@
 // The Open3D-style scene API on top of the Filament layer (docs/filament.md "Scene API"):
-// named splat clouds and meshes, a background, a camera, and offscreen RenderToImage /
-// RenderToDepthImage that run the whole frame (meshes, splat geometry and composite stages, the
-// blend).
+// named geometries drawn by their MaterialRecord (Gaussian splat clouds, plain point clouds,
+// lit or unlit meshes), a background, a camera, and offscreen RenderToImage /
+// RenderToDepthImage that run the whole frame (meshes and points, the splat geometry and
+// composite stages, the blend). Its view is added to the renderer, so the renderer's
+// BeginFrame runs its geometry stage.
 #pragma once
 
 #include <Eigen/Core>
 
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "open3d/camera/PinholeCamera.h"
@@ -16,6 +19,7 @@
 #include "open3d/visualization/rendering/filament/FilamentRenderer.h"
 #include "open3d/visualization/rendering/filament/FilamentScene.h"
 #include "open3d/visualization/rendering/filament/FilamentView.h"
+#include "open3d/visualization/rendering/filament/MaterialRecord.h"
 
 namespace open3d {
 namespace visualization {
@@ -30,6 +34,17 @@ struct Open3DSceneOptions {
     SplatSharing sharing = SplatSharing::kAuto;
 };
 
+/// What RenderToDepthImage returns.
+enum class DepthFormat {
+    /// Float32 [H, W, 1] view-space z in scene units, 0 where nothing is.
+    kViewZ,
+    /// UInt16 [H, W, 1] round(65535 * (z - near) / (far - near)), 65535 where nothing is.
+    kNormalized16,
+    /// Float32 [H, W, 1] Filament's reversed-Z depth of an infinite projection: near / z,
+    /// 1 at the near plane, 0 where nothing is.
+    kReversedZ
+};
+
 class Open3DScene {
 public:
     /// A scene drawn by `renderer`'s engine. Throws core::Open3DError when a named backend
@@ -37,9 +52,17 @@ public:
     explicit Open3DScene(FilamentRenderer& renderer, const Open3DSceneOptions& options = {});
     ~Open3DScene();
 
+    /// A point cloud: with the Gaussian attributes it is drawn as splats, otherwise as
+    /// points (MaterialRecord's defaults).
     void AddGeometry(const std::string& name, const t::geometry::PointCloud& cloud);
+    /// A point cloud drawn by `material.shader`: "gaussianSplat" (needs the Gaussian
+    /// attributes; its SH degree and antialias fields become the scene's splat settings) or
+    /// "defaultUnlit" / "defaultLit" (points of `point_size` pixels).
+    void AddGeometry(const std::string& name, const t::geometry::PointCloud& cloud,
+                     const MaterialRecord& material);
+    /// A triangle mesh, "defaultUnlit" or "defaultLit".
     void AddGeometry(const std::string& name, const t::geometry::TriangleMesh& mesh,
-                     const MeshMaterial& material = {});
+                     const MaterialRecord& material = {});
     void UpdateGeometry(const std::string& name, const t::geometry::PointCloud& cloud);
     void UpdateGeometry(const std::string& name, const t::geometry::TriangleMesh& mesh);
     bool RemoveGeometry(const std::string& name);
@@ -50,7 +73,10 @@ public:
     /// Linear RGBA where nothing is drawn (default opaque black).
     void SetBackground(const Eigen::Vector4f& rgba);
     /// Splat settings (SH degree cap, antialias, sort mode...); background is not used.
-    RenderConfig& GetSplatConfig() { return splat_config_; }
+    RenderConfig& GetSplatConfig() { return view_->GetSplatConfig(); }
+    /// The directional light of "defaultLit" meshes (direction from the light into the
+    /// scene, world frame) and the ambient term in [0, 1].
+    void SetLighting(const Eigen::Vector3f& direction, float ambient);
 
     /// The camera and the image size of the renders.
     void SetupCamera(const camera::PinholeCamera& camera);
@@ -68,10 +94,13 @@ public:
     /// background, top row first.
     t::geometry::Image RenderToImage(bool with_alpha = false);
     /// The nearer of the splat depth (expected depth where coverage >= 0.5) and the mesh
-    /// depth per pixel: Float32 [H, W, 1] view z in scene units (0 where nothing is), or
-    /// with `normalized` UInt16 round(65535 * (z - near) / (far - near)), 65535 = nothing.
-    t::geometry::Image RenderToDepthImage(bool normalized = false, float near = 0.2f,
-                                          float far = 100.0f);
+    /// depth per pixel, in `format`. `near` / `far` default to the view's (its mesh near
+    /// plane, 0.01 unless set, and its far plane); only kNormalized16 uses `far`.
+    t::geometry::Image RenderToDepthImage(DepthFormat format = DepthFormat::kViewZ,
+                                          std::optional<float> near = std::nullopt,
+                                          std::optional<float> far = std::nullopt);
+    /// The near and far planes of the view (FilamentView::SetMeshNearPlane / SetFarPlane).
+    void SetClipPlanes(double near, double far);
 
     /// The last frame's stats and times.
     const FrameResult& GetLastFrame() const { return last_frame_; }
@@ -82,7 +111,6 @@ private:
     FilamentRenderer& renderer_;
     std::unique_ptr<FilamentScene> scene_;
     std::unique_ptr<FilamentView> view_;
-    RenderConfig splat_config_;
     FrameResult last_frame_;
 };
 

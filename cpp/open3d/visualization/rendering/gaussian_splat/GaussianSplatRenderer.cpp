@@ -1,0 +1,208 @@
+#include "open3d/visualization/rendering/gaussian_splat/GaussianSplatRenderer.h"
+
+#include <algorithm>
+
+#include "open3d/core/Exception.h"
+#include "open3d/core/Logging.h"
+#include "open3d/visualization/rendering/gaussian_splat/GaussianSplatDataPacking.h"
+#include "open3d/visualization/rendering/gaussian_splat/GaussianSplatMerge.h"
+
+namespace open3d {
+namespace visualization {
+namespace rendering {
+
+std::unique_ptr<GaussianSplatBackend> ResolveGaussianSplatBackend(const std::string& name) {
+    if (name != "auto") return CreateGaussianSplatBackend(name);
+    const std::vector<std::string> names = GetGaussianSplatBackendNames();
+    if (std::find(names.begin(), names.end(), "vulkan") != names.end()) {
+        try {
+            return CreateGaussianSplatBackend("vulkan");
+        } catch (const core::Open3DError& e) {
+            core::LogWarning("No Vulkan device for Gaussian splats ({}); splats are not drawn",
+                             e.what());
+        }
+    } else {
+        core::LogWarning("No GPU splat backend is registered; splats are not drawn");
+    }
+    return CreateGaussianSplatBackend("placeholder");
+}
+
+namespace {
+
+int64_t NumSplats(const t::geometry::PointCloud& cloud) {
+    return cloud.GetPointPositions().GetShape(0);
+}
+
+}  // namespace
+
+GaussianSplatRenderer::GaussianSplatRenderer(const std::string& backend)
+    : backend_(ResolveGaussianSplatBackend(backend)) {}
+
+GaussianSplatRenderer::GaussianSplatRenderer(std::unique_ptr<GaussianSplatBackend> backend)
+    : backend_(std::move(backend)) {
+    if (!backend_) core::ThrowError("GaussianSplatRenderer: no backend given");
+}
+
+GaussianSplatRenderer::~GaussianSplatRenderer() = default;
+
+void GaussianSplatRenderer::AddCloud(const std::string& name,
+                                     const t::geometry::PointCloud& cloud) {
+    if (HasCloud(name)) core::ThrowError("GaussianSplatRenderer: a cloud named '{}' exists", name);
+    cloud.ValidateGaussianSplat();
+    clouds_.emplace(name, Cloud{cloud, 0, true});
+    merged_dirty_ = true;
+}
+
+void GaussianSplatRenderer::UpdateCloud(const std::string& name,
+                                        const t::geometry::PointCloud& cloud) {
+    auto it = clouds_.find(name);
+    if (it == clouds_.end()) core::ThrowError("GaussianSplatRenderer: no cloud named '{}'", name);
+    cloud.ValidateGaussianSplat();
+    it->second.cloud = cloud;
+    merged_dirty_ = true;
+}
+
+bool GaussianSplatRenderer::RemoveCloud(const std::string& name) {
+    if (clouds_.erase(name) == 0) return false;
+    merged_dirty_ = true;
+    return true;
+}
+
+void GaussianSplatRenderer::ShowCloud(const std::string& name, bool show) {
+    auto it = clouds_.find(name);
+    if (it == clouds_.end()) core::ThrowError("GaussianSplatRenderer: no cloud named '{}'", name);
+    if (it->second.visible == show) return;
+    it->second.visible = show;
+    // Without a mask in the backend, hidden clouds are left out of the merged scene.
+    if (merged_uses_mask_) {
+        mask_dirty_ = true;
+    } else {
+        merged_dirty_ = true;
+    }
+}
+
+bool GaussianSplatRenderer::IsCloudVisible(const std::string& name) const {
+    auto it = clouds_.find(name);
+    if (it == clouds_.end()) core::ThrowError("GaussianSplatRenderer: no cloud named '{}'", name);
+    return it->second.visible;
+}
+
+std::vector<std::string> GaussianSplatRenderer::GetCloudNames() const {
+    std::vector<std::string> names;
+    for (const auto& [name, cloud] : clouds_) names.push_back(name);
+    return names;
+}
+
+void GaussianSplatRenderer::Clear() {
+    if (!clouds_.empty()) merged_dirty_ = true;
+    clouds_.clear();
+}
+
+bool GaussianSplatRenderer::HasVisibleSplats() const {
+    for (const auto& [name, cloud] : clouds_) {
+        if (cloud.visible && NumSplats(cloud.cloud) > 0) return true;
+    }
+    return false;
+}
+
+bool GaussianSplatRenderer::GetBounds(Eigen::Vector3d& min_bound,
+                                      Eigen::Vector3d& max_bound) const {
+    bool any = false;
+    for (const auto& [name, cloud] : clouds_) {
+        const core::Tensor& p = cloud.cloud.GetPointPositions();
+        if (!cloud.visible || p.GetShape(0) == 0) continue;
+        const Eigen::Map<const Eigen::Matrix<float, 3, Eigen::Dynamic>> points(p.Data<float>(), 3,
+                                                                               p.GetShape(0));
+        const Eigen::Vector3d lo = points.rowwise().minCoeff().cast<double>();
+        const Eigen::Vector3d hi = points.rowwise().maxCoeff().cast<double>();
+        min_bound = any ? min_bound.cwiseMin(lo) : lo;
+        max_bound = any ? max_bound.cwiseMax(hi) : hi;
+        any = true;
+    }
+    return any;
+}
+
+std::vector<uint32_t> GaussianSplatRenderer::VisibilityMask() const {
+    int64_t n = 0;
+    for (const auto& [name, cloud] : clouds_) n += NumSplats(cloud.cloud);
+    std::vector<uint32_t> mask((n + 31) / 32, 0u);
+    for (const auto& [name, cloud] : clouds_) {
+        if (!cloud.visible) continue;
+        SetSplatVisibility(mask, cloud.first, cloud.first + NumSplats(cloud.cloud), true);
+    }
+    return mask;
+}
+
+void GaussianSplatRenderer::Prepare() {
+    if (merged_dirty_) {
+        std::vector<const t::geometry::PointCloud*> parts;
+        int64_t first = 0;
+        for (auto& [name, cloud] : clouds_) {
+            cloud.first = first;
+            if (!merged_uses_mask_ && !cloud.visible) continue;
+            parts.push_back(&cloud.cloud);
+            first += NumSplats(cloud.cloud);
+        }
+        if (parts.empty()) {
+            backend_->ReleaseResources();
+        } else {
+            backend_->SetScene(MergeGaussianSplatClouds(parts));
+            ++counters_.merged_rebuilds;
+            // A new scene starts all visible: send a mask only when something is hidden.
+            mask_dirty_ = false;
+            for (const auto& [name, cloud] : clouds_) mask_dirty_ |= !cloud.visible;
+            mask_dirty_ &= merged_uses_mask_;
+        }
+        merged_dirty_ = false;
+        has_current_view_ = false;  // the backend's sorted entries are of the old scene
+    }
+    if (mask_dirty_) {
+        mask_dirty_ = false;
+        has_current_view_ = false;
+        if (backend_->SetVisibilityMask(VisibilityMask())) {
+            ++counters_.mask_updates;
+        } else {
+            // The backend has no mask: from now on hidden clouds are left out instead.
+            merged_uses_mask_ = false;
+            merged_dirty_ = true;
+            Prepare();
+        }
+    }
+}
+
+void GaussianSplatRenderer::RenderGeometryStage(uint64_t view_id,
+                                                const camera::PinholeCamera& camera,
+                                                const RenderConfig& config) {
+    views_[view_id] = ViewState{camera, config};
+    backend_->RenderGeometryStage(camera, config);
+    ++counters_.geometry_stages;
+    current_view_ = view_id;
+    has_current_view_ = true;
+}
+
+void GaussianSplatRenderer::EnsureGeometryStage(uint64_t view_id) {
+    if (has_current_view_ && current_view_ == view_id) return;
+    auto it = views_.find(view_id);
+    if (it == views_.end()) {
+        core::ThrowError("GaussianSplatRenderer: view {} has no geometry stage to composite",
+                         view_id);
+    }
+    const ViewState state = it->second;
+    RenderGeometryStage(view_id, state.camera, state.config);
+    ++counters_.geometry_stage_reruns;
+}
+
+void GaussianSplatRenderer::RenderCompositeStage(uint64_t view_id, RenderOutput& output,
+                                                 const CompositeInputs& inputs) {
+    EnsureGeometryStage(view_id);
+    backend_->RenderCompositeStage(output, inputs);
+}
+
+void GaussianSplatRenderer::ReleaseView(uint64_t view_id) {
+    views_.erase(view_id);
+    if (has_current_view_ && current_view_ == view_id) has_current_view_ = false;
+}
+
+}  // namespace rendering
+}  // namespace visualization
+}  // namespace open3d

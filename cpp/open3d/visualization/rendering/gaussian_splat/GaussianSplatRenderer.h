@@ -1,0 +1,118 @@
+// The splat half of a scene (docs/DESIGN.md "Layers"): owns the chosen backend, the named
+// Gaussian clouds merged into the one scene the backend holds, the visibility mask over
+// that merged scene, and the state of every view drawn from it. The Filament layer keeps
+// one per FilamentScene and drives its two stages from FilamentRenderer::BeginFrame (the
+// geometry stage) and Draw (the composite stage).
+//
+// Adding, removing or replacing a cloud rebuilds the merged scene on the next Prepare();
+// showing or hiding one patches the backend's mask only. A backend holds the sorted
+// entries of one view at a time, so when several views share a renderer the composite of
+// a view whose geometry stage was overwritten runs that geometry stage again first.
+#pragma once
+
+#include <Eigen/Core>
+
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "open3d/camera/PinholeCamera.h"
+#include "open3d/t/geometry/PointCloud.h"
+#include "open3d/visualization/rendering/gaussian_splat/GaussianSplatBackend.h"
+#include "open3d/visualization/rendering/gaussian_splat/RenderConfig.h"
+
+namespace open3d {
+namespace visualization {
+namespace rendering {
+
+/// Makes the backend `name` names; "auto" = "vulkan" when registered and a device exists,
+/// else "placeholder" (with a warning). Throws core::Open3DError for an unknown name.
+std::unique_ptr<GaussianSplatBackend> ResolveGaussianSplatBackend(const std::string& name);
+
+class GaussianSplatRenderer {
+public:
+    /// `backend`: "auto" = "vulkan" when it is registered and a device exists, else
+    /// "placeholder" (draws nothing and says so once); or any registered name.
+    /// Throws core::Open3DError when a named backend cannot be made.
+    explicit GaussianSplatRenderer(const std::string& backend = "auto");
+    /// Takes an existing backend (tests, custom backends).
+    explicit GaussianSplatRenderer(std::unique_ptr<GaussianSplatBackend> backend);
+    ~GaussianSplatRenderer();
+    GaussianSplatRenderer(const GaussianSplatRenderer&) = delete;
+    GaussianSplatRenderer& operator=(const GaussianSplatRenderer&) = delete;
+
+    GaussianSplatBackend& GetBackend() const { return *backend_; }
+    std::string GetBackendName() const { return backend_->GetName(); }
+
+    /// Adds a Gaussian cloud. Throws core::Open3DError when the name is taken or the cloud
+    /// lacks the Gaussian attributes (nothing changes then).
+    void AddCloud(const std::string& name, const t::geometry::PointCloud& cloud);
+    /// Replaces a cloud, keeping its visibility. Throws when the name is unknown.
+    void UpdateCloud(const std::string& name, const t::geometry::PointCloud& cloud);
+    bool RemoveCloud(const std::string& name);
+    /// Throws when the name is unknown.
+    void ShowCloud(const std::string& name, bool show);
+    bool HasCloud(const std::string& name) const { return clouds_.count(name) > 0; }
+    bool IsCloudVisible(const std::string& name) const;
+    std::vector<std::string> GetCloudNames() const;
+    void Clear();
+
+    /// Some visible cloud has splats: the stages must run.
+    bool HasVisibleSplats() const;
+    /// Bounds of the visible splat centres; false when there are none.
+    bool GetBounds(Eigen::Vector3d& min_bound, Eigen::Vector3d& max_bound) const;
+
+    /// Uploads the merged scene or the visibility mask when they changed.
+    void Prepare();
+
+    /// Geometry stage of view `view_id` (any caller-chosen key): submitted, not waited for.
+    void RenderGeometryStage(uint64_t view_id, const camera::PinholeCamera& camera,
+                             const RenderConfig& config);
+    /// Composite stage of `view_id`'s last geometry stage; runs that geometry stage again
+    /// first when another view's replaced it in the backend. Throws when the view never
+    /// ran a geometry stage.
+    void RenderCompositeStage(uint64_t view_id, RenderOutput& output,
+                              const CompositeInputs& inputs = {});
+    /// Makes sure the backend holds `view_id`'s sorted entries (for callers that composite
+    /// through the backend directly, e.g. into shared images).
+    void EnsureGeometryStage(uint64_t view_id);
+    /// Forgets a view's state.
+    void ReleaseView(uint64_t view_id);
+
+    struct Counters {
+        int64_t merged_rebuilds = 0;       ///< merged scenes built and uploaded
+        int64_t mask_updates = 0;          ///< visibility masks sent without a rebuild
+        int64_t geometry_stages = 0;       ///< geometry stages asked of the backend
+        int64_t geometry_stage_reruns = 0; ///< of those, re-run because another view intervened
+    };
+    const Counters& GetCounters() const { return counters_; }
+
+private:
+    struct Cloud {
+        t::geometry::PointCloud cloud;
+        int64_t first = 0;  ///< index of its first splat in the merged scene
+        bool visible = true;
+    };
+    struct ViewState {
+        camera::PinholeCamera camera;
+        RenderConfig config;
+    };
+
+    std::vector<uint32_t> VisibilityMask() const;
+
+    std::unique_ptr<GaussianSplatBackend> backend_;
+    std::map<std::string, Cloud> clouds_;
+    std::map<uint64_t, ViewState> views_;
+    bool has_current_view_ = false;
+    uint64_t current_view_ = 0;     // whose sorted entries the backend holds
+    bool merged_dirty_ = false;     // clouds added, removed or replaced
+    bool mask_dirty_ = false;       // a cloud shown or hidden
+    bool merged_uses_mask_ = true;  // false: the backend has no mask; hidden clouds left out
+    Counters counters_;
+};
+
+}  // namespace rendering
+}  // namespace visualization
+}  // namespace open3d
