@@ -9,7 +9,7 @@
 // are its range of the tile-sorted entries, found beforehand by gaussian_tile_ranges.comp
 // (depth order preserved inside a tile); its splats are loaded cooperatively into shared
 // memory in batches of 256 and blended front to back with exactly the 3DGS rules
-// (docs/DESIGN.md section 3, cpu/Composite.cpp). Each pixel block visits only the batch
+// (docs/DESIGN.md "Numerical rules", cpu/Composite.cpp). Each pixel block visits only the batch
 // splats whose culling ellipse meets it (CompositeBlockMask), a list built per batch by one
 // workgroup scan, and takes them sixteen at a time (then eight, then singly): a step's
 // alphas first (independent loads and arithmetic), then the serial transmittance chain. On

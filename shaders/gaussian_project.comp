@@ -1,6 +1,6 @@
 #version 460
 // Geometry stage, pass 1: one invocation per splat. Exactly the 3DGS rasterizer's preprocess
-// (docs/DESIGN.md section 3, mirrored from cpu/Projection.cpp) in float32: near cull,
+// (docs/DESIGN.md "Numerical rules", mirrored from cpu/Projection.cpp) in float32: near cull,
 // guard-band clamped Jacobian, +0.3 dilation, optional antialias compensation, det == 0
 // cull, 3-sigma radius with the 0.1 eigenvalue floor, tile rectangle, SH colour. Visible
 // splats write their GaussianProjectedSplat and append (depth key, splat index) to the

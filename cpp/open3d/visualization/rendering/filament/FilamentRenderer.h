@@ -1,4 +1,4 @@
-// The frame schedule of docs/DESIGN.md section 5 (docs/filament.md "Frame"):
+// The frame schedule (docs/filament.md "Frame"):
 //   flushAndWait -> geometry stage submit (no CPU wait) -> Filament draws the meshes (colour +
 //   the shared depth) -> flushAndWait -> composite stage (waits for the geometry stage's fence,
 //   tests splats against the depth, writes the shared RGBA16F) -> the compose view blits the mesh

@@ -1,4 +1,4 @@
-// GPU radix sort of (uint32 key, uint32 value) pairs, a recorder (STYLE.md point 6): the
+// GPU radix sort of (uint32 key, uint32 value) pairs, a recorder (docs/DESIGN.md "Code rules"): the
 // caller allocates the scratch buffers from GetStorageRequirements and Record() only
 // records commands. The element count is read on the GPU from the producer's buffer.
 //
