@@ -123,7 +123,8 @@ mat3 CovarianceFactor(vec3 s, vec4 q) {
 const uint kShWords = 3u * ((kShDegree + 1u) * (kShDegree + 1u) - 1u);
 const uint kShVec4s = kShWords / 4u;
 // A product, not an && chain: glslang 12 (Debian 12) turns && of spec constants into a phi
-// that the OpSpecConstantOp then names before it exists (invalid SPIR-V, docs/vulkan.md).
+// that the OpSpecConstantOp then names before it exists (invalid SPIR-V,
+// docs/environment-notes.md).
 const uint kShVec4Layout = uint(kPrecision == kPrecisionExact) * uint(kShWords % 4u == 0u) *
                            uint(kShWords > 0u);
 

@@ -107,8 +107,8 @@ public:
 
     /// What the caller reads afterwards. kValuesOnly: the keys are left unspecified, and
     /// the last pass that runs and the copy write no keys (but the first pass of a
-    /// kFromKeyRange sort, which runs before the range is known). Geometry stage's depth sort
-    /// reads only the splat indices (docs/vulkan.md has the time).
+    /// kFromKeyRange sort, which runs before the range is known). The geometry stage's depth
+    /// sort reads only the splat indices (docs/perf/h200.md has the time).
     enum class Output {
         kKeysAndValues,
         kValuesOnly,
