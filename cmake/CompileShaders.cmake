@@ -1,4 +1,4 @@
-# Compute shaders are built with the library that uses them (STYLE.md point 9):
+# Compute shaders are built with the library that uses them (docs/DESIGN.md "Code rules"):
 #   GLSL --glslangValidator--> SPIR-V --EmbedSpirv.cmake--> uint32_t arrays in a generated .cpp
 #                                     --spirv-cross--> MSL (checked at build time, for Metal)
 # Everything generated lives in the build tree. glslang writes a depfile, so editing an

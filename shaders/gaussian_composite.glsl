@@ -9,13 +9,11 @@
 // are its range of the tile-sorted entries, found beforehand by gaussian_tile_ranges.comp
 // (depth order preserved inside a tile); its splats are loaded cooperatively into shared
 // memory in batches of 256 and blended front to back with exactly the 3DGS rules
-// (docs/DESIGN.md section 3, cpu/Composite.cpp). Each pixel block visits only the batch
+// (docs/DESIGN.md "Numerical rules", cpu/Composite.cpp). Each pixel block visits only the batch
 // splats whose culling ellipse meets it (CompositeBlockMask), a list built per batch by one
 // workgroup scan, and takes them sixteen at a time (then eight, then singly): a step's
-// alphas first (independent loads and arithmetic), then the serial transmittance chain. On
-// the H100 the lists with steps of eight took the grid's composite from 2.42 to 1.58 ms
-// (1080p) and playbot_125k's from 0.232 to 0.181 ms (1080p), the lists alone gained
-// nothing, and steps of sixteen took the grid to 1.54 ms.
+// alphas first (independent loads and arithmetic), then the serial transmittance chain. The
+// lists pay only together with the steps (docs/perf/h100.md "Composite").
 #ifndef OPEN3D_GAUSSIAN_COMPOSITE_GLSL
 #define OPEN3D_GAUSSIAN_COMPOSITE_GLSL
 
@@ -31,8 +29,7 @@ layout(local_size_x = kCompositeWorkgroupSize) in;
 // 0: no scene depth; the texture binding is never read (the recorder binds a placeholder).
 layout(constant_id = kSpecSceneDepth) const uint kSceneDepth = 0u;
 // kCompositeExpectedDepthBit | kCompositeMedianDepthBit: the depth images to write. A clear
-// bit drops that image's accumulation from every blend: colour alone measured 2.61 -> 2.43 ms
-// (grid 1080p) and 0.567 -> 0.509 ms (playbot 4K) on the H100.
+// bit drops that image's accumulation from every blend (8-10% of the composite, docs/perf/).
 layout(constant_id = kSpecCompositeDepth) const uint kDepthOutputs =
         kCompositeExpectedDepthBit | kCompositeMedianDepthBit;
 const bool kExpectedDepth = (kDepthOutputs & kCompositeExpectedDepthBit) != 0u;
@@ -164,11 +161,9 @@ uint BlockCounter(uvec4 counters, uint k) {
 // Splats blended per step of the batch loop. Unrolled because llvmpipe (lavapipe) ends
 // every loop of an invocation once 65535 back-edges have been taken in total (gallivm's loop
 // limiter): with steps of 16 (at most 24 back-edges per batch of 256) a tile may hold ~700k
-// entries. On the H100 (grid composite, 1080p) steps of 4 took 1.71 ms, of 8 1.58 ms, of 16
-// followed by singles 1.57 ms, of 16 followed by one of 8 1.54 ms; padding the lists to whole
-// steps with a null splat changed nothing. Registers (VK_KHR_pipeline_executable_properties,
-// H100): 91 at 8, 122 at 16, so two workgroups share an SM either way, and the unrolled loads
-// are what hides the shared-memory and exp2 latency.
+// entries. Steps of 16, then one of 8, measured fastest on NVIDIA; at 122 registers two
+// workgroups still share an SM, and the unrolled loads are what hides the shared-memory and
+// exp2 latency (docs/perf/h100.md "Composite").
 const uint kUnroll = 16u;
 
 // One step of N splats from position j of the block's list: N alphas, then N blends in order.
@@ -228,9 +223,9 @@ uint CompositeTile(uint tile, uvec2 range, uint next_index, uvec2 upcoming, uint
     if (p.done) atomicAdd(s_done, 1u);
 
     // The splat index of this invocation's next batch entry is read one batch ahead, so a
-    // batch load waits on one gather instead of two dependent ones: grid composite 1.583
-    // -> 1.566 ms (H100, 1080p). Reading the whole next record ahead held 12 more
-    // registers across the blend loop and measured slower (1.611 ms).
+    // batch load waits on one gather instead of two dependent ones. Reading the whole next
+    // record ahead holds more registers across the blend loop and measured slower
+    // (docs/perf/h100.md).
     for (uint batch = begin; batch < end; batch += kCompositeBatchSize) {
         barrier();  // the previous batch is consumed and its s_done increments made
         // Early exit when every pixel of the tile is done. Uniform: s_done is read
@@ -313,8 +308,7 @@ void main() {
     // This invocation's pixel within every tile it takes. Invocations 32 k .. 32 k + 31
     // cover block k of the tile: 8 columns by 4 rows, two blocks side by side. A compact block
     // meets fewer splats than a 16x2 row pair and its pixels agree more often on whether they
-    // blend a splat, which is what a subgroup of 32 pays for: 0.244 -> 0.237 ms composite
-    // (playbot 1080p), 0.467 -> 0.449 (biker 4K), the grid 2.73 -> 2.63 on the H100.
+    // blend a splat, which is what a subgroup of 32 pays for (docs/perf/h100.md "Composite").
     uint block = local / (kCompositeBlockWidth * kCompositeBlockHeight);
     uint blocks_x = kCompositeTileSize / kCompositeBlockWidth;
     uvec2 in_tile = uvec2(
@@ -334,9 +328,8 @@ void main() {
     // Tiles are claimed one ahead (near the end, see below): while a workgroup composites a
     // tile, the tile after it is already in s_tile and its range in flight, and the claim of
     // the one after that is in flight too. Claiming, reading the range and then the first
-    // index between two tiles waited on three dependent global accesses per tile: 0.509 ->
-    // 0.482 ms composite for playbot_125k at 4K (32,400 tiles) on the H200, 1080p unchanged
-    // (0.173 ms), the grid 1.540 -> 1.550-1.553 ms (four runs; not explained).
+    // index between two tiles waits on three dependent global accesses per tile, which
+    // counts most where tiles are many and short (4K; docs/perf/h200.md).
     uvec2 range = TileRange(tile, num_tiles);
     uint next_index = FirstIndex(range, slot);
     if (local == 0u) s_tile = gl_NumWorkGroups.x + atomicAdd(state.next_tile, 1u);
@@ -347,8 +340,7 @@ void main() {
         uint claimed = 0u;
         // Near the end of the tiles, a tile claimed ahead waits for the current one while
         // other workgroups find none left: in the last 2 x num_workgroups tiles the claim is
-        // made after the tile. Composite 0.173 -> 0.170 ms (playbot_125k 1080p), 0.482 ->
-        // 0.475 ms (4K), grid 1.551 -> 1.547 ms (H200). CPU devices always claim after.
+        // made after the tile (docs/perf/h200.md). CPU devices always claim after.
         bool ahead = following + 2u * gl_NumWorkGroups.x < num_tiles;
         if (ahead && local == 0u) claimed = atomicAdd(state.next_tile, 1u);
         next_index = CompositeTile(tile, range, next_index, following_range, slot, in_tile,

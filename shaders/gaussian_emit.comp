@@ -1,9 +1,9 @@
 #version 460
 // Geometry stage, tile entries: one invocation per visible splat in list order writes
 // (key, splat index) for every tile of its rectangle that TileRowSpan keeps, at its scanned
-// offset. (Sharing splats of 32+ entries across the subgroup measured slower on the H100:
-// 0.071 vs 0.063 ms scan + emit for playbot_125k at 1080p.) A splat whose
-// entries would pass the capacity writes none (the dispatch-args pass has flagged it).
+// offset (one invocation per splat: sharing splats of 32+ entries across the subgroup
+// measured slower, docs/perf/h100.md "Geometry stage"). A splat whose entries would pass
+// the capacity writes none (the dispatch-args pass has flagged it).
 // Exact order (kEmitTileKeys): the list is in depth order and the key is the tile index;
 // a stable sort by tile keeps that order. Packed option (kEmitPackedKeys): the list is in
 // the projection's append order and the key is the seed's packed (tile, truncated depth)

@@ -1,6 +1,6 @@
 #version 460
 // Geometry stage, pass 1: one invocation per splat. Exactly the 3DGS rasterizer's preprocess
-// (docs/DESIGN.md section 3, mirrored from cpu/Projection.cpp) in float32: near cull,
+// (docs/DESIGN.md "Numerical rules", mirrored from cpu/Projection.cpp) in float32: near cull,
 // guard-band clamped Jacobian, +0.3 dilation, optional antialias compensation, det == 0
 // cull, 3-sigma radius with the 0.1 eigenvalue floor, tile rectangle, SH colour. Visible
 // splats write their GaussianProjectedSplat and append (depth key, splat index) to the
@@ -123,7 +123,8 @@ mat3 CovarianceFactor(vec3 s, vec4 q) {
 const uint kShWords = 3u * ((kShDegree + 1u) * (kShDegree + 1u) - 1u);
 const uint kShVec4s = kShWords / 4u;
 // A product, not an && chain: glslang 12 (Debian 12) turns && of spec constants into a phi
-// that the OpSpecConstantOp then names before it exists (invalid SPIR-V, docs/vulkan.md).
+// that the OpSpecConstantOp then names before it exists (invalid SPIR-V,
+// docs/environment-notes.md).
 const uint kShVec4Layout = uint(kPrecision == kPrecisionExact) * uint(kShWords % 4u == 0u) *
                            uint(kShWords > 0u);
 

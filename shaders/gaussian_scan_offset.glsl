@@ -4,8 +4,8 @@
 // above (GaussianGeometryStage::GetStorageRequirements). The scan only goes up: each level is
 // exclusive within its blocks of kScanBlockSize and the top level is whole, so a slot's
 // offset is the sum of its value and its blocks' values on every level above, the sums a
-// down-sweep would have added. That saves the down-sweep's dispatches (22 us of the grid's
-// 71 us scan on the H200) for a few cached loads per read.
+// down-sweep would have added. That saves the down-sweep's dispatches for a few cached loads
+// per read (docs/perf/h200.md).
 #ifndef OPEN3D_GAUSSIAN_SCAN_OFFSET_GLSL
 #define OPEN3D_GAUSSIAN_SCAN_OFFSET_GLSL
 

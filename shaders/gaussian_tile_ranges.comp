@@ -27,8 +27,7 @@ layout(std430, set = 0, binding = kCompositeStateBinding) writeonly buffer State
 };
 
 // Entries each invocation examines per step of the grid-stride loop, loaded together: one
-// entry (and its neighbours' reloads) per step took 25 us for the grid's 9M entries on the
-// H200, a chain of dependent steps per invocation.
+// entry per step makes a chain of dependent loads per invocation (docs/perf/h200.md).
 const uint kRangeItems = 4u;
 
 void main() {

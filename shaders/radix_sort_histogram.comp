@@ -39,7 +39,7 @@ void main() {
     uint block_begin = gl_WorkGroupID.x * block_size;
     uint chunks = block_size / kRadixSortWorkgroupSize;  // uniform, 1..8
     // All loads first, so that they are in flight together (one load, then its atomic, per
-    // step took 20-37 us per pass of the grid's sorts on the H200).
+    // step measured slower: docs/perf/h200.md).
     uint keys[kRadixSortItemsPerInvocation];
     [[unroll]] for (uint k = 0u; k < kRadixSortItemsPerInvocation; ++k) {
         uint index = block_begin + local + k * kRadixSortWorkgroupSize;
@@ -56,8 +56,8 @@ void main() {
         }
     }
     if (track_range) {
-        // Subgroup, then workgroup, then one global atomic pair per block (per subgroup,
-        // 190k same-address atomics took 300 us of the grid's 6.1M-splat projection).
+        // Subgroup, then workgroup, then one global atomic pair per block: same-address
+        // global atomics serialise (docs/environment-notes.md).
         key_min = subgroupMin(key_min);
         key_max = subgroupMax(key_max);
         if (subgroupElect()) {

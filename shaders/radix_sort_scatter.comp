@@ -7,15 +7,13 @@
 // before its step plus its rank among the step's equal digits. One scan across subgroups
 // then gives each pair its block-local sorted position: the digit's start in the block +
 // the earlier subgroups' count of the digit + its rank in the subgroup. The block's output
-// index of that position is s_out_shift[digit] + position. Three barriers per block: the
-// earlier version scanned across subgroups after every chunk of 256 pairs (four barriers
-// each) and took 114-129 us per pass of the grid's 6.1M-key depth sort on the H100.
+// index of that position is s_out_shift[digit] + position. Three barriers per block, where a
+// scan across subgroups after every chunk of 256 pairs needs four per chunk (docs/perf/h100.md).
 // Writing (kLocalCapacity > 1, where shared memory allows): the pairs go to shared memory at
 // their local positions and the block is written out in sorted order at the end, so each
 // digit's run of the block is one contiguous write. Otherwise (lavapipe's 32 KiB) every
-// pair is written straight from its register, about one pair per digit and memory segment:
-// on the H100 that took 250 us per pass of the grid's depth sort, against 130 with the
-// local reorder.
+// pair is written straight from its register, about one pair per digit and memory segment,
+// about twice as slow on NVIDIA (docs/perf/h100.md "Radix sort").
 // Dropping (a first pass with drop_max_keys): pairs with key kRadixSortDroppedKey take no
 // rank and are not written, so the block's kept pairs are packed from its output offsets.
 // Stability: subgroups own runs in scan-slot order (gl_SubgroupID), a subgroup ranks its

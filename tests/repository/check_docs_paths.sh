@@ -1,11 +1,11 @@
 #!/usr/bin/env bash
-# The docs stay true (STYLE.md point 14): every repository path written in backticks in
-# docs/*.md and README.md must exist. Usage: check_docs_paths.sh ROOT
+# The docs stay true (docs/DESIGN.md "Code rules"): every repository path written in
+# backticks in docs/*.md, docs/*/*.md and README.md must exist. Usage: check_docs_paths.sh ROOT
 set -euo pipefail
 root="${1:?usage: $0 ROOT}"
 cd "$root"
 status=0
-for doc in docs/*.md README.md; do
+for doc in docs/*.md docs/*/*.md README.md; do
   [ -f "$doc" ] || continue
   # Backticked tokens that start with a top-level folder of the repository.
   while IFS= read -r path; do

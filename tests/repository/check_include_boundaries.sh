@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Layer boundaries (STYLE.md point 2): only a `vulkan/` folder includes <vulkan/...> and
+# Layer boundaries (docs/DESIGN.md "Layers"): only a `vulkan/` folder includes <vulkan/...> and
 # only a `filament/` folder includes Filament headers. Usage: check_include_boundaries.sh ROOT
 set -euo pipefail
 root="${1:?usage: $0 ROOT}"

@@ -1,4 +1,4 @@
-// The frame of docs/DESIGN.md "Frame" in three calls (docs/filament.md "Frame"):
+// The seed's frame in three calls (docs/filament.md "Frame"):
 //   BeginFrame: flushAndWait (the previous frame's GL work on the shared images is done),
 //               then the splat geometry stage of every added view with splats is submitted
 //               without a CPU wait, so it overlaps Filament's draw;

@@ -1,8 +1,7 @@
-// The backend interface at stage granularity (docs/DESIGN.md section 2): a backend holds a
+// The backend interface at stage granularity (docs/DESIGN.md "Code rules"): a backend holds a
 // scene, runs the geometry stage (RenderGeometryStage: project + per-tile entries + depth sort) for
 // a view, then the composite stage (RenderCompositeStage: per-tile front-to-back blending).
-// Backends are made by name ("cpu", "placeholder", later "vulkan"/"metal" registered by their
-// layers).
+// Backends are made by name ("cpu", "placeholder"; "vulkan" is registered by its layer).
 #pragma once
 
 #include <functional>

@@ -1,4 +1,4 @@
-// CPU-side packing of what the GPU projection reads (docs/vulkan.md (geometry stage)): per-splat
+// CPU-side packing of what the GPU projection reads (docs/vulkan.md "Geometry stage"): per-splat
 // attribute buffers from a Gaussian splat cloud (once per scene change) and the per-frame
 // GaussianViewParams. No Vulkan here: the layouts are the contract header's, so the CPU,
 // Vulkan and Metal layers all pack the same bytes.

@@ -1,5 +1,5 @@
 // Concatenating several splat clouds into one (the merged scene a backend uploads once for
-// all objects of a FilamentScene; docs/DESIGN.md section 6).
+// all objects of a FilamentScene; docs/filament.md "Scene").
 #pragma once
 
 #include <vector>

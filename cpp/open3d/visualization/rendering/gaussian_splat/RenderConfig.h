@@ -1,5 +1,6 @@
 // Every knob of the Gaussian splat pipeline, shared by all backends. Defaults reproduce
-// the original 3DGS rasterizer (docs/DESIGN.md section 3); other values are measured options.
+// the original 3DGS rasterizer (docs/DESIGN.md "Numerical rules"); other values are measured
+// options.
 #pragma once
 
 #include <Eigen/Core>

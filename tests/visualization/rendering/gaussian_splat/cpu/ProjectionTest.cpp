@@ -1,4 +1,4 @@
-// Analytic checks of the projection stage (docs/DESIGN.md section 3). Expected values are
+// Analytic checks of the projection stage (docs/DESIGN.md "Numerical rules"). Expected values are
 // closed-form; tolerances cover double rounding only (the projection stays in double).
 #include <gtest/gtest.h>
 

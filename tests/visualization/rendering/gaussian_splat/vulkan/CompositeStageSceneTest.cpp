@@ -51,7 +51,7 @@ const t::geometry::PointCloud& LoadScene(const std::string& relative) {
 // 5.5e-4/255, 99.9th percentile <= 3.0e-4/255, no value off by 1/255; expected depth within
 // 4.6e-6. The targets are the (80 dB, 1/255 on >= 99.99% of values, p99.9 <=
 // 0.1/255): 300x above what we measure, leaving room for near-threshold flips (alpha within
-// rounding of 1/255, T within rounding of 1e-4) that DESIGN.md section 3 expects elsewhere.
+// rounding of 1/255, T within rounding of 1e-4; docs/accuracy.md "Threshold decisions").
 constexpr double kMinPsnrDb = 80.0;
 constexpr double kMaxFractionOverLsb = 1e-4;
 constexpr double kMaxP999 = 0.1 / 255.0;

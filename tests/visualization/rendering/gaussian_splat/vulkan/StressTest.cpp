@@ -7,8 +7,8 @@
 // exception fails the test), the same culled set and tile lists (geometry stage compared splat by
 // splat), the same coverage and median depth per pixel, and colour / expected depth within
 // a tolerance that the comment beside it justifies by the error measured on lavapipe (an
-// H100 fits the same bounds; docs/vulkan.md "Numerical stress suite" has both, and the
-// fixes these cases needed).
+// H100 fits the same bounds; docs/perf/lavapipe.md and docs/perf/h100.md have both, and
+// docs/vulkan.md "Numerical stress suite" the rules these cases hold the renderers to).
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
@@ -189,8 +189,8 @@ TEST_F(Stress, HugeFlatSplatSeenEdgeOn) {
         p.f_dc = Eigen::Vector3d(0.9, 0.2 * i, 0.5);
         splats.push_back(p);
     }
-    // Measured 143.6 dB, max 3.6e-7, depth 1.6e-6. Before the fix (det = a c - b^2 in
-    // float32, both ~1e21 here): 59.8 dB, max 3.4e-3, depth 1.4e-2.
+    // Measured 143.6 dB, max 3.6e-7, depth 1.6e-6. With det = a c - b^2 in float32 (both
+    // ~1e21 here) it is 59.8 dB, max 3.4e-3, depth 1.4e-2: hence Lagrange's identity.
     const Bounds bounds = MakeBounds(130.0, 2e-6, 1e-5);
     RenderBoth("flat 1e4 disc edge-on", MakeRawCloud(splats), MakeCamera(kW, kH, kF), bounds);
 }
@@ -225,9 +225,9 @@ TEST_F(Stress, NearPlane) {
             splats.push_back(p);
             ++i;
         }
-        // Measured 148.9 / 146.1 dB, max 9.5e-7 / 1.4e-6, depth 1.5e-7. Before the fix the
-        // reference kept the splats at 0.2f (> 0.2 in double) that the GPU culled (0.2f > 0.2f
-        // is false): 5 vs 3 visible, 28.9 dB.
+        // Measured 148.9 / 146.1 dB, max 9.5e-7 / 1.4e-6, depth 1.5e-7. A near cull in double
+        // would keep the splats at 0.2f (> 0.2 in double) that the GPU culls (0.2f > 0.2f is
+        // false): 5 vs 3 visible, 28.9 dB.
         const Bounds bounds = MakeBounds(130.0, 5e-6, 1e-6);
         const camera::PinholeCamera cam = MakeCamera(kW, kH, kF, r, center);
         RenderBoth(tilted ? "near plane, tilted camera" : "near plane", MakeRawCloud(splats), cam,
@@ -339,7 +339,7 @@ TEST_F(Stress, SceneAndCamera1e5FromTheOrigin) {
         std::vector<RawSplat> splats;
         camera::PinholeCamera cam;
         MakeOffsetScene(Eigen::Vector3d(offset, -offset, offset), splats, cam);
-        // Measured 143.1 dB (origin) and 143.8 dB (1e5), max 1.3e-6, depth 2.0e-7. Before the
+        // Measured 143.1 dB (origin) and 143.8 dB (1e5), max 1.3e-6, depth 2.0e-7. Without the
         // camera-relative projection (R p + t in float32, 1e5-sized terms): 59.9 dB, max
         // 2.3e-2, depth 1.8e-2. The camera-relative depth order is the knob for such scenes:
         // the default reproduces the original rasterizer, whose float32 world-space depth and
@@ -543,8 +543,8 @@ TEST_F(Stress, RadiusBeyond2To32) {
     small.scale = Eigen::Vector3d(1e-4, 1.5e-4, 1e-4);
     small.logit = Logit(0.8);
     splats.push_back(small);
-    // Measured 149.6 dB, max 2.4e-7, depth 1.4e-6. Before the clamp the reference's radius
-    // converted to INT_MIN (x86): rect [4, 0) x [3, 0), counted as 12 tiles that emitted nothing.
+    // Measured 149.6 dB, max 2.4e-7, depth 1.4e-6. Without the clamp the reference's radius
+    // converts to INT_MIN (x86): rect [4, 0) x [3, 0), counted as 12 tiles that emit nothing.
     const Bounds bounds = MakeBounds(135.0, 1e-6, 1e-5);
     RenderBoth("radius > 2^32 (telephoto)", MakeRawCloud(splats), MakeCamera(kW, kH, 1e5), bounds);
 }

@@ -68,7 +68,8 @@ TEST_F(VulkanContextTest, DescribesDevice) {
     EXPECT_GE(info.max_subgroup_size, info.subgroup_size);
     EXPECT_GE(info.max_compute_shared_memory, 16384u);
     EXPECT_TRUE(IsPowerOfTwo(uint32_t(info.min_storage_buffer_offset_alignment)));
-    // LP_NATIVE_VECTOR_WIDTH=128/512 makes lavapipe use subgroups of 4/16 (docs/vulkan.md).
+    // LP_NATIVE_VECTOR_WIDTH=128/512 makes lavapipe use subgroups of 4/16
+    // (docs/environment-notes.md).
     if (info.driver_name == "llvmpipe" && std::getenv("LP_NATIVE_VECTOR_WIDTH") == nullptr) {
         EXPECT_EQ(info.subgroup_size, 8u) << "lavapipe's fixed subgroup size";
     }

@@ -1,6 +1,7 @@
 // Composite stage of the CPU reference: per-tile front-to-back blending with the 3DGS rules
-// (docs/DESIGN.md section 3): the blended values in double precision, the threshold decisions
-// (alpha >= 1/255, the transmittance stop) in float32 as the original rasterizer takes them.
+// (docs/DESIGN.md "Numerical rules"): the blended values in double precision, the threshold
+// decisions (alpha >= 1/255, the transmittance stop) in float32 as the original rasterizer
+// takes them.
 #pragma once
 
 #include <vector>

@@ -1,5 +1,5 @@
 // Geometry stage, step 1 of the CPU reference: per-splat projection, exactly the 3DGS
-// rasterizer's preprocess (docs/DESIGN.md section 3), computed in double precision.
+// rasterizer's preprocess (docs/DESIGN.md "Numerical rules"), computed in double precision.
 #pragma once
 
 #include <array>

@@ -1,7 +1,8 @@
-// Composite stage of the Vulkan pipeline as a recorder (STYLE.md point 6): the per-tile composite
-// of the tile-sorted entries that geometry stage (or a test) produced, and the depth merge for
-// depth readback. The caller owns every buffer and image; Record*() only records commands
-// (no allocation, no submit). Design, images and measured errors: docs/vulkan.md "Composite stage".
+// Composite stage of the Vulkan pipeline as a recorder (docs/DESIGN.md "Code rules"): the
+// per-tile composite of the tile-sorted entries that the geometry stage (or a test) produced,
+// and the depth merge for depth readback. The caller owns every buffer and image; Record*()
+// only records commands (no allocation, no submit). Design and images: docs/vulkan.md
+// "Composite stage"; measured errors and times: docs/perf/.
 #pragma once
 
 #include <vulkan/vulkan.h>

@@ -1,9 +1,9 @@
-// Geometry stage of the Vulkan pipeline as a recorder (STYLE.md point 6): project the splats,
-// order the visible ones by exact float32 depth (ties by splat index), emit one entry
+// Geometry stage of the Vulkan pipeline as a recorder (docs/DESIGN.md "Code rules"): project
+// the splats, order the visible ones by exact float32 depth (ties by splat index), emit one entry
 // per touched tile in that order and stably sort the entries by tile. The seed's packed
 // 32-bit (tile, truncated depth) key is an option (RenderConfig::sort_mode). The caller
 // allocates from GetStorageRequirements; Record() only records commands (no allocation,
-// no submit). Pass sequence and buffers: docs/vulkan.md (geometry stage).
+// no submit). Pass sequence and buffers: docs/vulkan.md "Geometry stage".
 #pragma once
 
 #include <vulkan/vulkan.h>

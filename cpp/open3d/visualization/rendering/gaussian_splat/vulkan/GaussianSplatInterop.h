@@ -3,7 +3,7 @@
 // composite) and the scene depth (D32_SFLOAT, written by Filament, sampled by the
 // composite) live in Vulkan memory exported as POSIX file descriptors, which GL imports
 // with GL_EXT_memory_object_fd. This header has no Vulkan types so the Filament layer can
-// use it (STYLE.md point 2); synchronisation is on the CPU (fence waits), because lavapipe
+// use it (docs/DESIGN.md "Layers"); synchronisation is on the CPU (fence waits), because lavapipe
 // has no external semaphores (docs/environment-notes.md).
 #pragma once
 

@@ -1,4 +1,4 @@
-// GPU radix sort of (uint32 key, uint32 value) pairs, a recorder (STYLE.md point 6): the
+// GPU radix sort of (uint32 key, uint32 value) pairs, a recorder (docs/DESIGN.md "Code rules"): the
 // caller allocates the scratch buffers from GetStorageRequirements and Record() only
 // records commands. The element count is read on the GPU from the producer's buffer.
 //
@@ -107,8 +107,8 @@ public:
 
     /// What the caller reads afterwards. kValuesOnly: the keys are left unspecified, and
     /// the last pass that runs and the copy write no keys (but the first pass of a
-    /// kFromKeyRange sort, which runs before the range is known). Geometry stage's depth sort
-    /// reads only the splat indices (docs/vulkan.md has the time).
+    /// kFromKeyRange sort, which runs before the range is known). The geometry stage's depth
+    /// sort reads only the splat indices (docs/perf/h200.md has the time).
     enum class Output {
         kKeysAndValues,
         kValuesOnly,

@@ -1,5 +1,5 @@
 // The Vulkan backend as code outside the Vulkan layer sees it (no Vulkan types, so the
-// Filament layer and its tests can include this; STYLE.md point 2).
+// Filament layer and its tests can include this; docs/DESIGN.md "Layers").
 #pragma once
 
 #include <cstdint>

@@ -1,4 +1,4 @@
-// Move-only owners of Vulkan objects created from a VkDevice (STYLE.md point 7). Each
+// Move-only owners of Vulkan objects created from a VkDevice (docs/DESIGN.md "Code rules"). Each
 // destroys its handle exactly once; handles owned by someone else (a host application,
 // Filament) are passed as plain Vk* values or BufferRange and never wrapped here.
 #pragma once
