@@ -13,6 +13,7 @@
 #include "open3d/core/Exception.h"
 #include "open3d/t/geometry/TriangleMesh.h"
 #include "open3d/t/io/ImageIO.h"
+#include "open3d/visualization/rendering/filament/FilamentRenderer.h"
 #include "visualization/visualizer/VisualizerTestFixture.h"
 
 namespace open3d {
@@ -38,6 +39,25 @@ void Drag(Visualizer& vis, int button, double x0, double y0, double x1, double y
     vis.OnCursorPos(0.5 * (x0 + x1), 0.5 * (y0 + y1));
     vis.OnCursorPos(x1, y1);
     vis.OnMouseButton(button, false, 0);
+}
+
+// The viewer draws through BeginFrame / Draw / EndFrame: the splat geometry stage is
+// submitted before Filament draws, the composite follows Filament's draw, and the compose
+// view is drawn on the window and presented last.
+TEST_F(VisualizerTest, FramesFollowTheSeedsOrder) {
+    Visualizer& vis = MakeVisualizer();
+    AddWallAndSphere(vis);
+    std::vector<rendering::FrameEvent> events;
+    renderer_->SetFrameEventListener(
+        [&](rendering::FrameEvent e, const rendering::FilamentView*) { events.push_back(e); });
+    const bool drawn = vis.RenderFrame();
+    renderer_->SetFrameEventListener({});
+    ASSERT_TRUE(drawn);
+    using rendering::FrameEvent;
+    const std::vector<FrameEvent> want = {FrameEvent::kBeginFrame,   FrameEvent::kGeometryStage,
+                                          FrameEvent::kFilamentDraw, FrameEvent::kComposite,
+                                          FrameEvent::kOverlay,      FrameEvent::kEndFrame};
+    EXPECT_EQ(events, want);
 }
 
 TEST_F(VisualizerTest, GeometryByName) {

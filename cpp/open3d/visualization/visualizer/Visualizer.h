@@ -165,8 +165,8 @@ public:
     t::geometry::Image RenderToImage(bool with_alpha = false);
     /// Offscreen depth (Open3DScene::RenderToDepthImage: near / far default to the view's).
     t::geometry::Image RenderToDepthImage(
-            rendering::DepthFormat format = rendering::DepthFormat::kViewZ,
-            std::optional<float> near = std::nullopt, std::optional<float> far = std::nullopt);
+        rendering::DepthFormat format = rendering::DepthFormat::kViewZ,
+        std::optional<float> near = std::nullopt, std::optional<float> far = std::nullopt);
 
     // Window.
     /// Requests a window size; the new size is used from the next frame on.

@@ -17,8 +17,8 @@
 #include <cstring>
 
 #include "open3d/core/Exception.h"
-#include "open3d/visualization/rendering/filament/FilamentMaterials.h"
 #include "open3d/core/Logging.h"
+#include "open3d/visualization/rendering/filament/FilamentMaterials.h"
 
 namespace open3d {
 namespace visualization {
@@ -59,8 +59,8 @@ std::vector<float> VertexColors(const core::Tensor* colors, int64_t n) {
     for (int64_t i = 0; i < n; ++i) {
         for (int k = 0; k < 3; ++k) {
             rgba[4 * i + k] = colors->GetDtype() == core::Dtype::UInt8
-                                      ? colors->Data<uint8_t>()[3 * i + k] / 255.0f
-                                      : colors->Data<float>()[3 * i + k];
+                                  ? colors->Data<uint8_t>()[3 * i + k] / 255.0f
+                                  : colors->Data<float>()[3 * i + k];
         }
     }
     return rgba;
@@ -92,7 +92,7 @@ FilamentScene::Mesh FilamentScene::BuildMesh(const t::geometry::TriangleMesh& in
     const float* p = mesh.GetVertexPositions().Data<float>();
     std::vector<float> positions(p, p + 3 * n);
     std::vector<float> colors =
-            VertexColors(mesh.HasVertexColors() ? &mesh.GetVertexColors() : nullptr, n);
+        VertexColors(mesh.HasVertexColors() ? &mesh.GetVertexColors() : nullptr, n);
     std::vector<float> normals;
     if (lit) {
         const float* nrm = mesh.GetVertexNormals().Data<float>();
@@ -111,11 +111,10 @@ FilamentScene::Mesh FilamentScene::BuildMesh(const t::geometry::TriangleMesh& in
     out.max_bound = mesh.GetMaxBound();
     VertexBuffer::Builder builder;
     builder.vertexCount(static_cast<uint32_t>(n))
-            .bufferCount(lit ? 3 : 2)
-            .attribute(filament::VertexAttribute::POSITION, 0, VertexBuffer::AttributeType::FLOAT3,
-                       0, 12)
-            .attribute(filament::VertexAttribute::COLOR, 1, VertexBuffer::AttributeType::FLOAT4, 0,
-                       16);
+        .bufferCount(lit ? 3 : 2)
+        .attribute(filament::VertexAttribute::POSITION, 0, VertexBuffer::AttributeType::FLOAT3, 0,
+                   12)
+        .attribute(filament::VertexAttribute::COLOR, 1, VertexBuffer::AttributeType::FLOAT4, 0, 16);
     if (lit) {
         builder.attribute(filament::VertexAttribute::CUSTOM0, 2,
                           VertexBuffer::AttributeType::FLOAT3, 0, 12);
@@ -125,9 +124,9 @@ FilamentScene::Mesh FilamentScene::BuildMesh(const t::geometry::TriangleMesh& in
     out.vertices->setBufferAt(engine_, 1, OwnedDescriptor(std::move(colors)));
     if (lit) out.vertices->setBufferAt(engine_, 2, OwnedDescriptor(std::move(normals)));
     out.indices = filament::IndexBuffer::Builder()
-                          .indexCount(static_cast<uint32_t>(indices.size()))
-                          .bufferType(filament::IndexBuffer::IndexType::UINT)
-                          .build(engine_);
+                      .indexCount(static_cast<uint32_t>(indices.size()))
+                      .bufferType(filament::IndexBuffer::IndexType::UINT)
+                      .build(engine_);
     const size_t num_indices = indices.size();
     out.indices->setBuffer(engine_, OwnedDescriptor(std::move(indices)));
     Finish(out, static_cast<int>(filament::RenderableManager::PrimitiveType::TRIANGLES),
@@ -149,7 +148,7 @@ FilamentScene::Mesh FilamentScene::BuildPoints(const t::geometry::PointCloud& cl
     const float* p = positions_tensor.Data<float>();
     std::vector<float> positions(p, p + 3 * n);
     std::vector<float> colors =
-            VertexColors(cloud.HasPointAttr("colors") ? &cloud.GetPointAttr("colors") : nullptr, n);
+        VertexColors(cloud.HasPointAttr("colors") ? &cloud.GetPointAttr("colors") : nullptr, n);
     std::vector<uint32_t> indices(n);
     for (int64_t i = 0; i < n; ++i) indices[i] = static_cast<uint32_t>(i);
 
@@ -161,19 +160,19 @@ FilamentScene::Mesh FilamentScene::BuildPoints(const t::geometry::PointCloud& cl
     out.min_bound = points.rowwise().minCoeff().cast<double>();
     out.max_bound = points.rowwise().maxCoeff().cast<double>();
     out.vertices = VertexBuffer::Builder()
-                           .vertexCount(static_cast<uint32_t>(n))
-                           .bufferCount(2)
-                           .attribute(filament::VertexAttribute::POSITION, 0,
-                                      VertexBuffer::AttributeType::FLOAT3, 0, 12)
-                           .attribute(filament::VertexAttribute::COLOR, 1,
-                                      VertexBuffer::AttributeType::FLOAT4, 0, 16)
-                           .build(engine_);
+                       .vertexCount(static_cast<uint32_t>(n))
+                       .bufferCount(2)
+                       .attribute(filament::VertexAttribute::POSITION, 0,
+                                  VertexBuffer::AttributeType::FLOAT3, 0, 12)
+                       .attribute(filament::VertexAttribute::COLOR, 1,
+                                  VertexBuffer::AttributeType::FLOAT4, 0, 16)
+                       .build(engine_);
     out.vertices->setBufferAt(engine_, 0, OwnedDescriptor(std::move(positions)));
     out.vertices->setBufferAt(engine_, 1, OwnedDescriptor(std::move(colors)));
     out.indices = filament::IndexBuffer::Builder()
-                          .indexCount(static_cast<uint32_t>(n))
-                          .bufferType(filament::IndexBuffer::IndexType::UINT)
-                          .build(engine_);
+                      .indexCount(static_cast<uint32_t>(n))
+                      .bufferType(filament::IndexBuffer::IndexType::UINT)
+                      .build(engine_);
     out.indices->setBuffer(engine_, OwnedDescriptor(std::move(indices)));
     Finish(out, static_cast<int>(filament::RenderableManager::PrimitiveType::POINTS), size_t(n));
     return out;
@@ -188,9 +187,9 @@ void FilamentScene::Finish(Mesh& out, int primitive, size_t num_indices) {
     out.material->setParameter("baseColor",
                                filament::math::float4(rgba[0], rgba[1], rgba[2], rgba[3]));
     if (lit) {
-        out.material->setParameter("lightDirection",
-                                   filament::math::float3(light_direction_[0], light_direction_[1],
-                                                          light_direction_[2]));
+        out.material->setParameter(
+            "lightDirection",
+            filament::math::float3(light_direction_[0], light_direction_[1], light_direction_[2]));
         out.material->setParameter("ambient", ambient_);
     } else {
         out.material->setParameter("pointSize", look.point_size);
@@ -198,17 +197,17 @@ void FilamentScene::Finish(Mesh& out, int primitive, size_t num_indices) {
     const Eigen::Vector3d center = 0.5 * (out.min_bound + out.max_bound);
     // A flat extent (one point, a plane) still needs a box Filament does not cull.
     const Eigen::Vector3d half =
-            (0.5 * (out.max_bound - out.min_bound)).cwiseMax(Eigen::Vector3d::Constant(1e-3));
+        (0.5 * (out.max_bound - out.min_bound)).cwiseMax(Eigen::Vector3d::Constant(1e-3));
     utils::Entity entity = utils::EntityManager::get().create();
     filament::RenderableManager::Builder(1)
-            .boundingBox({{float(center.x()), float(center.y()), float(center.z())},
-                          {float(half.x()), float(half.y()), float(half.z())}})
-            .material(0, out.material)
-            .geometry(0, static_cast<filament::RenderableManager::PrimitiveType>(primitive),
-                      out.vertices, out.indices, 0, num_indices)
-            .castShadows(false)
-            .receiveShadows(false)
-            .build(engine_, entity);
+        .boundingBox({{float(center.x()), float(center.y()), float(center.z())},
+                      {float(half.x()), float(half.y()), float(half.z())}})
+        .material(0, out.material)
+        .geometry(0, static_cast<filament::RenderableManager::PrimitiveType>(primitive),
+                  out.vertices, out.indices, 0, num_indices)
+        .castShadows(false)
+        .receiveShadows(false)
+        .build(engine_, entity);
     out.entity = entity.getId();
 }
 
@@ -240,10 +239,10 @@ void FilamentScene::AddGeometry(const std::string& name, const t::geometry::Poin
     if (material.shader == kShaderGaussianSplat) {
         if (!cloud.IsGaussianSplat()) {
             core::ThrowError(
-                    "FilamentScene: '{}' has the shader gaussianSplat but lacks Gaussian "
-                    "attributes (positions, rot, scale, opacity, f_dc); draw it with "
-                    "defaultUnlit to show its points",
-                    name);
+                "FilamentScene: '{}' has the shader gaussianSplat but lacks Gaussian "
+                "attributes (positions, rot, scale, opacity, f_dc); draw it with "
+                "defaultUnlit to show its points",
+                name);
         }
         splats_.AddCloud(name, cloud);
         cloud_materials_[name] = material;
@@ -352,8 +351,8 @@ void FilamentScene::SetLighting(const Eigen::Vector3f& direction, float ambient)
     ambient_ = ambient;
     for (auto& [name, mesh] : meshes_) {
         if (mesh.points || mesh.look.shader != kShaderDefaultLit) continue;
-        mesh.material->setParameter("lightDirection",
-                                    filament::math::float3(direction[0], direction[1], direction[2]));
+        mesh.material->setParameter(
+            "lightDirection", filament::math::float3(direction[0], direction[1], direction[2]));
         mesh.material->setParameter("ambient", ambient);
     }
 }

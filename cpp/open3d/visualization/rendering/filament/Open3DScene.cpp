@@ -57,9 +57,9 @@ void Open3DScene::AddGeometry(const std::string& name, const t::geometry::PointC
     if (differs && scene_->GetSplatRenderer().GetCloudNames().size() > 1) {
         // The merged scene renders with one setting.
         core::LogWarning(
-                "'{}': gaussianSplat SH degree {} / antialias {} now apply to every splat cloud "
-                "of the scene",
-                name, material.gaussian_splat_sh_degree, material.gaussian_splat_antialias);
+            "'{}': gaussianSplat SH degree {} / antialias {} now apply to every splat cloud "
+            "of the scene",
+            name, material.gaussian_splat_sh_degree, material.gaussian_splat_antialias);
     }
     config.sh_degree = material.gaussian_splat_sh_degree;
     config.antialias = material.gaussian_splat_antialias;
@@ -155,7 +155,8 @@ t::geometry::Image Open3DScene::RenderToDepthImage(DepthFormat format, std::opti
     t::geometry::Image reversed(z.GetRows(), z.GetCols(), 1, core::Dtype::Float32);
     const float* in = z.Data<float>();
     float* out = reversed.Data<float>();
-    for (int64_t i = 0; i < z.GetRows() * z.GetCols(); ++i) out[i] = in[i] > 0.0f ? n / in[i] : 0.0f;
+    for (int64_t i = 0; i < z.GetRows() * z.GetCols(); ++i)
+        out[i] = in[i] > 0.0f ? n / in[i] : 0.0f;
     return reversed;
 }
 

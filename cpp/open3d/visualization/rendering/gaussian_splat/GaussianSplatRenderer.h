@@ -82,10 +82,10 @@ public:
     void ReleaseView(uint64_t view_id);
 
     struct Counters {
-        int64_t merged_rebuilds = 0;       ///< merged scenes built and uploaded
-        int64_t mask_updates = 0;          ///< visibility masks sent without a rebuild
-        int64_t geometry_stages = 0;       ///< geometry stages asked of the backend
-        int64_t geometry_stage_reruns = 0; ///< of those, re-run because another view intervened
+        int64_t merged_rebuilds = 0;        ///< merged scenes built and uploaded
+        int64_t mask_updates = 0;           ///< visibility masks sent without a rebuild
+        int64_t geometry_stages = 0;        ///< geometry stages asked of the backend
+        int64_t geometry_stage_reruns = 0;  ///< of those, re-run because another view intervened
     };
     const Counters& GetCounters() const { return counters_; }
 
