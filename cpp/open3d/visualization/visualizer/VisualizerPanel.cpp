@@ -20,8 +20,8 @@ void FrameSection(const Visualizer& vis) {
     const double frame_ms = stats.GetSmoothedFrameMs();
     ImGui::Text("Frame %.1f ms (%.1f fps)", frame_ms, frame_ms > 0.0 ? 1000.0 / frame_ms : 0.0);
     const rendering::FrameTimes& t = stats.GetSmoothedParts();
-    ImGui::Text("Renderer %.1f ms: geometry stage %.1f", t.total_ms, t.geometry_stage_ms);
-    ImGui::Text("  Filament %.1f, composite stage %.1f, compose %.1f", t.filament_ms,
+    ImGui::Text("Renderer %.1f ms: geometry %.1f", t.total_ms, t.geometry_stage_ms);
+    ImGui::Text("  Filament %.1f, composite %.1f, compose %.1f", t.filament_ms,
                 t.composite_stage_ms, t.compose_ms);
     const uint32_t flags = vis.GetLastFrame().splat_stats.error_flags;
     if (flags != 0) ImGui::TextColored(kWarning, "GPU error flags 0x%x (see Splats)", flags);

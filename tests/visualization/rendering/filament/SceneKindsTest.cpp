@@ -6,9 +6,9 @@
 
 #include <cmath>
 
+#include "open3d/core/Exception.h"
 #include "open3d/t/geometry/TriangleMesh.h"
 #include "open3d/visualization/rendering/gaussian_splat/GaussianSplatMerge.h"
-#include "open3d/core/Exception.h"
 #include "visualization/rendering/filament/FilamentTestFixture.h"
 
 namespace open3d {
@@ -156,6 +156,34 @@ TEST_F(FilamentTest, DefaultLitShadesByTheDirectionalLightAndAmbient) {
     EXPECT_GT(checked, 200);
     // Mean error well under the bound: the shading follows the formula, not just roughly.
     EXPECT_LT(sum_error / checked, 2.5);
+}
+
+// The default light is a headlight: it turns with the camera, so the side of the sphere a
+// camera sees is lit the same from the front and from behind. A world-frame light stays.
+TEST_F(FilamentTest, DefaultLightFollowsTheCameraAndWorldLightStays) {
+    const camera::PinholeCamera front = MakeFilamentTestCamera(64, 48);
+    camera::PinholeCamera back = front;  // turned 180 degrees about y, at z = 4
+    back.world_to_camera.topLeftCorner<3, 3>() = Eigen::Vector3d(-1, 1, -1).asDiagonal();
+    back.world_to_camera.topRightCorner<3, 1>() = Eigen::Vector3d(0, 0, 4);
+    rendering::FilamentScene& scene = MakeScene("placeholder");
+    AddLitSphere(scene);
+    rendering::FilamentView& front_view = MakeView(front);
+    rendering::FilamentView& back_view = MakeView(back);
+    FrameRequest request;
+    request.read_color = true;
+    const size_t centre = 4 * (size_t(24) * 64 + 32);
+    const auto red_at_centre = [&](rendering::FilamentView& view) {
+        return int(renderer_->Draw(scene, view, request).color.Data<uint8_t>()[centre]);
+    };
+    const int headlight_front = red_at_centre(front_view);
+    const int headlight_back = red_at_centre(back_view);
+    // n . -l = 1 / |(0.3, 0.5, 1)| = 0.864 at the centre: 255 (0.25 + 0.75 0.864) = 229.
+    EXPECT_NEAR(headlight_front, 229, 8);  // 8: interpolated normals, as above
+    EXPECT_NEAR(headlight_back, headlight_front, 2);
+    scene.SetLighting(Eigen::Vector3f(0.3f, 0.5f, 1.0f), 0.25f);  // world frame
+    EXPECT_NEAR(red_at_centre(front_view), 229, 8);
+    // Seen from behind, the light comes from behind the sphere: ambient only, 0.25 * 255.
+    EXPECT_NEAR(red_at_centre(back_view), 64, 2);
 }
 
 // A cloud without the Gaussian attributes draws as points; asking for gaussianSplat on it

@@ -137,6 +137,7 @@ FrameResult FilamentRenderer::Draw(FilamentView& view, const FrameRequest& reque
     result.scene_depth_used = result.splats_drawn && scene.HasNonGaussianVisibleGeometry();
 
     Clock::time_point t = Clock::now();
+    scene.PrepareLighting(camera);
     filament::Renderer::ClearOptions clear;
     const Eigen::Vector4f& bg = view.GetBackground();
     clear.clearColor = {bg[0], bg[1], bg[2], bg[3]};

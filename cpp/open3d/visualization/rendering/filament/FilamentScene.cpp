@@ -343,17 +343,34 @@ void FilamentScene::ClearGeometry() {
     cloud_materials_.clear();
 }
 
-void FilamentScene::SetLighting(const Eigen::Vector3f& direction, float ambient) {
+void FilamentScene::SetLighting(const Eigen::Vector3f& direction, float ambient, LightFrame frame) {
     if (!(direction.norm() > 0.0f) || !(ambient >= 0.0f && ambient <= 1.0f)) {
         core::ThrowError("SetLighting: the direction must be non-zero and ambient in [0, 1]");
     }
     light_direction_ = direction;
+    light_frame_ = frame;
     ambient_ = ambient;
+    if (frame == LightFrame::kWorld) world_light_ = direction;
     for (auto& [name, mesh] : meshes_) {
         if (mesh.points || mesh.look.shader != kShaderDefaultLit) continue;
         mesh.material->setParameter(
-            "lightDirection", filament::math::float3(direction[0], direction[1], direction[2]));
+            "lightDirection",
+            filament::math::float3(world_light_[0], world_light_[1], world_light_[2]));
         mesh.material->setParameter("ambient", ambient);
+    }
+}
+
+void FilamentScene::PrepareLighting(const camera::PinholeCamera& camera) {
+    if (light_frame_ != LightFrame::kCamera) return;
+    // Camera to world: the transpose of the world-to-camera rotation.
+    const Eigen::Vector3f world =
+        (camera.GetRotation().transpose() * light_direction_.cast<double>()).cast<float>();
+    if (world == world_light_) return;
+    world_light_ = world;
+    for (auto& [name, mesh] : meshes_) {
+        if (mesh.points || mesh.look.shader != kShaderDefaultLit) continue;
+        mesh.material->setParameter("lightDirection",
+                                    filament::math::float3(world[0], world[1], world[2]));
     }
 }
 

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "open3d/camera/PinholeCamera.h"
 #include "open3d/t/geometry/PointCloud.h"
 #include "open3d/t/geometry/TriangleMesh.h"
 #include "open3d/visualization/rendering/filament/MaterialRecord.h"
@@ -71,8 +72,15 @@ public:
     const MaterialRecord& GetMaterial(const std::string& name) const;
 
     /// The directional light of "defaultLit" meshes: `direction` points from the light into
-    /// the scene (world frame); `ambient` in [0, 1] is the light every surface gets.
-    void SetLighting(const Eigen::Vector3f& direction, float ambient);
+    /// the scene, in the world frame or in the camera frame (OpenCV axes: x right, y down,
+    /// z forward; the light then follows the camera, as a headlight); `ambient` in [0, 1]
+    /// is the light every surface gets. Default: camera frame (0.3, 0.5, 1), from above
+    /// left behind the viewer, ambient 0.25.
+    enum class LightFrame { kWorld, kCamera };
+    void SetLighting(const Eigen::Vector3f& direction, float ambient,
+                     LightFrame frame = LightFrame::kWorld);
+    /// Points a camera-frame light for `camera` (FilamentRenderer::Draw calls it per view).
+    void PrepareLighting(const camera::PinholeCamera& camera);
     /// A visible splat cloud exists: the splat stages must run.
     bool HasVisibleGaussianSplats() const;
     /// Axis-aligned bounds of the visible geometry; false when there is none.
@@ -113,7 +121,9 @@ private:
     filament::Scene* scene_ = nullptr;
     std::map<std::string, Mesh> meshes_;
     std::map<std::string, MaterialRecord> cloud_materials_;  // "gaussianSplat" clouds
-    Eigen::Vector3f light_direction_{0.3f, 0.5f, 1.0f};
+    Eigen::Vector3f light_direction_{0.3f, 0.5f, 1.0f};      // in light_frame_
+    LightFrame light_frame_ = LightFrame::kCamera;
+    Eigen::Vector3f world_light_{0.3f, 0.5f, 1.0f};  // the direction the materials hold
     float ambient_ = 0.25f;
 };
 

@@ -68,8 +68,9 @@ void Open3DScene::AddGeometry(const std::string& name, const t::geometry::Triang
                               const MaterialRecord& material) {
     scene_->AddGeometry(name, mesh, material);
 }
-void Open3DScene::SetLighting(const Eigen::Vector3f& direction, float ambient) {
-    scene_->SetLighting(direction, ambient);
+void Open3DScene::SetLighting(const Eigen::Vector3f& direction, float ambient,
+                              FilamentScene::LightFrame frame) {
+    scene_->SetLighting(direction, ambient, frame);
 }
 void Open3DScene::SetClipPlanes(double near, double far) {
     if (!(near > 0.0) || !(far > near)) {

@@ -75,8 +75,10 @@ public:
     /// Splat settings (SH degree cap, antialias, sort mode...); background is not used.
     RenderConfig& GetSplatConfig() { return view_->GetSplatConfig(); }
     /// The directional light of "defaultLit" meshes (direction from the light into the
-    /// scene, world frame) and the ambient term in [0, 1].
-    void SetLighting(const Eigen::Vector3f& direction, float ambient);
+    /// scene, in the world frame or the camera's: FilamentScene::SetLighting) and the
+    /// ambient term in [0, 1]. Default: a headlight from above left behind the camera.
+    void SetLighting(const Eigen::Vector3f& direction, float ambient,
+                     FilamentScene::LightFrame frame = FilamentScene::LightFrame::kWorld);
 
     /// The camera and the image size of the renders.
     void SetupCamera(const camera::PinholeCamera& camera);
