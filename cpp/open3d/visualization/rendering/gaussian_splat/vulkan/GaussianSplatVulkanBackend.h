@@ -10,8 +10,8 @@
 #include <optional>
 
 #include "open3d/camera/PinholeCamera.h"
-#include "open3d/visualization/rendering/gaussian_splat/GaussianSplatDataPacking.h"
 #include "open3d/visualization/rendering/gaussian_splat/GaussianSplatBackend.h"
+#include "open3d/visualization/rendering/gaussian_splat/GaussianSplatDataPacking.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/Buffer.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/Commands.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/GaussianCompositeStage.h"
