@@ -2,7 +2,7 @@
 #   GLSL --glslangValidator--> SPIR-V --EmbedSpirv.cmake--> uint32_t arrays in a generated .cpp
 #                                     --spirv-cross--> MSL (checked at build time, for Metal)
 # Everything generated lives in the build tree. glslang writes a depfile, so editing an
-# included header (e.g. shaders/GaussianSplatContract.h) rebuilds the shaders using it.
+# included header (e.g. shaders/GaussianSplatProjectionContract.h) rebuilds the shaders using it.
 #
 # open3d_add_compute_shaders(<target>
 #     SOURCES <a.comp> ...             shader sources; file a_b.comp becomes symbol kAB

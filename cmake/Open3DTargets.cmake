@@ -4,7 +4,7 @@
 function(open3d_set_target_flags target)
   target_compile_options(${target} PRIVATE -Wall -Wextra -Werror)
   # No fused multiply-adds the source did not ask for: the CPU reference reproduces the
-  # shaders' float32 arithmetic (shaders/GaussianSplatSortDepth.h) only when every product
+  # shaders' float32 arithmetic (shaders/GaussianSplatShared.h) only when every product
   # and sum is rounded where the source says (GCC contracts by default where the target has FMA).
   target_compile_options(${target} PRIVATE -ffp-contract=off)
   if(OPEN3D_SANITIZE)
@@ -18,12 +18,16 @@ function(open3d_set_target_flags target)
   endif()
 endfunction()
 
-# open3d_add_library(name SOURCES ... DEPS ...): one library per layer.
+# open3d_add_library(name SOURCES ... DEPS ... SYSTEM_DEPS ... PRIVATE_DEPS ...): one library
+# per layer. DEPS and SYSTEM_DEPS are PUBLIC: the library's headers include theirs, so users
+# need their include paths too. PRIVATE_DEPS are used only by the library's .cpp files: users
+# get the link (a static library needs it) but not the include path, so a header that starts
+# including such a dependency fails to compile in the users instead of leaking it silently.
 function(open3d_add_library name)
-  cmake_parse_arguments(ARG "" "" "SOURCES;DEPS;SYSTEM_DEPS" ${ARGN})
+  cmake_parse_arguments(ARG "" "" "SOURCES;DEPS;SYSTEM_DEPS;PRIVATE_DEPS" ${ARGN})
   add_library(${name} STATIC ${ARG_SOURCES})
   target_include_directories(${name} PUBLIC ${CMAKE_SOURCE_DIR}/cpp)
-  target_link_libraries(${name} PUBLIC ${ARG_DEPS} ${ARG_SYSTEM_DEPS})
+  target_link_libraries(${name} PUBLIC ${ARG_DEPS} ${ARG_SYSTEM_DEPS} PRIVATE ${ARG_PRIVATE_DEPS})
   set_target_properties(${name} PROPERTIES POSITION_INDEPENDENT_CODE ON)
   open3d_set_target_flags(${name})
 endfunction()

@@ -22,7 +22,7 @@
 #extension GL_EXT_control_flow_attributes : require
 #extension GL_KHR_shader_subgroup_basic : require
 #extension GL_KHR_shader_subgroup_arithmetic : require
-#include "GaussianSplatContract.h"
+#include "GaussianSplatCompositeContract.h"
 
 layout(local_size_x = kCompositeWorkgroupSize) in;
 
@@ -74,9 +74,9 @@ shared uint s_done;
 // d = near / z_view (infinite far plane, cleared to 0), so z_view = near / d; d <= 0 (clear,
 // nothing drawn) means no geometry: +inf, which no splat depth exceeds.
 float SceneViewDepth(ivec2 pixel) {
-    int y = pc.entries.z != 0u ? int(pc.image.y) - 1 - pixel.y : pixel.y;
+    int y = pc.scene_depth_flip_y != 0u ? int(pc.height) - 1 - pixel.y : pixel.y;
     float d = texelFetch(scene_depth, ivec2(pixel.x, y), 0).r;
-    return d > 0.0 ? pc.scene_depth.x / d : uintBitsToFloat(0x7F800000u);
+    return d > 0.0 ? pc.scene_near / d : uintBitsToFloat(0x7F800000u);
 }
 
 // What one pixel has accumulated so far.
@@ -198,8 +198,8 @@ uint FirstIndex(uvec2 range, uint slot) {
 uint CompositeTile(uint tile, uvec2 range, uint next_index, uvec2 upcoming, uint slot,
                    uvec2 in_tile, uint block) {
     uint local = gl_LocalInvocationIndex;
-    uvec2 size = pc.image.xy;
-    uint tiles_x = pc.image.z;
+    uvec2 size = uvec2(pc.width, pc.height);
+    uint tiles_x = pc.tiles_x;
     uvec2 tile_origin = uvec2(tile % tiles_x, tile / tiles_x) * kCompositeTileSize;
     ivec2 pixel = ivec2(tile_origin + in_tile);
     bool inside = pixel.x < int(size.x) && pixel.y < int(size.y);
@@ -238,15 +238,15 @@ uint CompositeTile(uint tile, uvec2 range, uint next_index, uvec2 upcoming, uint
             if (entry + kCompositeBatchSize < end) {
                 next_index = entry_values[entry + kCompositeBatchSize];
             }
-            s_center_depth_opacity[slot] = splat.center_depth_opacity;
-            s_conic[slot] = splat.conic * vec4(-0.5 * kLog2E, -kLog2E, -0.5 * kLog2E,
-                                               -0.5 * kLog2E);
-            s_color[slot] = splat.color;
-            mask = CompositeBlockMask(splat.center_depth_opacity.x,
-                                      splat.center_depth_opacity.y, splat.conic.x,
-                                      splat.conic.y, splat.conic.z, splat.color.w,
-                                      splat.conic.w,
-                                      float(tile_origin.x), float(tile_origin.y));
+            s_center_depth_opacity[slot] =
+                vec4(splat.center_x, splat.center_y, splat.depth, splat.opacity);
+            s_conic[slot] = vec4(splat.conic, splat.cull_threshold) *
+                            vec4(-0.5 * kLog2E, -kLog2E, -0.5 * kLog2E, -0.5 * kLog2E);
+            s_color[slot] = vec4(splat.color, splat.det_q);
+            mask = CompositeBlockMask(splat.center_x, splat.center_y, splat.conic.x,
+                                      splat.conic.y, splat.conic.z, splat.det_q,
+                                      splat.cull_threshold, float(tile_origin.x),
+                                      float(tile_origin.y));
         }
         // Each block's list of the slots whose bit is set, in slot (depth) order: a
         // workgroup scan of the eight counters at once.
@@ -288,7 +288,7 @@ uint CompositeTile(uint tile, uvec2 range, uint next_index, uvec2 upcoming, uint
     if (inside) {
         float accumulated = 1.0 - p.transmittance;
         imageStore(out_color, pixel,
-                   vec4(p.color + p.transmittance * pc.background.rgb, accumulated));
+                   vec4(p.color + p.transmittance * pc.background, accumulated));
         if (kExpectedDepth) {
             imageStore(out_depth, pixel,
                        vec4(p.weight > 0.0 ? p.weighted_depth / p.weight : 0.0));
@@ -301,7 +301,7 @@ uint CompositeTile(uint tile, uvec2 range, uint next_index, uvec2 upcoming, uint
 
 void main() {
     uint local = gl_LocalInvocationIndex;
-    uint num_tiles = pc.image.z * pc.image.w;
+    uint num_tiles = pc.tiles_x * pc.tiles_y;
     // Workgroup i starts with tile i, then steals tiles num_workgroups, num_workgroups + 1...
     // from the counter: with as many workgroups as tiles (CPU devices) each does one tile.
     uint tile = gl_WorkGroupID.x;

@@ -8,7 +8,7 @@
 // faint haze need not hide what is behind it.
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_samplerless_texture_functions : require
-#include "GaussianSplatContract.h"
+#include "GaussianSplatCompositeContract.h"
 
 layout(local_size_x = kDepthMergeWorkgroupSize, local_size_y = kDepthMergeWorkgroupSize) in;
 
@@ -30,20 +30,20 @@ layout(set = 0, binding = kDepthMergeLinearBinding, r32f) writeonly uniform imag
 
 void main() {
     ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
-    if (pixel.x >= int(pc.image.x) || pixel.y >= int(pc.image.y)) return;
+    if (pixel.x >= int(pc.width) || pixel.y >= int(pc.height)) return;
     const float kInfinity = uintBitsToFloat(0x7F800000u);
 
     float z = kInfinity;
     float alpha = imageLoad(splat_alpha, pixel).r;
-    if (alpha > 0.0 && alpha >= pc.range.w) z = imageLoad(splat_depth, pixel).r;
+    if (alpha > 0.0 && alpha >= pc.min_alpha) z = imageLoad(splat_depth, pixel).r;
     if (kSceneDepth != 0u) {
         // Reversed-Z, infinite far plane, cleared to 0: z_view = near / d (as in the composite).
-        int y = pc.image.z != 0u ? int(pc.image.y) - 1 - pixel.y : pixel.y;
+        int y = pc.scene_depth_flip_y != 0u ? int(pc.height) - 1 - pixel.y : pixel.y;
         float d = texelFetch(scene_depth, ivec2(pixel.x, y), 0).r;
-        if (d > 0.0) z = min(z, pc.range.z / d);
+        if (d > 0.0) z = min(z, pc.scene_near / d);
     }
     bool found = z < kInfinity;
-    float normalized = clamp((z - pc.range.x) / (pc.range.y - pc.range.x), 0.0, 1.0);
+    float normalized = clamp((z - pc.near_plane) / (pc.far_plane - pc.near_plane), 0.0, 1.0);
     imageStore(out_linear, pixel, vec4(found ? z : 0.0));
     imageStore(out_normalized, pixel, uvec4(found ? uint(round(normalized * 65535.0)) : 65535u));
 }

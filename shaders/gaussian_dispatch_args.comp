@@ -7,7 +7,7 @@
 // the emitting splats are a prefix of the depth order: the first splat whose inclusive
 // offset passes the capacity is found by binary search and everything from it is dropped.
 #extension GL_GOOGLE_include_directive : require
-#include "GaussianSplatContract.h"
+#include "GaussianSplatTileListContract.h"
 
 layout(local_size_x = 1) in;
 
@@ -51,7 +51,7 @@ uint InclusiveOffset(uint k, uint visible, uint total) {
 void CountFittingEntries() {
     uint visible = counters.visible_count;
     uint total = counters.requested_entries;
-    uint capacity = view.limits.x;
+    uint capacity = view.entry_capacity;
     // Smallest k whose inclusive offset exceeds the capacity (visible when none does). When
     // everything fits, none does: the search (a chain of 23 dependent loads for the grid's
     // 5.1M splats, one invocation) is skipped.
@@ -70,7 +70,7 @@ void CountFittingEntries() {
     uint flags = 0u;
     if (entries < total) flags |= kErrorEntriesDropped;
     // The allocation, not RenderConfig::max_tile_entries_total, was the binding limit.
-    if (total > capacity && capacity < view.limits.z) flags |= kErrorCountsClamped;
+    if (total > capacity && capacity < view.max_tile_entries_total) flags |= kErrorCountsClamped;
     if (flags != 0u) atomicOr(counters.error_flags, flags);
     sort_params = RadixSortParamsFor(entries, pc.sort_max_count, pc.sort_target_blocks);
 }

@@ -10,7 +10,7 @@
 // key, sorted on all 32 bits; kEmitUnpackKeys then turns the sorted keys back into tile
 // indices, so later stages read the same layout in both modes.
 #extension GL_GOOGLE_include_directive : require
-#include "GaussianSplatContract.h"
+#include "GaussianSplatTileListContract.h"
 
 layout(local_size_x = kEmitWorkgroupSize) in;
 
@@ -42,7 +42,7 @@ layout(std430, set = 0, binding = kGeometryStageEntryValuesBinding) writeonly bu
 // Sorted packed keys -> tile indices. Dispatched with the emit pass's indirect size (one
 // invocation per visible splat, rounded up), so it strides over the entries.
 void UnpackKeys() {
-    uint depth_bits = kSortKeyBits - view.limits.w;
+    uint depth_bits = kSortKeyBits - view.tile_bits;
     uint count = counters.entry_count;
     uint stride = gl_NumWorkGroups.x * kEmitWorkgroupSize;
     for (uint i = gl_GlobalInvocationID.x; i < count; i += stride) {
@@ -60,36 +60,38 @@ void main() {
     if (k >= visible) return;
     uint begin = ScanOffset(k);
     uint end = k + 1u < visible ? ScanOffset(k + 1u) : counters.requested_entries;
-    if (end > view.limits.x || end == begin) return;
-    uint splat = ListValueSplat(splat_indices[k], view.scene.x);
-    uvec4 tiles = projected[splat].tiles;
-    uint min_x = tiles.x & 0xFFFFu, min_y = tiles.x >> 16u;
-    uint max_x = tiles.y & 0xFFFFu, max_y = tiles.y >> 16u;
-    uint tiles_x = view.image.z;
+    if (end > view.entry_capacity || end == begin) return;
+    uint splat = ListValueSplat(splat_indices[k], view.num_splats);
+    uint rect_min = projected[splat].rect_min, rect_max = projected[splat].rect_max;
+    uint min_x = rect_min & 0xFFFFu, min_y = rect_min >> 16u;
+    uint max_x = rect_max & 0xFFFFu, max_y = rect_max >> 16u;
+    uint tiles_x = view.tiles_x;
     // The same float32 view depth the exact order sorts by (the projection's output).
     float norm_depth = kEmitMode == kEmitPackedKeys
-                           ? PackedSortKeyDepth(projected[splat].center_depth_opacity.z,
-                                                view.clip.z, view.clip.w)
+                           ? PackedSortKeyDepth(projected[splat].depth,
+                                                view.near_plane, view.packed_depth_scale)
                            : 0.0;
-    uint tile_bits = view.limits.w;
+    uint tile_bits = view.tile_bits;
     // When the count equals the rectangle's area the projection kept every tile of it (a
     // row's span is at most its width): every row is whole, no span is recomputed and the
     // record's centre and conic, the other half of its 64 bytes, are not read. The grid's
     // splats mostly cover one or two tiles.
     bool whole_rect = end - begin == (max_x - min_x) * (max_y - min_y);
-    vec4 cdo = vec4(0.0);
-    vec4 conic = vec4(0.0);
+    vec2 center = vec2(0.0);
+    vec3 conic = vec3(0.0);
+    float cull_t = 0.0;
     float det_q = 0.0;
     if (!whole_rect) {
-        cdo = projected[splat].center_depth_opacity;
+        center = vec2(projected[splat].center_x, projected[splat].center_y);
         conic = projected[splat].conic;
-        det_q = projected[splat].color.w;
+        cull_t = projected[splat].cull_threshold;
+        det_q = projected[splat].det_q;
     }
     uint out_index = begin;
     for (uint ty = min_y; ty < max_y && out_index < end; ++ty) {
         uint span = whole_rect ? min_x | (max_x << 16u)
-                               : TileRowSpan(cdo.x, cdo.y, conic.x, conic.y, conic.z, det_q,
-                                             conic.w, ty, min_x, max_x);
+                               : TileRowSpan(center.x, center.y, conic.x, conic.y, conic.z,
+                                             det_q, cull_t, ty, min_x, max_x);
         uint last = min(span >> 16u, (span & 0xFFFFu) + (end - out_index));
         for (uint tx = span & 0xFFFFu; tx < last; ++tx) {
             uint tile = ty * tiles_x + tx;

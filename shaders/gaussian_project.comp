@@ -10,7 +10,7 @@
 #extension GL_KHR_shader_subgroup_arithmetic : require
 #extension GL_KHR_shader_subgroup_ballot : require
 #extension GL_EXT_control_flow_attributes : require
-#include "GaussianSplatContract.h"
+#include "GaussianSplatTileListContract.h"
 
 layout(local_size_x = kProjectWorkgroupSize) in;
 
@@ -99,7 +99,7 @@ float ShapeValue(uint i, uint k) {
 // SH rest coefficient j (1-based basis index), channel c of splat i; layout [Nc, 3].
 float ShValue(uint i, uint j, uint c) {
     uint k = (j - 1u) * 3u + c;
-    uint base = i * view.scene.w;
+    uint base = i * view.sh_words_per_splat;
     if (kPrecision == kPrecisionCompact) return HalfAt(base, k, true);
     return uintBitsToFloat(sh[base + k]);
 }
@@ -132,7 +132,7 @@ const uint kShVec4Layout = uint(kPrecision == kPrecisionExact) * uint(kShWords %
 vec3 ShColor(uint i, vec3 relative) {
     vec3 dc = vec3(ShapeValue(i, 7u), ShapeValue(i, 8u), ShapeValue(i, 9u));
     bool vec4_path = kShVec4Layout != 0u;
-    if (view.scene.w != kShWords) vec4_path = false;  // packed at another degree
+    if (view.sh_words_per_splat != kShWords) vec4_path = false;  // packed at another degree
     vec3 rgb = kSH_C0 * dc;
     if (kShDegree >= 1u) {
         vec3 d = normalize(relative);
@@ -196,37 +196,34 @@ bool Project(uint i, out float depth, out uint entries) {
     if ((visibility[i >> 5u] & (1u << (i & 31u))) == 0u) return false;
     vec4 position_opacity = positions[i];
     vec3 p = position_opacity.xyz;
-    // Camera-relative (p - c_hi) - c_lo: precise 1e5 from the origin too (contract header).
-    vec3 c_hi = view.camera_center.xyz;
-    vec3 c_lo = vec3(view.world_to_camera_row0.w, view.world_to_camera_row1.w,
-                     view.world_to_camera_row2.w);
+    // Camera-relative (p - c_hi) - c_lo: precise 1e5 from the origin too (GaussianSplatShared.h).
+    vec3 c_hi = view.center_high;
+    vec3 c_lo = vec3(view.center_low_x, view.center_low_y, view.center_low_z);
     vec3 rel = vec3(CameraRelative(p.x, c_hi.x, c_lo.x), CameraRelative(p.y, c_hi.y, c_lo.y),
                     CameraRelative(p.z, c_hi.z, c_lo.z));
-    vec3 r2 = view.world_to_camera_row2.xyz;
+    vec3 r2 = view.rotation_row2;
     // The camera-relative view z: the projection, the composite's depth and depth images.
     float view_z = SortDepth(r2.x, r2.y, r2.z, rel.x, rel.y, rel.z);
     // The depth that orders the splat and culls it at the near plane, bit for bit the CPU
-    // reference's: the original rasterizer's float32 z by default (GaussianSplatSortDepth.h).
+    // reference's: the original rasterizer's float32 z by default (GaussianSplatShared.h).
     float order_depth = view_z;
-    if (view.depth_order.x == kDepthOrderReference) {
-        vec4 m = view.reference_depth_row;
-        order_depth = ReferenceViewDepth(m.x, m.y, m.z, m.w, p.x, p.y, p.z);
+    if (view.depth_order == kDepthOrderReference) {
+        order_depth = ReferenceViewDepth(view.reference_m2, view.reference_m6, view.reference_m10,
+                                         view.reference_m14, p.x, p.y, p.z);
     }
-    if (!(order_depth > view.clip.z)) return false;  // near plane (also NaN)
+    if (!(order_depth > view.near_plane)) return false;  // near plane (also NaN)
     LoadShape(i);
-    vec3 v = vec3(dot(view.world_to_camera_row0.xyz, rel), dot(view.world_to_camera_row1.xyz, rel),
-                  view_z);
-    float fx = view.intrinsics.x, fy = view.intrinsics.y;
-    float px = fx * v.x / v.z + view.intrinsics.z;
-    float py = fy * v.y / v.z + view.intrinsics.w;
+    vec3 v = vec3(dot(view.rotation_row0, rel), dot(view.rotation_row1, rel), view_z);
+    float fx = view.fx, fy = view.fy;
+    float px = fx * v.x / v.z + view.cx;
+    float py = fy * v.y / v.z + view.cy;
 
     // Jacobian at the guard-band clamped position (keeps off-screen footprints bounded).
-    float tx = clamp(v.x / v.z, -view.clip.x, view.clip.x) * v.z;
-    float ty = clamp(v.y / v.z, -view.clip.y, view.clip.y) * v.z;
+    float tx = clamp(v.x / v.z, -view.guard_x, view.guard_x) * v.z;
+    float ty = clamp(v.y / v.z, -view.guard_y, view.guard_y) * v.z;
     float z2 = v.z * v.z;
     // Rows of J (2x3) times W (the world-to-camera rotation): T = J W.
-    vec3 w0 = view.world_to_camera_row0.xyz, w1 = view.world_to_camera_row1.xyz,
-         w2 = view.world_to_camera_row2.xyz;
+    vec3 w0 = view.rotation_row0, w1 = view.rotation_row1, w2 = view.rotation_row2;
     vec3 t0 = (fx / v.z) * w0 + (-fx * tx / z2) * w2;
     vec3 t1 = (fy / v.z) * w1 + (-fy * ty / z2) * w2;
     vec3 scale = vec3(ShapeValue(i, 0u), ShapeValue(i, 1u), ShapeValue(i, 2u));
@@ -256,7 +253,7 @@ bool Project(uint i, out float depth, out uint entries) {
     // Clamped before the conversion, which is undefined past 2^32 (kMaxSplatRadius).
     uint radius = uint(min(ceil(3.0 * sqrt(lambda1)), float(kMaxSplatRadius)));
 
-    uint tiles_x = view.image.z, tiles_y = view.image.w;
+    uint tiles_x = view.tiles_x, tiles_y = view.tiles_y;
     float r = float(radius);
     uvec2 rect_min = uvec2(TileBound(px - r, tiles_x), TileBound(py - r, tiles_y));
     uvec2 rect_max = uvec2(TileBound(px + r + float(kGaussianTileSize - 1u), tiles_x),
@@ -276,11 +273,18 @@ bool Project(uint i, out float depth, out uint entries) {
 
     vec3 color = ShColor(i, rel);
     GaussianProjectedSplat out_splat;
-    out_splat.center_depth_opacity = vec4(px, py, view_z, opacity);
-    out_splat.conic = vec4(conic, cull_t);
-    out_splat.color = vec4(color, det_q);
-    out_splat.tiles = uvec4(rect_min.x | (rect_min.y << 16u), rect_max.x | (rect_max.y << 16u),
-                            num_tiles, radius);
+    out_splat.center_x = px;
+    out_splat.center_y = py;
+    out_splat.depth = view_z;
+    out_splat.opacity = opacity;
+    out_splat.conic = conic;
+    out_splat.cull_threshold = cull_t;
+    out_splat.color = color;
+    out_splat.det_q = det_q;
+    out_splat.rect_min = rect_min.x | (rect_min.y << 16u);
+    out_splat.rect_max = rect_max.x | (rect_max.y << 16u);
+    out_splat.num_entries = num_tiles;
+    out_splat.radius = radius;
     projected[i] = out_splat;
     tile_counts[i] = num_tiles;
     depth = order_depth;
@@ -292,8 +296,8 @@ void main() {
     uint i = gl_GlobalInvocationID.x;
     float depth = 0.0;
     uint entries = 0u;
-    bool visible = i < view.scene.x && Project(i, depth, entries);
-    uint value = PackListValue(i, entries, view.scene.x);
+    bool visible = i < view.num_splats && Project(i, depth, entries);
+    uint value = PackListValue(i, entries, view.num_splats);
 
     // One atomicAdd per subgroup reserves the slots of all its visible splats.
     uint flag = visible ? 1u : 0u;
@@ -306,7 +310,7 @@ void main() {
     base = subgroupBroadcastFirst(base);
     if (kIndexedList != 0u) {
         // Slot i = splat i; hidden or culled splats get the largest key and sort last.
-        if (i < view.scene.x) {
+        if (i < view.num_splats) {
             depth_keys[i] = visible ? floatBitsToUint(depth) : 0xFFFFFFFFu;
             splat_indices[i] = value;
         }

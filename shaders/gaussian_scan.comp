@@ -9,7 +9,7 @@
 // (splats over max_tiles_per_splat count 0 and flag; slots past visible_count, which the
 // exact order also scans, count 0).
 #extension GL_GOOGLE_include_directive : require
-#include "GaussianSplatContract.h"
+#include "GaussianSplatTileListContract.h"
 
 layout(local_size_x = kScanWorkgroupSize) in;
 
@@ -45,11 +45,11 @@ uint LoadCount(uint index) {
     // (the depth sort dropped the culled splats), which count nothing.
     if (index >= counters.visible_count) return 0u;
     uint value = splat_indices[index];
-    uint count = ListValueCount(value, view.scene.x);
-    if (count == ListCountSentinel(view.scene.x)) {
-        count = tile_counts[ListValueSplat(value, view.scene.x)];
+    uint count = ListValueCount(value, view.num_splats);
+    if (count == ListCountSentinel(view.num_splats)) {
+        count = tile_counts[ListValueSplat(value, view.num_splats)];
     }
-    if (count > view.limits.y) {  // over max_tiles_per_splat: the splat emits nothing
+    if (count > view.max_tiles_per_splat) {  // over max_tiles_per_splat: the splat emits nothing
         atomicOr(counters.error_flags, kErrorEntriesDropped);
         return 0u;
     }

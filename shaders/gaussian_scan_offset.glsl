@@ -15,7 +15,7 @@ uint SatAdd(uint a, uint b) {
 
 // Exclusive offset of list slot k (k below the scanned count).
 uint ScanOffset(uint k) {
-    uint count = max(view.scene.x, 1u);  // level 0's size, N
+    uint count = max(view.num_splats, 1u);  // level 0's size, N
     uint offset = scan[k];
     uint base = 0u;
     for (uint level = 1u; level < kScanMaxLevels && count > kScanBlockSize; ++level) {

@@ -7,7 +7,7 @@
 // capacity, the count is only known on the GPU.
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_control_flow_attributes : require
-#include "GaussianSplatContract.h"
+#include "GaussianSplatCompositeContract.h"
 
 layout(local_size_x = kCompositeWorkgroupSize) in;
 
@@ -31,8 +31,8 @@ layout(std430, set = 0, binding = kCompositeStateBinding) writeonly buffer State
 const uint kRangeItems = 4u;
 
 void main() {
-    uint count = min(counts[pc.entries.x], pc.entries.y);
-    uint num_tiles = pc.image.z * pc.image.w;
+    uint count = min(counts[pc.count_index], pc.entry_capacity);
+    uint num_tiles = pc.tiles_x * pc.tiles_y;
     uint stride = gl_NumWorkGroups.x * kCompositeWorkgroupSize;
     for (uint first = gl_GlobalInvocationID.x; first < count; first += kRangeItems * stride) {
         uint keys[kRangeItems];

@@ -7,7 +7,7 @@
 #extension GL_KHR_shader_subgroup_basic : require
 #extension GL_KHR_shader_subgroup_arithmetic : require
 
-#include "GaussianSplatContract.h"
+#include "GaussianSplatRadixSortContract.h"
 
 layout(push_constant, std430) uniform PushConstantsBlock {
     RadixSortPushConstants pc;

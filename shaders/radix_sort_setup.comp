@@ -1,7 +1,7 @@
 #version 460
 // Reads the element count written on the GPU by the producer, clamps it to max_count,
 // chooses the block size and writes the indirect dispatch size of the per-block passes (no
-// CPU readback): RadixSortParamsFor in the contract header. RadixSort::GetStorageRequirements
+// CPU readback): RadixSortParamsFor in GaussianSplatRadixSortContract.h. RadixSort::GetStorageRequirements
 // bounds the block count the same way.
 // With PassCount::kFromKeyRange (the setup after the first pass): the kept keys' (min, max),
 // which the first pass's histogram found, decide how many passes are needed. Keys are

@@ -182,15 +182,8 @@ double PackedSortKeyFar(const camera::PinholeCamera& camera, double near_plane,
 
 CameraCenterSplit SplitCameraCenter(const camera::PinholeCamera& camera) {
     const Eigen::Vector3d c = camera.GetCenter();
-    CameraCenterSplit split;
-    for (int i = 0; i < 3; ++i) {
-        // volatile: GCC 12.2 -O2 folds c - double(float(c)) to 0 in this loop for i = 1, 2
-        // (reproduced in isolation), losing the low part.
-        volatile float high = static_cast<float>(c[i]);
-        split.high[i] = high;
-        split.low[i] = static_cast<float>(c[i] - double(high));
-    }
-    return split;
+    const double center[3] = {c.x(), c.y(), c.z()};
+    return shader::SplitCameraCenter(center);
 }
 
 ReferenceDepthRow GetReferenceDepthRow(const camera::PinholeCamera& camera) {
@@ -200,18 +193,13 @@ ReferenceDepthRow GetReferenceDepthRow(const camera::PinholeCamera& camera) {
     return {float(r(2, 0)), float(r(2, 1)), float(r(2, 2)), float(t.z())};
 }
 
-bool UsesPackedSortKey(const shader::GaussianViewParams& params) { return params.clip.w > 0.0f; }
+bool UsesPackedSortKey(const RenderConfig& config) {
+    return config.sort_mode == SortMode::kPackedKey32;
+}
 
-shader::GaussianViewParams PackGaussianViewParams(const camera::PinholeCamera& camera,
-                                                  const RenderConfig& config,
-                                                  const ViewPackingInputs& inputs) {
-    camera.Validate();
-    const Eigen::Matrix3d r = camera.GetRotation();
-    // The camera centre as float32 c_hi plus its rounding error c_lo (shader::CameraRelative).
-    const CameraCenterSplit center = SplitCameraCenter(camera);
-    auto row = [&](int i) {
-        return shader::vec4{float(r(i, 0)), float(r(i, 1)), float(r(i, 2)), center.low[i]};
-    };
+GeometryStageChoices ChooseGeometryStage(const camera::PinholeCamera& camera,
+                                         const RenderConfig& config,
+                                         const ViewPackingInputs& inputs) {
     const cpu::TileGrid grid = cpu::TileGrid::ForImage(camera.width, camera.height);
     if (grid.tiles_x > 0xFFFF || grid.tiles_y > 0xFFFF) {
         core::ThrowError("PackGaussianViewParams: {}x{} tiles, at most 65535 per axis",
@@ -221,44 +209,83 @@ shader::GaussianViewParams PackGaussianViewParams(const camera::PinholeCamera& c
     const uint64_t saturation = shader::kScanSaturation;
     const uint32_t config_limit =
         static_cast<uint32_t>(std::min<uint64_t>(config.max_tile_entries_total, saturation - 1));
-    const uint32_t capacity = std::min(config_limit, inputs.entry_capacity);
-    const uint32_t words = inputs.precision == SplatPrecision::kExact ? shader::kShapeWordsExact
-                                                                      : shader::kShapeWordsCompact;
+    GeometryStageChoices choices;
+    choices.num_splats = uint32_t(inputs.num_splats);
+    choices.sh_degree = uint32_t(EvaluatedShDegree(config, inputs.packed_sh_degree));
+    choices.antialias = config.antialias;
+    choices.packed_key = UsesPackedSortKey(config);
+    choices.tile_bits = SortKeyTileBits(static_cast<uint64_t>(grid.NumTiles()));
+    choices.entry_capacity = std::min(config_limit, inputs.entry_capacity);
+    choices.entry_capacity_allocated = inputs.entry_capacity;
+    return choices;
+}
+
+PackedView PackGaussianView(const camera::PinholeCamera& camera, const RenderConfig& config,
+                            const ViewPackingInputs& inputs) {
+    camera.Validate();
+    const GeometryStageChoices choices = ChooseGeometryStage(camera, config, inputs);
+    const Eigen::Matrix3d r = camera.GetRotation();
+    // The camera centre as float32 c_hi plus its rounding error c_lo (shader::CameraRelative).
+    const CameraCenterSplit center = SplitCameraCenter(camera);
+    auto row = [&](int i) { return shader::vec3{float(r(i, 0)), float(r(i, 1)), float(r(i, 2))}; };
+    const uint64_t saturation = shader::kScanSaturation;
 
     shader::GaussianViewParams p{};
-    p.world_to_camera_row0 = row(0);
-    p.world_to_camera_row1 = row(1);
-    p.world_to_camera_row2 = row(2);
-    p.camera_center = {center.high[0], center.high[1], center.high[2], 0.0f};
-    p.intrinsics = {float(camera.fx), float(camera.fy), float(camera.cx), float(camera.cy)};
-    // clip.w > 0 selects the packed key: its depth scale, kept finite for a tiny range.
-    float depth_scale = 0.0f;
-    if (config.sort_mode == SortMode::kPackedKey32) {
+    p.rotation_row0 = row(0);
+    p.rotation_row1 = row(1);
+    p.rotation_row2 = row(2);
+    p.center_low_x = center.low[0];
+    p.center_low_y = center.low[1];
+    p.center_low_z = center.low[2];
+    p.center_high = {center.high[0], center.high[1], center.high[2]};
+    p.fx = float(camera.fx);
+    p.fy = float(camera.fy);
+    p.cx = float(camera.cx);
+    p.cy = float(camera.cy);
+    p.guard_x = float(1.3 * camera.GetTanHalfFovX());
+    p.guard_y = float(1.3 * camera.GetTanHalfFovY());
+    p.near_plane = float(config.near_plane);
+    // A positive scale is the packed key's, kept finite for a tiny depth range.
+    if (choices.packed_key) {
         const double far =
             PackedSortKeyFar(camera, config.near_plane, inputs.center_min, inputs.center_max);
-        depth_scale = static_cast<float>(
+        p.packed_depth_scale = static_cast<float>(
             std::min<double>(1.0 / (far - config.near_plane), std::numeric_limits<float>::max()));
     }
-    p.clip = {float(1.3 * camera.GetTanHalfFovX()), float(1.3 * camera.GetTanHalfFovY()),
-              float(config.near_plane), depth_scale};
-    p.image = {uint32_t(camera.width), uint32_t(camera.height), uint32_t(grid.tiles_x),
-               uint32_t(grid.tiles_y)};
-    p.limits = {capacity, config.max_tiles_per_splat, config_limit,
-                SortKeyTileBits(static_cast<uint64_t>(grid.NumTiles()))};
-    p.scene = {uint32_t(inputs.num_splats),
-               uint32_t(EvaluatedShDegree(config, inputs.packed_sh_degree)),
-               config.antialias ? 1u : 0u, inputs.sh_words_per_splat};
-    p.flags = {inputs.scene_depth_present ? 1u : 0u,
-               inputs.precision == SplatPrecision::kExact ? shader::kPrecisionExact
-                                                          : shader::kPrecisionCompact,
-               words, inputs.entry_capacity};
+    const cpu::TileGrid grid = cpu::TileGrid::ForImage(camera.width, camera.height);
+    p.width = uint32_t(camera.width);
+    p.height = uint32_t(camera.height);
+    p.tiles_x = uint32_t(grid.tiles_x);
+    p.tiles_y = uint32_t(grid.tiles_y);
+    p.entry_capacity = choices.entry_capacity;
+    p.max_tiles_per_splat = config.max_tiles_per_splat;
+    p.max_tile_entries_total =
+        static_cast<uint32_t>(std::min<uint64_t>(config.max_tile_entries_total, saturation - 1));
+    p.tile_bits = choices.tile_bits;
+    p.num_splats = choices.num_splats;
+    p.sh_degree = choices.sh_degree;
+    p.antialias = choices.antialias ? 1u : 0u;
+    p.sh_words_per_splat = inputs.sh_words_per_splat;
+    p.scene_depth_present = inputs.scene_depth_present ? 1u : 0u;
+    const bool exact = inputs.precision == SplatPrecision::kExact;
+    p.splat_precision = exact ? shader::kPrecisionExact : shader::kPrecisionCompact;
+    p.shape_words_per_splat = exact ? shader::kShapeWordsExact : shader::kShapeWordsCompact;
+    p.entry_capacity_allocated = choices.entry_capacity_allocated;
     const ReferenceDepthRow m = GetReferenceDepthRow(camera);
-    p.reference_depth_row = {m.m2, m.m6, m.m10, m.m14};
-    p.depth_order = {config.depth_order == DepthOrder::kReference
-                         ? shader::kDepthOrderReference
-                         : shader::kDepthOrderCameraRelative,
-                     0u, 0u, 0u};
-    return p;
+    p.reference_m2 = m.m2;
+    p.reference_m6 = m.m6;
+    p.reference_m10 = m.m10;
+    p.reference_m14 = m.m14;
+    p.depth_order = config.depth_order == DepthOrder::kReference
+                        ? shader::kDepthOrderReference
+                        : shader::kDepthOrderCameraRelative;
+    return {p, choices};
+}
+
+shader::GaussianViewParams PackGaussianViewParams(const camera::PinholeCamera& camera,
+                                                  const RenderConfig& config,
+                                                  const ViewPackingInputs& inputs) {
+    return PackGaussianView(camera, config, inputs).params;
 }
 
 }  // namespace rendering

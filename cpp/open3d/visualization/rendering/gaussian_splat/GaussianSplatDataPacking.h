@@ -1,7 +1,7 @@
 // CPU-side packing of what the GPU projection reads (docs/vulkan.md "Geometry stage"): per-splat
 // attribute buffers from a Gaussian splat cloud (once per scene change) and the per-frame
-// GaussianViewParams. No Vulkan here: the layouts are the contract header's, so the CPU,
-// Vulkan and Metal layers all pack the same bytes.
+// GaussianViewParams. No Vulkan here: the layouts are GaussianSplatProjectionContract.h's, so the
+// CPU, Vulkan and Metal layers all pack the same bytes.
 #pragma once
 
 #include <Eigen/Core>
@@ -9,10 +9,10 @@
 #include <limits>
 #include <vector>
 
+#include "GaussianSplatTileListContract.h"
 #include "open3d/camera/PinholeCamera.h"
 #include "open3d/t/geometry/PointCloud.h"
 #include "open3d/visualization/rendering/gaussian_splat/RenderConfig.h"
-#include "shaders/GaussianSplatContract.h"
 
 namespace open3d {
 namespace visualization {
@@ -75,12 +75,36 @@ struct ViewPackingInputs {
     Eigen::Vector3d center_max = -center_min;
 };
 
+/// What the host decides for one frame's geometry stage, from its own camera, config and
+/// scene: the pipelines and passes are picked from these values, never read back out of the
+/// packed GaussianViewParams (which PackGaussianView fills from the same values).
+struct GeometryStageChoices {
+    uint32_t num_splats = 0;
+    uint32_t sh_degree = 0;  ///< evaluated: EvaluatedShDegree
+    bool antialias = false;
+    bool packed_key = false;  ///< config.sort_mode == kPackedKey32
+    uint32_t tile_bits = 0;   ///< SortKeyTileBits of the frame's tile count
+    /// Tile entries used: min(allocated, max_tile_entries_total), below shader::kScanSaturation.
+    uint32_t entry_capacity = 0;
+    uint32_t entry_capacity_allocated = 0;  ///< ViewPackingInputs::entry_capacity
+};
+GeometryStageChoices ChooseGeometryStage(const camera::PinholeCamera& camera,
+                                         const RenderConfig& config,
+                                         const ViewPackingInputs& inputs);
+
+/// One frame's view parameters for the GPU and the host choices they were packed from.
+struct PackedView {
+    shader::GaussianViewParams params;
+    GeometryStageChoices choices;
+};
+
 /// The per-frame view parameters: world-to-camera rows, intrinsics, guard band
 /// 1.3 tan(fov / 2) with tan(fov_x / 2) = W / (2 fx), near plane, image and tile grid,
-/// capacity limits (the entry limit is min(allocation, max_tile_entries_total), kept below
-/// shader::kScanSaturation), tile bits, SH degree evaluated = min(config, packed).
-/// config.sort_mode == kPackedKey32 sets clip.w = 1 / (far - near) with far from
-/// PackedSortKeyFar (a positive value selects the packed key); kExact leaves clip.w = 0.
+/// the choices of ChooseGeometryStage. config.sort_mode == kPackedKey32 sets
+/// packed_depth_scale = 1 / (far - near) with far from PackedSortKeyFar; kExact leaves 0.
+PackedView PackGaussianView(const camera::PinholeCamera& camera, const RenderConfig& config,
+                            const ViewPackingInputs& inputs);
+/// PackGaussianView(...).params.
 shader::GaussianViewParams PackGaussianViewParams(const camera::PinholeCamera& camera,
                                                   const RenderConfig& config,
                                                   const ViewPackingInputs& inputs);
@@ -99,25 +123,18 @@ uint32_t SortKeyTileBits(uint64_t num_tiles);
 double PackedSortKeyFar(const camera::PinholeCamera& camera, double near_plane,
                         const Eigen::Vector3d& center_min, const Eigen::Vector3d& center_max);
 
-/// The camera centre c as float32 `high` = float(c) plus `low` = float(c - high): the
-/// projection works on (p - high) - low (shader::CameraRelative), so a scene far from the
-/// origin keeps its precision. The CPU reference's sort depth uses the same split.
-struct CameraCenterSplit {
-    float high[3] = {0.f, 0.f, 0.f};
-    float low[3] = {0.f, 0.f, 0.f};
-};
+/// The camera centre as float32 high + low (shader::SplitCameraCenter, GaussianSplatShared.h):
+/// the projection works on (p - high) - low (shader::CameraRelative).
+using CameraCenterSplit = shader::CameraCenterSplit;
 CameraCenterSplit SplitCameraCenter(const camera::PinholeCamera& camera);
 
-/// Row 2 of the world-to-view matrix [R | t] as the original rasterizer receives it (each
-/// entry rounded to float32): m2, m6, m10, m14 of shader::ReferenceViewDepth, for the GPU's
-/// GaussianViewParams::reference_depth_row and the CPU reference alike.
-struct ReferenceDepthRow {
-    float m2 = 0.f, m6 = 0.f, m10 = 0.f, m14 = 0.f;
-};
+/// Row 2 of the world-to-view matrix [R | t] as the original rasterizer receives it
+/// (shader::ReferenceDepthRow): GaussianViewParams::reference_m2 .. reference_m14.
+using ReferenceDepthRow = shader::ReferenceDepthRow;
 ReferenceDepthRow GetReferenceDepthRow(const camera::PinholeCamera& camera);
 
-/// True when `params` select the packed 32-bit key (clip.w > 0), false for exact order.
-bool UsesPackedSortKey(const shader::GaussianViewParams& params);
+/// True when `config` selects the packed 32-bit key, false for exact order.
+bool UsesPackedSortKey(const RenderConfig& config);
 
 /// IEEE half from float, round to nearest even (overflow to inf, NaN kept).
 uint16_t FloatToHalf(float value);

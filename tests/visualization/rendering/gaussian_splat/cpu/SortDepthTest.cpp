@@ -1,4 +1,4 @@
-// The depths that order splats (shaders/GaussianSplatSortDepth.h): the fused multiply-add
+// The depths that order splats (shaders/GaussianSplatShared.h): the fused multiply-add
 // built from plain float operations against the C library's fmaf, the original rasterizer's
 // view z against hand-computed float32 values, and the order the CPU reference gives two
 // splats closer than one float32 step.
@@ -11,10 +11,10 @@
 #include <random>
 #include <vector>
 
+#include "GaussianSplatShared.h"
 #include "open3d/visualization/rendering/gaussian_splat/GaussianSplatDataPacking.h"
 #include "open3d/visualization/rendering/gaussian_splat/cpu/Projection.h"
 #include "open3d/visualization/rendering/gaussian_splat/cpu/TileLists.h"
-#include "shaders/GaussianSplatContract.h"
 #include "visualization/rendering/gaussian_splat/cpu/SplatTestScene.h"
 
 namespace open3d {

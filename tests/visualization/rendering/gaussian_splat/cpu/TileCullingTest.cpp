@@ -9,6 +9,7 @@
 #include <cstring>
 #include <random>
 
+#include "GaussianSplatCompositeContract.h"
 #include "SplatTestScene.h"
 #include "TestUtility.h"
 #include "open3d/camera/CamerasJson.h"
@@ -17,7 +18,6 @@
 #include "open3d/visualization/rendering/gaussian_splat/cpu/Composite.h"
 #include "open3d/visualization/rendering/gaussian_splat/cpu/Projection.h"
 #include "open3d/visualization/rendering/gaussian_splat/cpu/TileLists.h"
-#include "shaders/GaussianSplatContract.h"
 
 namespace open3d {
 namespace tests {

@@ -12,7 +12,7 @@
 #include "open3d/visualization/rendering/gaussian_splat/cpu/Composite.h"
 #include "open3d/visualization/rendering/gaussian_splat/cpu/Projection.h"
 #include "open3d/visualization/rendering/gaussian_splat/cpu/TileLists.h"
-#include "open3d/visualization/rendering/gaussian_splat/vulkan/GaussianCompositeStageRunner.h"
+#include "visualization/rendering/gaussian_splat/vulkan/support/GaussianCompositeStageRunner.h"
 
 namespace open3d {
 namespace tests {
@@ -32,16 +32,21 @@ inline gpu::CompositeStageRunInputs ToCompositeStageInputs(
         const rendering::cpu::ProjectedSplat& s = splats[i];
         if (!s.IsVisible()) continue;
         rendering::shader::GaussianProjectedSplat& p = in.projected[i];
-        p.center_depth_opacity = {float(s.x), float(s.y), float(s.depth), float(s.opacity)};
-        // w: the culling threshold and det_q, as the projection stores them (the composite
+        p.center_x = float(s.x);
+        p.center_y = float(s.y);
+        p.depth = float(s.depth);
+        p.opacity = float(s.opacity);
+        p.conic = {float(s.conic_a), float(s.conic_b), float(s.conic_c)};
+        // The culling threshold and det_q, as the projection stores them (the composite
         // skips pixels past the threshold).
-        p.conic = {float(s.conic_a), float(s.conic_b), float(s.conic_c),
-                   rendering::shader::TileCullThreshold(float(s.opacity), float(s.conic_a),
-                                                        float(s.conic_c), float(s.det_q))};
-        p.color = {float(s.color[0]), float(s.color[1]), float(s.color[2]), float(s.det_q)};
-        p.tiles = {uint32_t(s.rect_min_x) | uint32_t(s.rect_min_y) << 16,
-                   uint32_t(s.rect_max_x) | uint32_t(s.rect_max_y) << 16, uint32_t(s.NumTiles()),
-                   uint32_t(s.radius)};
+        p.cull_threshold = rendering::shader::TileCullThreshold(float(s.opacity), float(s.conic_a),
+                                                                float(s.conic_c), float(s.det_q));
+        p.color = {float(s.color[0]), float(s.color[1]), float(s.color[2])};
+        p.det_q = float(s.det_q);
+        p.rect_min = uint32_t(s.rect_min_x) | uint32_t(s.rect_min_y) << 16;
+        p.rect_max = uint32_t(s.rect_max_x) | uint32_t(s.rect_max_y) << 16;
+        p.num_entries = uint32_t(s.NumTiles());
+        p.radius = uint32_t(s.radius);
     }
     for (int64_t tile = 0; tile + 1 < static_cast<int64_t>(lists.offsets.size()); ++tile) {
         for (uint64_t k = lists.offsets[tile]; k < lists.offsets[tile + 1]; ++k) {

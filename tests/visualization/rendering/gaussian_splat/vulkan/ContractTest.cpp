@@ -1,14 +1,15 @@
-// The contract header compiles as C++ (its static_asserts hold) and the GLSL side lays
+// The contract headers compile as C++ (their static_asserts hold) and the GLSL side lays
 // the mirrored structs out at the offsets the C++ side asserts.
 #include <gtest/gtest.h>
 
 #include <cstring>
 
+#include "GaussianSplatCompositeContract.h"
+#include "GaussianSplatTileListContract.h"
 #include "VulkanTestFixture.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/Buffer.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/ComputePipeline.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/RadixSort.h"
-#include "shaders/GaussianSplatContract.h"
 #include "vulkan_test_shaders/TestShaders.h"
 
 namespace open3d {
@@ -62,7 +63,8 @@ TEST(GaussianSplatContract, ListValuesCarryTheSplatAndItsEntryCount) {
 using GaussianSplatContractGpu = VulkanTest;
 
 TEST_F(GaussianSplatContractGpu, ShaderLayoutMatchesCpp) {
-    UniqueDescriptorSetLayout set_layout = CreateStorageBufferPushLayout(Context(), 2);
+    constexpr uint32_t kBindings = 6;
+    UniqueDescriptorSetLayout set_layout = CreateStorageBufferPushLayout(Context(), kBindings);
     UniquePipelineLayout layout =
         CreatePipelineLayout(Context(), set_layout.Get(), sizeof(shader::RadixSortPushConstants));
     UniquePipeline pipeline =
@@ -71,6 +73,14 @@ TEST_F(GaussianSplatContractGpu, ShaderLayoutMatchesCpp) {
                   MemoryUsage::kHostReadback);
     Buffer push_out(Context(), sizeof(shader::RadixSortPushConstants),
                     VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, MemoryUsage::kHostReadback);
+    const auto readback = [&](VkDeviceSize size) {
+        return Buffer(Context(), size, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
+                      MemoryUsage::kHostReadback);
+    };
+    Buffer view_out = readback(sizeof(shader::GaussianViewParams));
+    Buffer splat_out = readback(sizeof(shader::GaussianProjectedSplat));
+    Buffer composite_out = readback(sizeof(shader::GaussianCompositePushConstants));
+    Buffer merge_out = readback(sizeof(shader::GaussianDepthMergePushConstants));
     shader::RadixSortPushConstants push{};
     push.shift = 201;
     push.digit_bits = 202;
@@ -82,18 +92,20 @@ TEST_F(GaussianSplatContractGpu, ShaderLayoutMatchesCpp) {
     push.num_passes = 208;
     push.values_only = 209;
     SubmitAndWait(Context(), Pool(), [&](VkCommandBuffer cmd) {
-        VkDescriptorBufferInfo infos[2] = {{params.Get(), 0, VK_WHOLE_SIZE},
-                                           {push_out.Get(), 0, VK_WHOLE_SIZE}};
-        VkWriteDescriptorSet writes[2] = {};
-        for (uint32_t i = 0; i < 2; ++i) {
+        VkDescriptorBufferInfo infos[kBindings] = {
+            {params.Get(), 0, VK_WHOLE_SIZE},        {push_out.Get(), 0, VK_WHOLE_SIZE},
+            {view_out.Get(), 0, VK_WHOLE_SIZE},      {splat_out.Get(), 0, VK_WHOLE_SIZE},
+            {composite_out.Get(), 0, VK_WHOLE_SIZE}, {merge_out.Get(), 0, VK_WHOLE_SIZE}};
+        VkWriteDescriptorSet writes[kBindings] = {};
+        for (uint32_t i = 0; i < kBindings; ++i) {
             writes[i].sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET;
             writes[i].dstBinding = i;
             writes[i].descriptorCount = 1;
             writes[i].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
             writes[i].pBufferInfo = &infos[i];
         }
-        Context().GetCmdPushDescriptorSet()(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, layout.Get(), 0, 2,
-                                            writes);
+        Context().GetCmdPushDescriptorSet()(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, layout.Get(), 0,
+                                            kBindings, writes);
         vkCmdPushConstants(cmd, layout.Get(), VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(push), &push);
         vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline.Get());
         vkCmdDispatch(cmd, 1, 1, 1);
@@ -135,6 +147,86 @@ TEST_F(GaussianSplatContractGpu, ShaderLayoutMatchesCpp) {
     EXPECT_EQ(q.key_range, 207u);
     EXPECT_EQ(q.num_passes, 208u);
     EXPECT_EQ(q.values_only, 209u);
+
+    // The stage structs: every named member at its C++ offset (numbered as the probe writes).
+    shader::GaussianViewParams v;
+    std::memcpy(&v, view_out.GetMapped(), sizeof(v));
+    const float* rotation[3] = {&v.rotation_row0.x, &v.rotation_row1.x, &v.rotation_row2.x};
+    const float center_low[3] = {v.center_low_x, v.center_low_y, v.center_low_z};
+    for (int row = 0; row < 3; ++row) {
+        SCOPED_TRACE(row);
+        for (int i = 0; i < 3; ++i) EXPECT_EQ(rotation[row][i], float(300 + 4 * row + i));
+        EXPECT_EQ(center_low[row], float(303 + 4 * row));
+    }
+    EXPECT_EQ(v.center_high.x, 312.0f);
+    EXPECT_EQ(v.center_high.z, 314.0f);
+    EXPECT_EQ(v.reserved0, 315.0f);
+    const float view_floats[] = {v.fx,      v.fy,      v.cx,         v.cy,
+                                 v.guard_x, v.guard_y, v.near_plane, v.packed_depth_scale};
+    for (int i = 0; i < 8; ++i) EXPECT_EQ(view_floats[i], float(316 + i)) << i;
+    const uint32_t view_uints[] = {v.width,
+                                   v.height,
+                                   v.tiles_x,
+                                   v.tiles_y,
+                                   v.entry_capacity,
+                                   v.max_tiles_per_splat,
+                                   v.max_tile_entries_total,
+                                   v.tile_bits,
+                                   v.num_splats,
+                                   v.sh_degree,
+                                   v.antialias,
+                                   v.sh_words_per_splat,
+                                   v.scene_depth_present,
+                                   v.splat_precision,
+                                   v.shape_words_per_splat,
+                                   v.entry_capacity_allocated};
+    for (uint32_t i = 0; i < 16; ++i) EXPECT_EQ(view_uints[i], 324u + i) << i;
+    EXPECT_EQ(v.reference_m2, 340.0f);
+    EXPECT_EQ(v.reference_m6, 341.0f);
+    EXPECT_EQ(v.reference_m10, 342.0f);
+    EXPECT_EQ(v.reference_m14, 343.0f);
+    EXPECT_EQ(v.depth_order, 344u);
+    EXPECT_EQ(v.reserved3, 347u);
+
+    shader::GaussianProjectedSplat s;
+    std::memcpy(&s, splat_out.GetMapped(), sizeof(s));
+    EXPECT_EQ(s.center_x, 400.0f);
+    EXPECT_EQ(s.center_y, 401.0f);
+    EXPECT_EQ(s.depth, 402.0f);
+    EXPECT_EQ(s.opacity, 403.0f);
+    EXPECT_EQ(s.conic.x, 404.0f);
+    EXPECT_EQ(s.conic.z, 406.0f);
+    EXPECT_EQ(s.cull_threshold, 407.0f);
+    EXPECT_EQ(s.color.x, 408.0f);
+    EXPECT_EQ(s.color.z, 410.0f);
+    EXPECT_EQ(s.det_q, 411.0f);
+    EXPECT_EQ(s.rect_min, 412u);
+    EXPECT_EQ(s.rect_max, 413u);
+    EXPECT_EQ(s.num_entries, 414u);
+    EXPECT_EQ(s.radius, 415u);
+
+    shader::GaussianCompositePushConstants c;
+    std::memcpy(&c, composite_out.GetMapped(), sizeof(c));
+    EXPECT_EQ(c.width, 500u);
+    EXPECT_EQ(c.height, 501u);
+    EXPECT_EQ(c.tiles_x, 502u);
+    EXPECT_EQ(c.tiles_y, 503u);
+    EXPECT_EQ(c.count_index, 504u);
+    EXPECT_EQ(c.entry_capacity, 505u);
+    EXPECT_EQ(c.scene_depth_flip_y, 506u);
+    EXPECT_EQ(c.background.x, 508.0f);
+    EXPECT_EQ(c.background.z, 510.0f);
+    EXPECT_EQ(c.scene_near, 511.0f);
+
+    shader::GaussianDepthMergePushConstants m;
+    std::memcpy(&m, merge_out.GetMapped(), sizeof(m));
+    EXPECT_EQ(m.width, 600u);
+    EXPECT_EQ(m.height, 601u);
+    EXPECT_EQ(m.scene_depth_flip_y, 602u);
+    EXPECT_EQ(m.near_plane, 604.0f);
+    EXPECT_EQ(m.far_plane, 605.0f);
+    EXPECT_EQ(m.scene_near, 606.0f);
+    EXPECT_EQ(m.min_alpha, 607.0f);
 }
 
 }  // namespace

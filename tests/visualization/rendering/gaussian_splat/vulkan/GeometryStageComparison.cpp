@@ -16,8 +16,8 @@ namespace {
 uint32_t GpuRowSpan(const visualization::rendering::shader::GaussianProjectedSplat& g,
                     uint32_t ty) {
     return visualization::rendering::shader::TileRowSpan(
-        g.center_depth_opacity.x, g.center_depth_opacity.y, g.conic.x, g.conic.y, g.conic.z,
-        g.color.w, g.conic.w, ty, g.tiles.x & 0xFFFFu, g.tiles.y & 0xFFFFu);
+        g.center_x, g.center_y, g.conic.x, g.conic.y, g.conic.z, g.det_q, g.cull_threshold, ty,
+        g.rect_min & 0xFFFFu, g.rect_max & 0xFFFFu);
 }
 
 using visualization::rendering::kTileSize;
@@ -100,7 +100,7 @@ GeometryStageComparison CompareGeometryStage(
         const ProjectedSplat& r = ref[i];
         c.visible_cpu += r.IsVisible();
         const shader::GaussianProjectedSplat* g = gpu_visible[i] ? &gpu.projected.at(i) : nullptr;
-        const int gpu_radius = g ? static_cast<int>(g->tiles.w) : 0;
+        const int gpu_radius = g ? static_cast<int>(g->radius) : 0;
         if (r.IsVisible() != gpu_visible[i]) {
             ++c.cull_flips;
             if (!DecisionNearBorder(r, config, gpu_radius)) ++c.cull_flips_unexplained;
@@ -109,14 +109,14 @@ GeometryStageComparison CompareGeometryStage(
         }
         if (!g) continue;
         ProjectionErrors& e = c.errors;
-        const auto& cdo = g->center_depth_opacity;
-        e.center_px = std::max({e.center_px, std::abs(cdo.x - r.x), std::abs(cdo.y - r.y)});
-        e.depth_rel = std::max(e.depth_rel, std::abs(cdo.z - r.depth) / r.depth);
+        e.center_px =
+            std::max({e.center_px, std::abs(g->center_x - r.x), std::abs(g->center_y - r.y)});
+        e.depth_rel = std::max(e.depth_rel, std::abs(g->depth - r.depth) / r.depth);
         const double conic_scale = std::max(std::abs(r.conic_a), std::abs(r.conic_c));
         e.conic_rel = std::max({e.conic_rel, std::abs(g->conic.x - r.conic_a) / conic_scale,
                                 std::abs(g->conic.y - r.conic_b) / conic_scale,
                                 std::abs(g->conic.z - r.conic_c) / conic_scale});
-        e.opacity_abs = std::max(e.opacity_abs, std::abs(cdo.w - r.opacity));
+        e.opacity_abs = std::max(e.opacity_abs, std::abs(g->opacity - r.opacity));
         e.color_abs =
             std::max({e.color_abs, std::abs(g->color.x - r.color[0]),
                       std::abs(g->color.y - r.color[1]), std::abs(g->color.z - r.color[2])});
@@ -125,7 +125,7 @@ GeometryStageComparison CompareGeometryStage(
         if (dr > 1) ++e.radius_off_more;
         const uint32_t min_packed = uint32_t(r.rect_min_x) | (uint32_t(r.rect_min_y) << 16);
         const uint32_t max_packed = uint32_t(r.rect_max_x) | (uint32_t(r.rect_max_y) << 16);
-        if (g->tiles.x != min_packed || g->tiles.y != max_packed) {
+        if (g->rect_min != min_packed || g->rect_max != max_packed) {
             ++e.rect_differs;
             if (!DecisionNearBorder(r, config, gpu_radius)) ++c.cull_flips_unexplained;
             border.insert(static_cast<uint32_t>(i));
@@ -174,7 +174,7 @@ GeometryStageComparison CompareGeometryStage(
         if (gpu_entries_of[i] == 0) continue;  // dropped by a limit, or no tile to emit
         const shader::GaussianProjectedSplat& g = gpu.projected.at(i);
         int64_t expected = 0;
-        for (uint32_t ty = g.tiles.x >> 16; ty < (g.tiles.y >> 16); ++ty) {
+        for (uint32_t ty = g.rect_min >> 16; ty < (g.rect_max >> 16); ++ty) {
             expected += shader::TileSpanCount(GpuRowSpan(g, ty));
         }
         if (expected != gpu_entries_of[i]) ++c.gpu_span_mismatches;

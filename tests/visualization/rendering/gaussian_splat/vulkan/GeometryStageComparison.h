@@ -15,7 +15,7 @@
 #include "open3d/visualization/rendering/gaussian_splat/RenderConfig.h"
 #include "open3d/visualization/rendering/gaussian_splat/cpu/Projection.h"
 #include "open3d/visualization/rendering/gaussian_splat/cpu/TileLists.h"
-#include "open3d/visualization/rendering/gaussian_splat/vulkan/GaussianGeometryStageRunner.h"
+#include "visualization/rendering/gaussian_splat/vulkan/support/GaussianGeometryStageRunner.h"
 
 namespace open3d {
 namespace tests {

@@ -10,6 +10,7 @@
 #include <limits>
 #include <string_view>
 
+#include "GaussianSplatTileListContract.h"
 #include "GeometryStageComparison.h"
 #include "TestUtility.h"
 #include "open3d/camera/CamerasJson.h"
@@ -17,10 +18,9 @@
 #include "open3d/t/io/PointCloudIO.h"
 #include "open3d/visualization/rendering/gaussian_splat/DefaultScene.h"
 #include "open3d/visualization/rendering/gaussian_splat/GaussianSplatDataPacking.h"
-#include "open3d/visualization/rendering/gaussian_splat/vulkan/GaussianGeometryStageRunner.h"
-#include "shaders/GaussianSplatContract.h"
 #include "visualization/rendering/gaussian_splat/cpu/SplatTestScene.h"
 #include "visualization/rendering/gaussian_splat/vulkan/VulkanTestFixture.h"
+#include "visualization/rendering/gaussian_splat/vulkan/support/GaussianGeometryStageRunner.h"
 
 namespace open3d {
 namespace tests {
@@ -187,7 +187,7 @@ TEST_F(GeometryStageFeatures, CapacityOverflowDropsEntriesFlagsAndWarnsOnce) {
     core::LogSink previous = core::SetLogSink(nullptr);
     core::SetLogSink([&](core::LogLevel level, std::string_view message) {
         if (level == core::LogLevel::Warning &&
-            message.find("Geometry stage") != std::string_view::npos) {
+            message.find("geometry stage") != std::string_view::npos) {
             ++warnings;
         }
         if (previous) previous(level, message);

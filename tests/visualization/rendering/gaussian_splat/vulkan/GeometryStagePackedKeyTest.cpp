@@ -1,5 +1,5 @@
 // The seed's packed 32-bit sort key (RenderConfig::sort_mode == SortMode::kPackedKey32):
-// unit tests of the key math shared by gaussian_emit.comp and C++ (the contract header's
+// unit tests of the key math shared by gaussian_emit.comp and C++ (GaussianSplatTileListContract.h:
 // PackedSortKey / PackedSortKeyDepth), and a real scene where the packed order must hold
 // the same entries per tile as the exact order and may differ from it only between
 // entries whose truncated keys are equal. The number of such swaps is reported.
@@ -13,14 +13,14 @@
 #include <random>
 #include <vector>
 
+#include "GaussianSplatTileListContract.h"
 #include "TestUtility.h"
 #include "open3d/camera/CamerasJson.h"
 #include "open3d/t/io/PointCloudIO.h"
 #include "open3d/visualization/rendering/gaussian_splat/GaussianSplatDataPacking.h"
-#include "open3d/visualization/rendering/gaussian_splat/vulkan/GaussianGeometryStageRunner.h"
-#include "shaders/GaussianSplatContract.h"
 #include "visualization/rendering/gaussian_splat/cpu/SplatTestScene.h"
 #include "visualization/rendering/gaussian_splat/vulkan/VulkanTestFixture.h"
+#include "visualization/rendering/gaussian_splat/vulkan/support/GaussianGeometryStageRunner.h"
 
 namespace open3d {
 namespace tests {
@@ -38,7 +38,7 @@ uint32_t TileBitsFor(int width, int height) {
     config.sort_mode = SortMode::kPackedKey32;
     ViewPackingInputs inputs;
     inputs.entry_capacity = 1;
-    return PackGaussianViewParams(MakeTestCamera(width, height), config, inputs).limits.w;
+    return PackGaussianViewParams(MakeTestCamera(width, height), config, inputs).tile_bits;
 }
 
 TEST(GeometryStagePackedKey, TileAndDepthBitsAtCommonResolutions) {
@@ -155,16 +155,18 @@ TEST(GeometryStagePackedKey, FarPlaneFromTheCentreBox) {
     inputs.entry_capacity = 16;
     inputs.center_min = lo;
     inputs.center_max = hi;
-    const auto exact = PackGaussianViewParams(cam, config, inputs);
-    EXPECT_EQ(exact.clip.w, 0.0f);
-    EXPECT_FALSE(UsesPackedSortKey(exact));
+    const PackedView exact = PackGaussianView(cam, config, inputs);
+    EXPECT_EQ(exact.params.packed_depth_scale, 0.0f);
+    EXPECT_FALSE(exact.choices.packed_key);
+    EXPECT_FALSE(UsesPackedSortKey(config));
     config.sort_mode = SortMode::kPackedKey32;
-    const auto packed = PackGaussianViewParams(cam, config, inputs);
-    EXPECT_EQ(packed.clip.w, static_cast<float>(1.0 / (8.0 - 0.2)));
-    EXPECT_TRUE(UsesPackedSortKey(packed));
+    const PackedView packed = PackGaussianView(cam, config, inputs);
+    EXPECT_EQ(packed.params.packed_depth_scale, static_cast<float>(1.0 / (8.0 - 0.2)));
+    EXPECT_TRUE(packed.choices.packed_key);
+    EXPECT_TRUE(UsesPackedSortKey(config));
     // Everything else is the same in both modes.
-    EXPECT_EQ(packed.limits.w, exact.limits.w);
-    EXPECT_EQ(packed.clip.z, exact.clip.z);
+    EXPECT_EQ(packed.params.tile_bits, exact.params.tile_bits);
+    EXPECT_EQ(packed.params.near_plane, exact.params.near_plane);
 }
 
 // Inversions of `ranks` (pairs i < j with ranks[i] > ranks[j]), by merge sort.
@@ -249,14 +251,12 @@ void GeometryStagePackedKeyScene::CompareModes(int width, int height) {
     inputs.center_min = packed.center_min;
     inputs.center_max = packed.center_max;
     const shader::GaussianViewParams params = PackGaussianViewParams(cam, packed_config, inputs);
-    ASSERT_TRUE(UsesPackedSortKey(params));
-    const uint32_t tile_bits = params.limits.w;
-    const auto depth_of = [&](uint32_t splat) {
-        return gpu.projected[splat].center_depth_opacity.z;
-    };
+    ASSERT_GT(params.packed_depth_scale, 0.0f);
+    const uint32_t tile_bits = params.tile_bits;
+    const auto depth_of = [&](uint32_t splat) { return gpu.projected[splat].depth; };
     for (uint32_t splat : exact.visible_in_depth_order) {
         ASSERT_EQ(std::bit_cast<uint32_t>(depth_of(splat)),
-                  std::bit_cast<uint32_t>(exact.projected[splat].center_depth_opacity.z));
+                  std::bit_cast<uint32_t>(exact.projected[splat].depth));
     }
     // Exact order: (float32 depth, splat index); positive depths order like their bits.
     const auto exact_rank = [&](uint32_t splat) {
@@ -264,7 +264,8 @@ void GeometryStagePackedKeyScene::CompareModes(int width, int height) {
     };
     const auto key_of = [&](uint32_t tile, uint32_t splat, uint32_t bits) {
         return PackedSortKey(
-            tile, PackedSortKeyDepth(depth_of(splat), params.clip.z, params.clip.w), bits);
+            tile, PackedSortKeyDepth(depth_of(splat), params.near_plane, params.packed_depth_scale),
+            bits);
     };
 
     int64_t adjacent_swaps = 0, entries_moved = 0, inversions = 0, tiles_with_swaps = 0;
@@ -333,7 +334,8 @@ void GeometryStagePackedKeyScene::CompareModes(int width, int height) {
     std::cout << "[packed key] playbot_31k view 0 " << width << "x" << height << ": "
               << gpu.counters.visible_count << " visible, " << n << " entries in "
               << tiles_with_entries << " tiles (largest " << largest_tile << "), tile bits "
-              << tile_bits << ", far " << params.clip.z + 1.0f / params.clip.w << "\n"
+              << tile_bits << ", far " << params.near_plane + 1.0f / params.packed_depth_scale
+              << "\n"
               << "[packed key]   out of exact order: " << adjacent_swaps << " adjacent pairs in "
               << tiles_with_swaps << " tiles, " << entries_moved
               << " entries not at their exact position, " << inversions

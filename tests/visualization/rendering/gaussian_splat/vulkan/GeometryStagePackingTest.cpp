@@ -7,8 +7,8 @@
 #include <cmath>
 #include <cstddef>
 
+#include "GaussianSplatTileListContract.h"
 #include "open3d/visualization/rendering/gaussian_splat/GaussianSplatDataPacking.h"
-#include "shaders/GaussianSplatContract.h"
 #include "visualization/rendering/gaussian_splat/cpu/SplatTestScene.h"
 
 namespace open3d {
@@ -19,14 +19,16 @@ using namespace visualization::rendering;
 namespace shader = visualization::rendering::shader;
 
 TEST(GeometryStagePacking, ContractLayoutsArePinned) {
-    // The same numbers as the static_asserts in the contract header, checked at
+    // The same numbers as the static_asserts in GaussianSplatProjectionContract.h, checked at
     // run time too so a layout change shows up as a named test failure.
     EXPECT_EQ(sizeof(shader::GaussianViewParams), 192u);
-    EXPECT_EQ(offsetof(shader::GaussianViewParams, limits), 112u);
-    EXPECT_EQ(offsetof(shader::GaussianViewParams, reference_depth_row), 160u);
+    EXPECT_EQ(offsetof(shader::GaussianViewParams, entry_capacity), 112u);
+    EXPECT_EQ(offsetof(shader::GaussianViewParams, sh_degree), 132u);
+    EXPECT_EQ(offsetof(shader::GaussianViewParams, antialias), 136u);
+    EXPECT_EQ(offsetof(shader::GaussianViewParams, reference_m2), 160u);
     EXPECT_EQ(offsetof(shader::GaussianViewParams, depth_order), 176u);
     EXPECT_EQ(sizeof(shader::GaussianProjectedSplat), 64u);
-    EXPECT_EQ(offsetof(shader::GaussianProjectedSplat, tiles), 48u);
+    EXPECT_EQ(offsetof(shader::GaussianProjectedSplat, rect_min), 48u);
     EXPECT_EQ(sizeof(shader::GaussianGeometryStageCounters), 32u + 16u * shader::kScanMaxLevels);
     EXPECT_EQ(offsetof(shader::GaussianGeometryStageCounters, entry_count),
               4u * shader::kCounterEntriesIndex);
@@ -119,22 +121,28 @@ TEST(GeometryStagePacking, ViewParams) {
     inputs.num_splats = 7;
     inputs.packed_sh_degree = 3;
     inputs.entry_capacity = 1000;
-    const shader::GaussianViewParams v = PackGaussianViewParams(cam, config, inputs);
-    EXPECT_FLOAT_EQ(v.clip.x, float(1.3 * 100 / 200.0));  // 1.3 tan(fov_x / 2) = 1.3 W / 2 fx
-    EXPECT_FLOAT_EQ(v.clip.y, float(1.3 * 75 / 200.0));
-    EXPECT_FLOAT_EQ(v.clip.z, 0.2f);
-    EXPECT_EQ(v.image.z, 7u);  // ceil(100 / 16)
-    EXPECT_EQ(v.image.w, 5u);  // ceil(75 / 16)
-    EXPECT_EQ(v.limits.x,
-              1000u);  // the allocation is below max_tile_entries_total
-    EXPECT_EQ(v.limits.z, uint32_t(config.max_tile_entries_total));
-    EXPECT_EQ(v.limits.w, SortKeyTileBits(35));
-    EXPECT_EQ(v.scene.x, 7u);
-    EXPECT_EQ(v.scene.y, 2u);  // min(config 2, packed 3)
-    EXPECT_EQ(v.scene.z, 1u);
+    const PackedView packed = PackGaussianView(cam, config, inputs);
+    const shader::GaussianViewParams& v = packed.params;
+    EXPECT_FLOAT_EQ(v.guard_x, float(1.3 * 100 / 200.0));  // 1.3 tan(fov_x / 2) = 1.3 W / 2 fx
+    EXPECT_FLOAT_EQ(v.guard_y, float(1.3 * 75 / 200.0));
+    EXPECT_FLOAT_EQ(v.near_plane, 0.2f);
+    EXPECT_EQ(v.tiles_x, 7u);            // ceil(100 / 16)
+    EXPECT_EQ(v.tiles_y, 5u);            // ceil(75 / 16)
+    EXPECT_EQ(v.entry_capacity, 1000u);  // the allocation is below max_tile_entries_total
+    EXPECT_EQ(v.max_tile_entries_total, uint32_t(config.max_tile_entries_total));
+    EXPECT_EQ(v.tile_bits, SortKeyTileBits(35));
+    EXPECT_EQ(v.num_splats, 7u);
+    EXPECT_EQ(v.sh_degree, 2u);  // min(config 2, packed 3)
+    EXPECT_EQ(v.antialias, 1u);
+    // The host's choices are the values it packed, not read back from the struct.
+    EXPECT_EQ(packed.choices.sh_degree, v.sh_degree);
+    EXPECT_TRUE(packed.choices.antialias);
+    EXPECT_FALSE(packed.choices.packed_key);
+    EXPECT_EQ(packed.choices.tile_bits, v.tile_bits);
+    EXPECT_EQ(packed.choices.entry_capacity, v.entry_capacity);
     config.max_tile_entries_total = uint64_t(1) << 40;  // clamped below the scan saturation
     inputs.entry_capacity = 0xFFFFFFFFu;
-    EXPECT_LT(PackGaussianViewParams(cam, config, inputs).limits.x, shader::kScanSaturation);
+    EXPECT_LT(PackGaussianViewParams(cam, config, inputs).entry_capacity, shader::kScanSaturation);
 }
 
 }  // namespace

@@ -14,9 +14,9 @@
 #include "open3d/t/io/PointCloudIO.h"
 #include "open3d/visualization/rendering/gaussian_splat/DefaultScene.h"
 #include "open3d/visualization/rendering/gaussian_splat/GaussianSplatDataPacking.h"
-#include "open3d/visualization/rendering/gaussian_splat/vulkan/GaussianGeometryStageRunner.h"
 #include "visualization/rendering/gaussian_splat/cpu/SplatTestScene.h"
 #include "visualization/rendering/gaussian_splat/vulkan/VulkanTestFixture.h"
+#include "visualization/rendering/gaussian_splat/vulkan/support/GaussianGeometryStageRunner.h"
 
 namespace open3d {
 namespace tests {

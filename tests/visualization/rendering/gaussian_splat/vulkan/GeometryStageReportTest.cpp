@@ -14,8 +14,8 @@
 #include "open3d/camera/CamerasJson.h"
 #include "open3d/t/io/PointCloudIO.h"
 #include "open3d/visualization/rendering/gaussian_splat/GaussianSplatDataPacking.h"
-#include "open3d/visualization/rendering/gaussian_splat/vulkan/GaussianGeometryStageRunner.h"
 #include "visualization/rendering/gaussian_splat/vulkan/VulkanTestFixture.h"
+#include "visualization/rendering/gaussian_splat/vulkan/support/GaussianGeometryStageRunner.h"
 
 namespace open3d {
 namespace tests {

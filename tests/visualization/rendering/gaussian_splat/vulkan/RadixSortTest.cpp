@@ -13,11 +13,11 @@
 #include <string>
 #include <vector>
 
+#include "GaussianSplatRadixSortContract.h"
 #include "VulkanTestFixture.h"
 #include "open3d/core/Exception.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/Buffer.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/RadixSort.h"
-#include "shaders/GaussianSplatContract.h"
 
 namespace open3d {
 namespace tests {

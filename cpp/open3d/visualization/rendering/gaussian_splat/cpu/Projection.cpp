@@ -7,13 +7,15 @@
 #include "open3d/core/Exception.h"
 #include "open3d/core/ParallelFor.h"
 #include "open3d/t/geometry/SphericalHarmonics.h"
-#include "open3d/visualization/rendering/gaussian_splat/GaussianSplatDataPacking.h"
-#include "shaders/GaussianSplatContract.h"
+// The float-exact arithmetic shared with the shaders, and nothing of the GPU packing.
+#include "GaussianSplatShared.h"
 
 namespace open3d {
 namespace visualization {
 namespace rendering {
 namespace cpu {
+
+static_assert(shader::kGaussianTileSize == static_cast<uint32_t>(kTileSize));
 
 namespace {
 
@@ -131,10 +133,10 @@ namespace {
 struct ViewParams {
     Eigen::Matrix3d rotation;  // world to camera
     Eigen::Vector3d translation;
-    Eigen::Vector3d center;          // camera centre, world space
-    CameraCenterSplit center_split;  // the same as float32 high + low (the sort depth's)
-    ReferenceDepthRow depth_row;     // the original's float32 matrix row (its view z)
-    OriginalProjection original;     // its full projection, for its float32 pixel centre
+    Eigen::Vector3d center;                  // camera centre, world space
+    shader::CameraCenterSplit center_split;  // float32 high + low (the sort depth's)
+    shader::ReferenceDepthRow depth_row;     // the original's float32 matrix row (its view z)
+    OriginalProjection original;             // its full projection, for its float32 pixel centre
     double fx, fy, cx, cy;
     double lim_x, lim_y;  // 1.3 tan(fov / 2): the Jacobian guard band
     TileGrid grid;
@@ -155,7 +157,7 @@ Eigen::Matrix3d CovarianceFactor(const float* scale, const float* rot) {
 // The float32 depth that orders and near-culls the splat, exactly as the GPU computes it.
 float OrderDepth(const ViewParams& view, DepthOrder order, const float* position) {
     if (order == DepthOrder::kReference) {
-        const ReferenceDepthRow& m = view.depth_row;
+        const shader::ReferenceDepthRow& m = view.depth_row;
         return shader::ReferenceViewDepth(m.m2, m.m6, m.m10, m.m14, position[0], position[1],
                                           position[2]);
     }
@@ -265,8 +267,10 @@ std::vector<ProjectedSplat> ProjectSplats(const t::geometry::PointCloud& cloud,
     view.rotation = camera.GetRotation();
     view.translation = camera.GetTranslation();
     view.center = camera.GetCenter();
-    view.center_split = SplitCameraCenter(camera);
-    view.depth_row = GetReferenceDepthRow(camera);
+    const double center[3] = {view.center.x(), view.center.y(), view.center.z()};
+    view.center_split = shader::SplitCameraCenter(center);
+    view.depth_row = {float(view.rotation(2, 0)), float(view.rotation(2, 1)),
+                      float(view.rotation(2, 2)), float(view.translation.z())};
     view.original = GetOriginalProjection(camera);
     view.fx = camera.fx;
     view.fy = camera.fy;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <vector>
 
+#include "GaussianSplatCompositeContract.h"
 #include "open3d/core/Exception.h"
 #include "open3d/visualization/rendering/gaussian_splat/RenderConfig.h"
 #include "open3d/visualization/rendering/gaussian_splat/cpu/Composite.h"
@@ -10,7 +11,6 @@
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/ComputePipeline.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/EmbeddedShaders.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/VulkanContext.h"
-#include "shaders/GaussianSplatContract.h"
 
 namespace open3d {
 namespace visualization {
@@ -231,11 +231,15 @@ void GaussianCompositeStage::RecordComposite(VkCommandBuffer cmd,
     const VkDeviceSize count_offset =
         inputs.entry_count.offset - inputs.entry_count.offset % alignment;
     GaussianCompositePushConstants push{};
-    push.image = {targets.width, targets.height, tiles_x, tiles_y};
-    push.entries = {static_cast<uint32_t>((inputs.entry_count.offset - count_offset) / 4),
-                    inputs.entry_capacity, params.scene_depth && params.scene_depth->flip_y, 0u};
-    push.background = {params.background[0], params.background[1], params.background[2], 0.f};
-    push.scene_depth = {params.scene_depth ? params.scene_depth->near_plane : 0.f, 0.f, 0.f, 0.f};
+    push.width = targets.width;
+    push.height = targets.height;
+    push.tiles_x = tiles_x;
+    push.tiles_y = tiles_y;
+    push.count_index = static_cast<uint32_t>((inputs.entry_count.offset - count_offset) / 4);
+    push.entry_capacity = inputs.entry_capacity;
+    push.scene_depth_flip_y = params.scene_depth && params.scene_depth->flip_y ? 1u : 0u;
+    push.background = {params.background[0], params.background[1], params.background[2]};
+    push.scene_near = params.scene_depth ? params.scene_depth->near_plane : 0.f;
 
     const VkDeviceSize entry_bytes = VkDeviceSize(std::max(inputs.entry_capacity, 1u)) * 4;
     const std::array<VkDescriptorBufferInfo, 5> buffers{{
@@ -300,10 +304,13 @@ void GaussianCompositeStage::RecordDepthMerge(VkCommandBuffer cmd, const DepthMe
                          params.far);
     }
     GaussianDepthMergePushConstants push{};
-    push.image = {images.width, images.height, params.scene_depth && params.scene_depth->flip_y,
-                  0u};
-    push.range = {params.near, params.far,
-                  params.scene_depth ? params.scene_depth->near_plane : 0.f, params.min_alpha};
+    push.width = images.width;
+    push.height = images.height;
+    push.scene_depth_flip_y = params.scene_depth && params.scene_depth->flip_y ? 1u : 0u;
+    push.near_plane = params.near;
+    push.far_plane = params.far;
+    push.scene_near = params.scene_depth ? params.scene_depth->near_plane : 0.f;
+    push.min_alpha = params.min_alpha;
     const std::array<VkDescriptorImageInfo, kDepthMergeNumBindings> infos{{
         StorageImage(images.splat_depth),
         StorageImage(images.splat_alpha),

@@ -166,18 +166,19 @@ void GaussianGeometryStage::PushBindings(VkCommandBuffer cmd,
 }
 
 void GaussianGeometryStage::Record(VkCommandBuffer cmd, const GeometryStageSceneBuffers& scene,
-                                   const GeometryStageViewBuffers& buffers,
-                                   const GaussianViewParams& params,
+                                   const GeometryStageViewBuffers& buffers, const PackedView& view,
                                    const GpuTimestamps* timestamps) {
     if (timestamps) timestamps->RecordBegin(cmd, TimedPass::kProject);
     const uint32_t n = scene.num_splats;
-    const uint32_t capacity = params.flags.w;  // entries allocated
-    const bool packed_key = UsesPackedSortKey(params);
-    if (params.scene.x != n || params.limits.x > capacity) {
+    const GaussianViewParams& params = view.params;
+    const GeometryStageChoices& choices = view.choices;
+    const uint32_t capacity = choices.entry_capacity_allocated;
+    const bool packed_key = choices.packed_key;
+    if (choices.num_splats != n || choices.entry_capacity > capacity) {
         core::ThrowError(
             "GaussianGeometryStage: view parameters for {} splats / capacity {} do not "
             "match the scene ({} splats)",
-            params.scene.x, params.limits.x, n);
+            choices.num_splats, choices.entry_capacity, n);
     }
     const GeometryStageStorageRequirements need = GetStorageRequirements(n, capacity);
     const VkPipelineLayout layout = pipeline_layout_.Get();
@@ -220,7 +221,7 @@ void GaussianGeometryStage::Record(VkCommandBuffer cmd, const GeometryStageScene
     PushBindings(cmd, scene, buffers);
     vkCmdBindPipeline(
         cmd, VK_PIPELINE_BIND_POINT_COMPUTE,
-        GetProjectPipeline(params.scene.y, params.scene.z != 0, scene.precision, !packed_key));
+        GetProjectPipeline(choices.sh_degree, choices.antialias, scene.precision, !packed_key));
     if (n > 0) vkCmdDispatch(cmd, DivCeil(n, kProjectWorkgroupSize), 1, 1);
     ComputeBarrier(cmd);
 
@@ -312,7 +313,7 @@ void GaussianGeometryStage::Record(VkCommandBuffer cmd, const GeometryStageScene
     begin(TimedPass::kTileSort);
     sort_.Record(cmd, buffers.entry_keys, buffers.entry_values, buffers.sort_scratch,
                  counter_range(kCounterEntriesIndex), std::max(capacity, 1u),
-                 packed_key ? kSortKeyBits : params.limits.w,
+                 packed_key ? kSortKeyBits : choices.tile_bits,
                  RadixSort::Params::kWrittenByProducer);
     if (packed_key) {
         ComputeBarrier(cmd);

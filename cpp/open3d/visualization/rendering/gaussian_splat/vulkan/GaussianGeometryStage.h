@@ -12,12 +12,12 @@
 #include <cstdint>
 #include <map>
 
+#include "GaussianSplatTileListContract.h"
 #include "open3d/visualization/rendering/gaussian_splat/GaussianSplatDataPacking.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/Buffer.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/GpuTimestamps.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/RadixSort.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/VulkanHandle.h"
-#include "shaders/GaussianSplatContract.h"
 
 namespace open3d {
 namespace visualization {
@@ -92,16 +92,17 @@ public:
     static GeometryStageStorageRequirements GetStorageRequirements(uint32_t num_splats,
                                                                    uint32_t entry_capacity);
 
-    /// Records geometry stage for one view: writes `params` into buffers.view_params, zeroes the
+    /// Records geometry stage for one view: writes view.params into buffers.view_params, zeroes the
     /// counters (and, from N, the scan and emit sizes and the depth sort's parameters), then
     /// project (slot i = splat i) -> one stable sort of all
     /// N slots by depth (culled splats last, ties by index) -> scan tile counts of the N slots
     /// -> dispatch args (entries that fit; the tile sort's parameters, so no sort runs its setup
-    /// pass) -> emit entries -> stable sort by tile (params.limits.w bits). Every size after the
-    /// projection comes from GPU-side counts. `params` must come from PackGaussianViewParams for
-    /// this scene and a capacity <= the one the buffers were sized for.
+    /// pass) -> emit entries -> stable sort by tile (view.choices.tile_bits bits). Every size after
+    /// the projection comes from GPU-side counts. `view` must come from PackGaussianView for
+    /// this scene and a capacity <= the one the buffers were sized for. Pipelines and passes
+    /// are picked from view.choices, the host's own values, not read back from view.params.
     ///
-    /// With the packed key (UsesPackedSortKey(params)): no sort of the visible list (scan
+    /// With the packed key (view.choices.packed_key): no sort of the visible list (scan
     /// and emit follow the append order, sized by a dispatch-args pass), entries keyed by
     /// shader::PackedSortKey, one stable 32-bit sort, then the keys are shifted back to tile
     /// indices. The outputs have the same layout in both modes.
@@ -112,7 +113,7 @@ public:
     /// With `timestamps` (reset by the caller in this command buffer), the projection and
     /// its dispatch arguments are timed as TimedPass::kProject and everything after as kSort.
     void Record(VkCommandBuffer cmd, const GeometryStageSceneBuffers& scene,
-                const GeometryStageViewBuffers& buffers, const shader::GaussianViewParams& params,
+                const GeometryStageViewBuffers& buffers, const PackedView& view,
                 const GpuTimestamps* timestamps = nullptr);
 
 private:

@@ -119,8 +119,8 @@ GeometryStageViewBuffers GeometryStageResources::View() const {
     return view;
 }
 
-shader::GaussianViewParams GeometryStageResources::ViewParams(const camera::PinholeCamera& camera,
-                                                              const RenderConfig& config) const {
+PackedView GeometryStageResources::ViewParams(const camera::PinholeCamera& camera,
+                                              const RenderConfig& config) const {
     ViewPackingInputs inputs;
     inputs.num_splats = layout_.num_splats;
     inputs.packed_sh_degree = layout_.sh_degree;
@@ -129,7 +129,7 @@ shader::GaussianViewParams GeometryStageResources::ViewParams(const camera::Pinh
     inputs.entry_capacity = entry_capacity_;
     inputs.center_min = layout_.center_min;
     inputs.center_max = layout_.center_max;
-    return PackGaussianViewParams(camera, config, inputs);
+    return PackGaussianView(camera, config, inputs);
 }
 
 }  // namespace vulkan

@@ -38,9 +38,9 @@ public:
     /// Bindings of the uploaded scene and of the view buffers for GaussianGeometryStage::Record.
     GeometryStageSceneBuffers Scene() const;
     GeometryStageViewBuffers View() const;
-    /// The view parameters of `camera` for this scene and view allocation.
-    shader::GaussianViewParams ViewParams(const camera::PinholeCamera& camera,
-                                          const RenderConfig& config) const;
+    /// The view parameters of `camera` for this scene and view allocation, with the choices
+    /// GaussianGeometryStage::Record picks its pipelines from.
+    PackedView ViewParams(const camera::PinholeCamera& camera, const RenderConfig& config) const;
 
     /// The packing's sizes (its attribute vectors are empty).
     const PackedGaussianSplats& Layout() const { return layout_; }

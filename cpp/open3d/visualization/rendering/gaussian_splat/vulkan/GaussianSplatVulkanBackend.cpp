@@ -175,14 +175,14 @@ void GaussianSplatVulkanBackend::RenderGeometryStage(const camera::PinholeCamera
     EnsureViewBuffers(static_cast<uint32_t>(
         std::min<uint64_t>(MaxEntryCapacity(config), initial_entry_capacity_)));
 
-    const shader::GaussianViewParams params = geometry_stage_resources_.ViewParams(camera, config);
+    const PackedView view = geometry_stage_resources_.ViewParams(camera, config);
 
     geometry_stage_cmd_ = pool_.Allocate();
     VkCommandBuffer cmd = geometry_stage_cmd_.Get();
     geometry_stage_cmd_.Begin();
     geometry_stage_timestamps_.RecordReset(cmd);
     geometry_stage_.Record(cmd, geometry_stage_resources_.Scene(), geometry_stage_resources_.View(),
-                           params, &geometry_stage_timestamps_);
+                           view, &geometry_stage_timestamps_);
     // The counters reach the host with the geometry stage's fence: composite stage can skip an
     // empty frame.
     RecordMemoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,

@@ -3,13 +3,13 @@
 #include <algorithm>
 #include <array>
 
+#include "GaussianSplatRadixSortContract.h"
 #include "open3d/core/Exception.h"
 #include "open3d/visualization/rendering/gaussian_splat/RenderConfig.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/Commands.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/ComputePipeline.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/EmbeddedShaders.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/VulkanContext.h"
-#include "shaders/GaussianSplatContract.h"
 
 namespace open3d {
 namespace visualization {

@@ -9,10 +9,10 @@
 #include <cstdint>
 #include <vector>
 
+#include "GaussianSplatCompositeContract.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/Commands.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/GaussianCompositeStage.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/GpuTimestamps.h"
-#include "shaders/GaussianSplatContract.h"
 
 namespace open3d {
 namespace visualization {

@@ -1,12 +1,14 @@
-// A small synchronous driver around GaussianGeometryStage for tests, tools and benchmarks: it
-// uploads a packed scene once, then per Run() records geometry stage, submits, waits on the
-// fence and reads back the projected splats, the depth-ordered visible list, the sorted
-// tile entries and the counters. Frames of the real backend submit without waiting.
+// A small synchronous driver around GaussianGeometryStage for the tests
+// (open3d_test_support_vulkan): it uploads a packed scene once, then per Run() records geometry
+// stage, submits, waits on the fence and reads back the projected splats, the depth-ordered visible
+// list, the sorted tile entries and the counters. Frames of the real backend submit without
+// waiting.
 #pragma once
 
 #include <cstdint>
 #include <vector>
 
+#include "GaussianSplatTileListContract.h"
 #include "open3d/camera/PinholeCamera.h"
 #include "open3d/visualization/rendering/gaussian_splat/GaussianSplatDataPacking.h"
 #include "open3d/visualization/rendering/gaussian_splat/RenderConfig.h"
@@ -14,7 +16,6 @@
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/Commands.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/GaussianGeometryStage.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/GaussianGeometryStageResources.h"
-#include "shaders/GaussianSplatContract.h"
 
 namespace open3d {
 namespace visualization {

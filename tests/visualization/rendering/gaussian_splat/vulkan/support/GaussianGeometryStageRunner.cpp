@@ -1,4 +1,4 @@
-#include "open3d/visualization/rendering/gaussian_splat/vulkan/GaussianGeometryStageRunner.h"
+#include "visualization/rendering/gaussian_splat/vulkan/support/GaussianGeometryStageRunner.h"
 #include "open3d/core/Timer.h"
 
 #include <chrono>
@@ -79,7 +79,7 @@ void GaussianGeometryStageRunner::SetVisibility(const std::vector<uint32_t>& mas
 GeometryStageReadback GaussianGeometryStageRunner::Run(const camera::PinholeCamera& camera,
                                                        const RenderConfig& config,
                                                        bool read_projected) {
-    const shader::GaussianViewParams params = resources_.ViewParams(camera, config);
+    const PackedView packed_view = resources_.ViewParams(camera, config);
     const GeometryStageSceneBuffers scene = resources_.Scene();
     const GeometryStageViewBuffers view = resources_.View();
 
@@ -89,7 +89,7 @@ GeometryStageReadback GaussianGeometryStageRunner::Run(const camera::PinholeCame
     {
         CommandBuffer cmd = pool_.Allocate();
         cmd.Begin();
-        geometry_stage_.Record(cmd.Get(), scene, view, params);
+        geometry_stage_.Record(cmd.Get(), scene, view, packed_view);
         ComputeToTransferBarrier(cmd.Get());
         RecordCopy(context_, cmd.Get(), resources_.counters, sizeof(out.counters), &out.counters,
                    pending);

@@ -1,4 +1,4 @@
-#include "open3d/visualization/rendering/gaussian_splat/vulkan/GaussianCompositeStageRunner.h"
+#include "visualization/rendering/gaussian_splat/vulkan/support/GaussianCompositeStageRunner.h"
 #include "open3d/core/Timer.h"
 
 #include <chrono>

@@ -1,0 +1,49 @@
+// The base of the GPU contract between host code and compute shaders (STYLE.md point 5),
+// included by every stage's contract header: the shared float-exact arithmetic
+// (GaussianSplatShared.h), the GLSL vector types the C++ mirrors of buffer structs use, and
+// the error flags every stage reports. One header per stage follows it (radix sort,
+// projection, tile lists, composite), so a stage's layout changes where only its users look.
+// Compiled as GLSL (#include from shaders/*.comp through GL_GOOGLE_include_directive) and as
+// C++ (namespace open3d::visualization::rendering::shader), where every mirrored struct gets
+// static_asserts on size and member offsets. Structs use 4-byte scalars, vec3 followed by a
+// scalar, and 16-byte vectors only, so std430 (and std140) agree with C++ without hidden
+// padding. Never includes Vulkan headers: the CPU and Metal layers may read it too.
+#ifndef OPEN3D_SHADERS_GAUSSIAN_SPLAT_COMMON_H
+#define OPEN3D_SHADERS_GAUSSIAN_SPLAT_COMMON_H
+
+#include "GaussianSplatShared.h"
+
+#ifdef __cplusplus
+#include <cstddef>
+
+namespace open3d {
+namespace visualization {
+namespace rendering {
+namespace shader {
+
+// GLSL's uvec4 as std430 lays it out.
+struct alignas(16) uvec4 {
+    uint32_t x, y, z, w;
+};
+// GLSL's vec3: std430 aligns it to 16 bytes but it takes 12, so a 4-byte scalar may follow
+// in the same 16 bytes. The C++ struct has 4-byte alignment: every vec3 member's offset is
+// static_asserted to be a multiple of 16, and a named scalar fills the remaining 4 bytes.
+// Never in arrays (GLSL pads vec3 array elements to 16 bytes).
+struct vec3 {
+    float x, y, z;
+};
+static_assert(sizeof(vec4) == 16 && sizeof(uvec4) == 16 && sizeof(vec3) == 12);
+#endif
+
+// ---- Error flags (same bits as RenderStats::error_flags, checked in RadixSort.cpp) ----
+OPEN3D_SHADER_CONST uint kErrorEntriesDropped = 1u;
+OPEN3D_SHADER_CONST uint kErrorCountsClamped = 2u;
+
+#ifdef __cplusplus
+static_assert(kErrorEntriesDropped == 1u && kErrorCountsClamped == 2u);
+}  // namespace shader
+}  // namespace rendering
+}  // namespace visualization
+}  // namespace open3d
+#endif  // __cplusplus
+#endif  // OPEN3D_SHADERS_GAUSSIAN_SPLAT_COMMON_H

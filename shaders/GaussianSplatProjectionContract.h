@@ -1,0 +1,174 @@
+// The projection's part of the GPU contract (GaussianGeometryStage.cpp,
+// GaussianSplatDataPacking.cpp, shaders/gaussian_project.comp): the per-frame view
+// parameters, the projected splat record the later passes read, the geometry stage's
+// bindings and the projection's specialisation constants. A stage of its own because the
+// view parameters are the one struct the host fills per frame: every value is a named member.
+// GLSL and C++ as GaussianSplatCommon.h says; C++ gets static_asserts on every offset.
+#ifndef OPEN3D_SHADERS_GAUSSIAN_SPLAT_PROJECTION_CONTRACT_H
+#define OPEN3D_SHADERS_GAUSSIAN_SPLAT_PROJECTION_CONTRACT_H
+
+#include "GaussianSplatCommon.h"
+
+#ifdef __cplusplus
+namespace open3d {
+namespace visualization {
+namespace rendering {
+namespace shader {
+#endif
+
+// Workgroup size of the projection (one invocation per splat).
+OPEN3D_SHADER_CONST uint kProjectWorkgroupSize = 256u;
+
+// The depth that orders splats and culls at the near plane (RenderConfig::depth_order,
+// GaussianSplatShared.h): the original rasterizer's float32 view z, or the camera-relative one.
+OPEN3D_SHADER_CONST uint kDepthOrderReference = 0u;
+OPEN3D_SHADER_CONST uint kDepthOrderCameraRelative = 1u;
+
+// Precision of the packed attributes (specialisation constant kSpecPrecision).
+OPEN3D_SHADER_CONST uint kPrecisionExact = 0u;    // fp32 everything
+OPEN3D_SHADER_CONST uint kPrecisionCompact = 1u;  // fp16 scale, rotation, f_dc, SH
+// uint words per splat in the shape buffer: scale xyz, rotation wxyz, f_dc rgb.
+OPEN3D_SHADER_CONST uint kShapeWordsExact = 10u;   // 10 floats
+OPEN3D_SHADER_CONST uint kShapeWordsCompact = 5u;  // 10 halves
+
+// Specialisation constant ids of gaussian_project.comp.
+OPEN3D_SHADER_CONST uint kSpecShDegree = 0u;   // 0..3; 0 reads no SH buffer
+OPEN3D_SHADER_CONST uint kSpecAntialias = 1u;  // 0 / 1
+OPEN3D_SHADER_CONST uint kSpecPrecision = 2u;  // kPrecisionExact / kPrecisionCompact
+// 1 (exact order): slot i of the visible list holds splat i (key ~0u when not visible), so
+// one stable depth sort of all N slots orders ties by splat index; 0 (packed key): visible
+// splats are appended in subgroup order.
+OPEN3D_SHADER_CONST uint kSpecIndexedList = 3u;
+
+// Descriptor set 0 of every geometry stage projection pipeline (one push-descriptor layout; each
+// shader declares only the bindings it uses).
+OPEN3D_SHADER_CONST uint kGeometryStageViewBinding = 0u;       // GaussianViewParams
+OPEN3D_SHADER_CONST uint kGeometryStagePositionsBinding = 1u;  // vec4[N]: xyz, sigmoid(opacity)
+OPEN3D_SHADER_CONST uint kGeometryStageShapeBinding = 2u;      // uint[N * shape words]
+OPEN3D_SHADER_CONST uint kGeometryStageShBinding = 3u;  // uint[N * sh words]; unread at degree 0
+OPEN3D_SHADER_CONST uint kGeometryStageVisibilityBinding =
+    4u;  // uint[ceil(N / 32)], bit i = splat i
+OPEN3D_SHADER_CONST uint kGeometryStageProjectedBinding = 5u;     // GaussianProjectedSplat[N]
+OPEN3D_SHADER_CONST uint kGeometryStageCountersBinding = 6u;      // GaussianGeometryStageCounters
+OPEN3D_SHADER_CONST uint kGeometryStageDepthKeysBinding = 7u;     // uint[N]: visible depth keys
+OPEN3D_SHADER_CONST uint kGeometryStageSplatIndexBinding = 8u;    // uint[N]: visible splat indices
+OPEN3D_SHADER_CONST uint kGeometryStageScanBinding = 9u;          // uint[scan words]: all levels
+OPEN3D_SHADER_CONST uint kGeometryStageEntryKeysBinding = 10u;    // uint[capacity]: tile index
+OPEN3D_SHADER_CONST uint kGeometryStageEntryValuesBinding = 11u;  // uint[capacity]: splat index
+OPEN3D_SHADER_CONST uint kGeometryStageSortParamsBinding = 12u;  // RadixSortParams of the next sort
+OPEN3D_SHADER_CONST uint kGeometryStageTileCountsBinding = 13u;  // uint[N]: tiles of splat i
+OPEN3D_SHADER_CONST uint kGeometryStageNumBindings = 14u;
+
+// Per-frame view parameters (a readonly std430 storage buffer), one named member per value;
+// each vec3 shares its 16 bytes with the scalar after it (GaussianSplatCommon.h).
+struct GaussianViewParams {
+    // Camera-relative projection: p_cam = R ((p - c_hi) - c_lo) (CameraRelative), exact to
+    // float32 rounding of p - c even 1e5 from the origin, where R p + t loses ~1e-2.
+    vec3 rotation_row0;  // row 0 of R (world to camera)
+    float center_low_x;  // c_lo = float(c - c_hi), the centre's rounding error
+    vec3 rotation_row1;  // row 1 of R
+    float center_low_y;
+    vec3 rotation_row2;  // row 2 of R
+    float center_low_z;
+    vec3 center_high;  // c_hi, the camera centre rounded to float32
+    float reserved0;
+    float fx, fy, cx, cy;  // intrinsics (pixels)
+    float guard_x;         // guard band 1.3 tan(fov_x / 2)
+    float guard_y;         // guard band 1.3 tan(fov_y / 2)
+    float near_plane;
+    float packed_depth_scale;  // packed key's 1 / (far - near); 0 = exact depth order
+    uint width, height, tiles_x, tiles_y;
+    uint entry_capacity;  // tile entries used (<= entry_capacity_allocated)
+    uint max_tiles_per_splat;
+    uint max_tile_entries_total;  // clamped below 2^31
+    uint tile_bits;               // SortKeyTileBits of the tile count
+    uint num_splats;
+    uint sh_degree;  // SH degree evaluated (== kSpecShDegree of the pipeline)
+    uint antialias;  // 0 / 1 (== kSpecAntialias of the pipeline)
+    uint sh_words_per_splat;
+    uint scene_depth_present;  // 0 / 1
+    uint splat_precision;      // kPrecisionExact / kPrecisionCompact
+    uint shape_words_per_splat;
+    uint entry_capacity_allocated;
+    // Row 2 of the original rasterizer's float32 world-to-view matrix [R | t]
+    // (ReferenceViewDepth, ReferenceDepthRow).
+    float reference_m2, reference_m6, reference_m10, reference_m14;
+    uint depth_order;  // kDepthOrderReference / kDepthOrderCameraRelative
+    uint reserved1, reserved2, reserved3;
+};
+
+// One projected splat, written for visible splats only, indexed by splat index (std430).
+struct GaussianProjectedSplat {
+    float center_x, center_y;  // pixels
+    float depth;               // view-space z
+    float opacity;             // antialias applied
+    vec3 conic;                // inverse dilated 2D covariance a, b, c
+    float cull_threshold;      // TileCullThreshold of the splat
+    vec3 color;                // max(0, 0.5 + SH), not clamped above
+    float det_q;               // a c - b^2 of the conic (1 / det of the dilated covariance)
+    uint rect_min;             // tile rect [min, max): x | y << 16
+    uint rect_max;
+    uint num_entries;  // the rect's tiles that TileRowSpan keeps
+    uint radius;       // pixels
+};
+
+#ifdef __cplusplus
+static_assert(sizeof(GaussianViewParams) == 192);
+static_assert(offsetof(GaussianViewParams, rotation_row0) == 0);
+static_assert(offsetof(GaussianViewParams, center_low_x) == 12);
+static_assert(offsetof(GaussianViewParams, rotation_row1) == 16);
+static_assert(offsetof(GaussianViewParams, center_low_y) == 28);
+static_assert(offsetof(GaussianViewParams, rotation_row2) == 32);
+static_assert(offsetof(GaussianViewParams, center_low_z) == 44);
+static_assert(offsetof(GaussianViewParams, center_high) == 48);
+static_assert(offsetof(GaussianViewParams, reserved0) == 60);
+static_assert(offsetof(GaussianViewParams, fx) == 64);
+static_assert(offsetof(GaussianViewParams, fy) == 68);
+static_assert(offsetof(GaussianViewParams, cx) == 72);
+static_assert(offsetof(GaussianViewParams, cy) == 76);
+static_assert(offsetof(GaussianViewParams, guard_x) == 80);
+static_assert(offsetof(GaussianViewParams, guard_y) == 84);
+static_assert(offsetof(GaussianViewParams, near_plane) == 88);
+static_assert(offsetof(GaussianViewParams, packed_depth_scale) == 92);
+static_assert(offsetof(GaussianViewParams, width) == 96);
+static_assert(offsetof(GaussianViewParams, height) == 100);
+static_assert(offsetof(GaussianViewParams, tiles_x) == 104);
+static_assert(offsetof(GaussianViewParams, tiles_y) == 108);
+static_assert(offsetof(GaussianViewParams, entry_capacity) == 112);
+static_assert(offsetof(GaussianViewParams, max_tiles_per_splat) == 116);
+static_assert(offsetof(GaussianViewParams, max_tile_entries_total) == 120);
+static_assert(offsetof(GaussianViewParams, tile_bits) == 124);
+static_assert(offsetof(GaussianViewParams, num_splats) == 128);
+static_assert(offsetof(GaussianViewParams, sh_degree) == 132);
+static_assert(offsetof(GaussianViewParams, antialias) == 136);
+static_assert(offsetof(GaussianViewParams, sh_words_per_splat) == 140);
+static_assert(offsetof(GaussianViewParams, scene_depth_present) == 144);
+static_assert(offsetof(GaussianViewParams, splat_precision) == 148);
+static_assert(offsetof(GaussianViewParams, shape_words_per_splat) == 152);
+static_assert(offsetof(GaussianViewParams, entry_capacity_allocated) == 156);
+static_assert(offsetof(GaussianViewParams, reference_m2) == 160);
+static_assert(offsetof(GaussianViewParams, reference_m6) == 164);
+static_assert(offsetof(GaussianViewParams, reference_m10) == 168);
+static_assert(offsetof(GaussianViewParams, reference_m14) == 172);
+static_assert(offsetof(GaussianViewParams, depth_order) == 176);
+static_assert(offsetof(GaussianViewParams, reserved3) == 188);
+
+static_assert(sizeof(GaussianProjectedSplat) == 64);
+static_assert(offsetof(GaussianProjectedSplat, center_x) == 0);
+static_assert(offsetof(GaussianProjectedSplat, center_y) == 4);
+static_assert(offsetof(GaussianProjectedSplat, depth) == 8);
+static_assert(offsetof(GaussianProjectedSplat, opacity) == 12);
+static_assert(offsetof(GaussianProjectedSplat, conic) == 16);
+static_assert(offsetof(GaussianProjectedSplat, cull_threshold) == 28);
+static_assert(offsetof(GaussianProjectedSplat, color) == 32);
+static_assert(offsetof(GaussianProjectedSplat, det_q) == 44);
+static_assert(offsetof(GaussianProjectedSplat, rect_min) == 48);
+static_assert(offsetof(GaussianProjectedSplat, rect_max) == 52);
+static_assert(offsetof(GaussianProjectedSplat, num_entries) == 56);
+static_assert(offsetof(GaussianProjectedSplat, radius) == 60);
+}  // namespace shader
+}  // namespace rendering
+}  // namespace visualization
+}  // namespace open3d
+#endif  // __cplusplus
+#endif  // OPEN3D_SHADERS_GAUSSIAN_SPLAT_PROJECTION_CONTRACT_H

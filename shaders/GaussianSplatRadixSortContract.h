@@ -1,0 +1,188 @@
+// The radix sort's part of the GPU contract (RadixSort.cpp, shaders/radix_sort_*.comp):
+// digit and block sizes, specialisation constants, the push-descriptor bindings, the
+// GPU-written RadixSortParams (also an indirect dispatch command) and the push constants,
+// and RadixSortParamsFor, which the setup shader and the sort's producers share. A stage of
+// its own because the geometry stage's two sorts and the tests all run it unchanged.
+// GLSL and C++ as GaussianSplatCommon.h says; C++ gets static_asserts on every offset.
+#ifndef OPEN3D_SHADERS_GAUSSIAN_SPLAT_RADIX_SORT_CONTRACT_H
+#define OPEN3D_SHADERS_GAUSSIAN_SPLAT_RADIX_SORT_CONTRACT_H
+
+#include "GaussianSplatCommon.h"
+
+#ifdef __cplusplus
+namespace open3d {
+namespace visualization {
+namespace rendering {
+namespace shader {
+#endif
+
+// ---- Radix sort of (uint32 key, uint32 value) pairs: LSD, 8-bit digits ----
+OPEN3D_SHADER_CONST uint kRadixSortDigitBits = 8u;
+OPEN3D_SHADER_CONST uint kRadixSortBins = 256u;  // 1 << kRadixSortDigitBits
+// The key a first pass with drop_max_keys leaves out (RadixSort::DropMaxKeys).
+OPEN3D_SHADER_CONST uint kRadixSortDroppedKey = 0xFFFFFFFFu;
+// One invocation per bin in the histogram, scan and scatter shaders (asserted below).
+OPEN3D_SHADER_CONST uint kRadixSortWorkgroupSize = 256u;
+// A workgroup owns a block of 256 * chunks elements, chunks = 1..8 chosen per sort by
+// radix_sort_setup.comp from the GPU-side count: the fewest chunks that keep the block count
+// at or below kRadixSortTargetBlocks, so a small sort still spreads over the whole GPU
+// instead of queueing 16 chunks in a handful of workgroups (the H100 sorted 125k depth keys
+// 3x slower with fixed 4096-element blocks). 256 measured best on the H100 (playbot_125k
+// 1080p sort 0.232 ms; 128: 0.249, 1024: 0.252, 2048: 0.263). At most 2048 elements, so
+// that a block fits the scatter's shared memory for its local reorder (radix_sort_scatter).
+OPEN3D_SHADER_CONST uint kRadixSortItemsPerInvocation = 8u;  // chunks per block, at most
+OPEN3D_SHADER_CONST uint kRadixSortBlockSize = 2048u;        // elements per block, at most
+OPEN3D_SHADER_CONST uint kRadixSortTargetBlocks = 256u;      // GPUs; CPU devices use fewer
+// Upper bound of gl_NumSubgroups on any device (the scatter's per-subgroup counts are then
+// [32][128] words, 16 KiB of lavapipe's 32), so RadixSort requires minSubgroupSize >=
+// kRadixSortWorkgroupSize / kRadixSortMaxSubgroups = 8.
+OPEN3D_SHADER_CONST uint kRadixSortMaxSubgroups = 32u;
+// Specialisation constants of the radix-sort shaders, set by RadixSort.cpp per device:
+// the bound of gl_NumSubgroups there (kRadixSortWorkgroupSize / minSubgroupSize; 8 on
+// NVIDIA, whose scatter counts then take 4 KiB), and the scatter's local reorder capacity
+// (kRadixSortBlockSize where its shared arrays fit maxComputeSharedMemorySize, else 1).
+OPEN3D_SHADER_CONST uint kSpecRadixSortSubgroups = 0u;
+OPEN3D_SHADER_CONST uint kSpecRadixSortLocalCapacity = 1u;
+
+// Descriptor set 0 of every radix-sort pipeline (one push-descriptor layout for all).
+OPEN3D_SHADER_CONST uint kRadixSortParamsBinding = 0u;     // RadixSortParams
+OPEN3D_SHADER_CONST uint kRadixSortCountBinding = 1u;      // uint[]: the count producer's buffer
+OPEN3D_SHADER_CONST uint kRadixSortKeysInBinding = 2u;     // uint[max_count]
+OPEN3D_SHADER_CONST uint kRadixSortValuesInBinding = 3u;   // uint[max_count]
+OPEN3D_SHADER_CONST uint kRadixSortKeysOutBinding = 4u;    // uint[max_count]
+OPEN3D_SHADER_CONST uint kRadixSortValuesOutBinding = 5u;  // uint[max_count]
+OPEN3D_SHADER_CONST uint kRadixSortHistogramBinding = 6u;  // uint[bins + bins * max_blocks]
+OPEN3D_SHADER_CONST uint kRadixSortNumBindings = 7u;
+// Most passes one sort records: 32-bit keys.
+OPEN3D_SHADER_CONST uint kRadixSortMaxPasses = 4u;
+
+// Written on the GPU by radix_sort_setup.comp from the element count; the first three
+// members are a VkDispatchIndirectCommand for the per-block passes.
+struct RadixSortParams {
+    uint dispatch_x;  // number of blocks = ceil(count / block_size)
+    uint dispatch_y;  // 1
+    uint dispatch_z;  // 1
+    uint count;       // min(count from the producer, max_count)
+    uint num_blocks;  // == dispatch_x, row stride of the histogram table
+    uint flags;       // kErrorCountsClamped when the producer's count exceeded max_count
+    uint block_size;  // elements per block: kRadixSortWorkgroupSize * (1..16)
+    // Subtracted from every key before its digits are taken; a multiple of kRadixSortBins,
+    // so the first pass's digit is the key's own. Non-zero only with a key range.
+    uint key_base;
+    // With PassCount::kFromKeyRange: the kept keys' smallest and largest key, found by the
+    // first pass's histogram (atomics from ~0u and 0), and from the setup after the first
+    // pass the passes their span needs (1..recorded) and indirect dispatch sizes (x, y, z)
+    // per pass of the histogram and scatter (pass_blocks) and of the row scan (pass_rows),
+    // zero groups for the passes past range_passes, and of the copy that brings an odd
+    // number of passes back to the caller's buffers (copy_blocks). Without it: range
+    // passes 0, every pass's sizes as if it runs, copy_blocks zero groups.
+    uint key_min;
+    uint key_max;
+    uint range_passes;
+    uint reserved0;
+    uvec4 pass_blocks[kRadixSortMaxPasses];
+    uvec4 pass_rows[kRadixSortMaxPasses];
+    uvec4 copy_blocks;
+};
+
+// Push constants of every radix-sort pipeline.
+struct RadixSortPushConstants {
+    uint shift;          // first key bit of this pass's digit
+    uint digit_bits;     // 1..8: bits of this pass's digit (the last pass may be narrower)
+    uint count_index;    // uint index of the count within the count binding
+    uint max_count;      // capacity of the key/value buffers
+    uint target_blocks;  // 1..kRadixSortTargetBlocks: block count the setup aims at
+    uint drop_max_keys;  // 1: this pass leaves out pairs with key kRadixSortDroppedKey
+    // 1: PassCount::kFromKeyRange (the first pass's histogram finds the kept keys' range,
+    // the setup after it decides the passes)
+    uint key_range;
+    uint num_passes;  // passes recorded: ceil(num_bits / 8)
+    // 1: RadixSort::Output::kValuesOnly (the last pass that runs and the copy write no keys)
+    uint values_only;
+    uint reserved0;
+    uint reserved1;
+    uint reserved2;
+};
+
+// ---- Radix sort parameters for an element count ----
+// Clamps the count to max_count (kErrorCountsClamped) and chooses the block size: the
+// fewest chunks of kRadixSortWorkgroupSize that keep the block count at or below
+// target_blocks (clamped to 1..kRadixSortTargetBlocks), 1..kRadixSortItemsPerInvocation
+// chunks. radix_sort_setup.comp calls it, and so does a producer that writes the sort's
+// parameters itself (gaussian_dispatch_args.comp, and GaussianGeometryStage on the host for the
+// depth sort, whose count is N), saving the sort its setup dispatch. No
+// overflow: the host keeps max_count far below 2^32 - kRadixSortBlockSize.
+OPEN3D_SHADER_FUNC RadixSortParams RadixSortParamsFor(uint count, uint max_count,
+                                                      uint target_blocks) {
+    RadixSortParams p;
+    p.flags = 0u;
+    if (count > max_count) {
+        count = max_count;
+        p.flags = kErrorCountsClamped;
+    }
+    uint target = target_blocks < 1u ? 1u : target_blocks;
+    target = target < kRadixSortTargetBlocks ? target : kRadixSortTargetBlocks;
+    uint wave = kRadixSortWorkgroupSize * target;
+    uint chunks = (count + wave - 1u) / wave;
+    chunks = chunks < 1u ? 1u : chunks;
+    chunks = chunks < kRadixSortItemsPerInvocation ? chunks : kRadixSortItemsPerInvocation;
+    p.block_size = kRadixSortWorkgroupSize * chunks;
+    p.num_blocks = (count + p.block_size - 1u) / p.block_size;
+    p.dispatch_x = p.num_blocks;
+    p.dispatch_y = 1u;
+    p.dispatch_z = 1u;
+    p.count = count;
+    p.key_base = 0u;
+    p.key_min = 0xFFFFFFFFu;
+    p.key_max = 0u;
+    p.range_passes = 0u;
+    p.reserved0 = 0u;
+    for (uint pass = 0u; pass < kRadixSortMaxPasses; ++pass) {
+        p.pass_blocks[pass] = uvec4(p.num_blocks, 1u, 1u, 0u);
+        p.pass_rows[pass] = uvec4(kRadixSortBins, 1u, 1u, 0u);
+    }
+    p.copy_blocks = uvec4(0u, 1u, 1u, 0u);
+    return p;
+}
+
+#ifdef __cplusplus
+static_assert(kRadixSortBins == (1u << kRadixSortDigitBits));
+static_assert(kRadixSortWorkgroupSize == kRadixSortBins, "one invocation per bin");
+static_assert(kRadixSortBlockSize == kRadixSortWorkgroupSize * kRadixSortItemsPerInvocation);
+static_assert(kRadixSortWorkgroupSize % kRadixSortMaxSubgroups == 0);
+
+static_assert(sizeof(RadixSortParams) == 192);
+static_assert(offsetof(RadixSortParams, dispatch_x) == 0);
+static_assert(offsetof(RadixSortParams, dispatch_y) == 4);
+static_assert(offsetof(RadixSortParams, dispatch_z) == 8);
+static_assert(offsetof(RadixSortParams, count) == 12);
+static_assert(offsetof(RadixSortParams, num_blocks) == 16);
+static_assert(offsetof(RadixSortParams, flags) == 20);
+static_assert(offsetof(RadixSortParams, block_size) == 24);
+static_assert(offsetof(RadixSortParams, key_base) == 28);
+static_assert(offsetof(RadixSortParams, key_min) == 32);
+static_assert(offsetof(RadixSortParams, key_max) == 36);
+static_assert(offsetof(RadixSortParams, range_passes) == 40);
+static_assert(offsetof(RadixSortParams, pass_blocks) == 48);
+static_assert(offsetof(RadixSortParams, pass_rows) == 112);
+static_assert(offsetof(RadixSortParams, copy_blocks) == 176);
+
+static_assert(sizeof(RadixSortPushConstants) == 48);
+static_assert(offsetof(RadixSortPushConstants, target_blocks) == 16);
+static_assert(offsetof(RadixSortPushConstants, shift) == 0);
+static_assert(offsetof(RadixSortPushConstants, digit_bits) == 4);
+static_assert(offsetof(RadixSortPushConstants, count_index) == 8);
+static_assert(offsetof(RadixSortPushConstants, max_count) == 12);
+static_assert(offsetof(RadixSortPushConstants, drop_max_keys) == 20);
+static_assert(offsetof(RadixSortPushConstants, key_range) == 24);
+static_assert(offsetof(RadixSortPushConstants, num_passes) == 28);
+static_assert(offsetof(RadixSortPushConstants, values_only) == 32);
+static_assert(offsetof(RadixSortPushConstants, reserved2) == 44);
+static_assert(offsetof(RadixSortParams, reserved0) == 44);
+
+}  // namespace shader
+}  // namespace rendering
+}  // namespace visualization
+}  // namespace open3d
+#endif  // __cplusplus
+#endif  // OPEN3D_SHADERS_GAUSSIAN_SPLAT_RADIX_SORT_CONTRACT_H
