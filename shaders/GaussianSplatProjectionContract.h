@@ -112,6 +112,44 @@ struct GaussianProjectedSplat {
     uint radius;       // pixels
 };
 
+// How the shaders store a GaussianProjectedSplat: the same 64 bytes as four 16-byte words,
+// so the projection writes it and the emit and composite passes read it with 128-bit
+// accesses. Stored member by member, the projection took 1.5-1.8x the time on the H200
+// (playbot_125k 0.026 -> 0.038 ms, the 7x7 grid 0.415 -> 0.765 ms; docs/perf/h200.md).
+// Shaders go through PackProjectedSplat / UnpackProjectedSplat only.
+struct GaussianProjectedWords {
+    vec4 center_depth_opacity;
+    vec4 conic_cull;
+    vec4 color_det;
+    uvec4 tiles;
+};
+#ifndef __cplusplus
+GaussianProjectedWords PackProjectedSplat(GaussianProjectedSplat s) {
+    GaussianProjectedWords w;
+    w.center_depth_opacity = vec4(s.center_x, s.center_y, s.depth, s.opacity);
+    w.conic_cull = vec4(s.conic, s.cull_threshold);
+    w.color_det = vec4(s.color, s.det_q);
+    w.tiles = uvec4(s.rect_min, s.rect_max, s.num_entries, s.radius);
+    return w;
+}
+GaussianProjectedSplat UnpackProjectedSplat(GaussianProjectedWords w) {
+    GaussianProjectedSplat s;
+    s.center_x = w.center_depth_opacity.x;
+    s.center_y = w.center_depth_opacity.y;
+    s.depth = w.center_depth_opacity.z;
+    s.opacity = w.center_depth_opacity.w;
+    s.conic = w.conic_cull.xyz;
+    s.cull_threshold = w.conic_cull.w;
+    s.color = w.color_det.xyz;
+    s.det_q = w.color_det.w;
+    s.rect_min = w.tiles.x;
+    s.rect_max = w.tiles.y;
+    s.num_entries = w.tiles.z;
+    s.radius = w.tiles.w;
+    return s;
+}
+#endif
+
 #ifdef __cplusplus
 static_assert(sizeof(GaussianViewParams) == 192);
 static_assert(offsetof(GaussianViewParams, rotation_row0) == 0);
@@ -166,6 +204,8 @@ static_assert(offsetof(GaussianProjectedSplat, rect_min) == 48);
 static_assert(offsetof(GaussianProjectedSplat, rect_max) == 52);
 static_assert(offsetof(GaussianProjectedSplat, num_entries) == 56);
 static_assert(offsetof(GaussianProjectedSplat, radius) == 60);
+// The words hold the members at these same offsets (PackProjectedSplat above).
+static_assert(sizeof(GaussianProjectedWords) == sizeof(GaussianProjectedSplat));
 }  // namespace shader
 }  // namespace rendering
 }  // namespace visualization

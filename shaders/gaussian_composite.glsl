@@ -40,7 +40,7 @@ layout(push_constant, std430) uniform PushConstantsBlock {
 };
 
 layout(std430, set = 0, binding = kCompositeProjectedBinding) readonly buffer ProjectedBlock {
-    GaussianProjectedSplat projected[];
+    GaussianProjectedWords projected[];
 };
 layout(std430, set = 0, binding = kCompositeEntryValuesBinding) readonly buffer ValuesBlock {
     uint entry_values[];  // splat index, front to back inside a tile
@@ -234,7 +234,7 @@ uint CompositeTile(uint tile, uvec2 range, uint next_index, uvec2 upcoming, uint
         uint entry = batch + slot;
         uint mask = 0u;
         if (entry < end) {
-            GaussianProjectedSplat splat = projected[next_index];
+            GaussianProjectedSplat splat = UnpackProjectedSplat(projected[next_index]);
             if (entry + kCompositeBatchSize < end) {
                 next_index = entry_values[entry + kCompositeBatchSize];
             }

@@ -20,7 +20,7 @@ layout(std430, set = 0, binding = kGeometryStageViewBinding) readonly buffer Vie
     GaussianViewParams view;
 };
 layout(std430, set = 0, binding = kGeometryStageProjectedBinding) readonly buffer ProjectedBlock {
-    GaussianProjectedSplat projected[];
+    GaussianProjectedWords projected[];
 };
 layout(std430, set = 0, binding = kGeometryStageCountersBinding) readonly buffer CountersBlock {
     GaussianGeometryStageCounters counters;
@@ -62,13 +62,15 @@ void main() {
     uint end = k + 1u < visible ? ScanOffset(k + 1u) : counters.requested_entries;
     if (end > view.entry_capacity || end == begin) return;
     uint splat = ListValueSplat(splat_indices[k], view.num_splats);
-    uint rect_min = projected[splat].rect_min, rect_max = projected[splat].rect_max;
+    // Only the words of the members used are loaded: the rest of an unpacked record is dead.
+    GaussianProjectedSplat record = UnpackProjectedSplat(projected[splat]);
+    uint rect_min = record.rect_min, rect_max = record.rect_max;
     uint min_x = rect_min & 0xFFFFu, min_y = rect_min >> 16u;
     uint max_x = rect_max & 0xFFFFu, max_y = rect_max >> 16u;
     uint tiles_x = view.tiles_x;
     // The same float32 view depth the exact order sorts by (the projection's output).
     float norm_depth = kEmitMode == kEmitPackedKeys
-                           ? PackedSortKeyDepth(projected[splat].depth,
+                           ? PackedSortKeyDepth(record.depth,
                                                 view.near_plane, view.packed_depth_scale)
                            : 0.0;
     uint tile_bits = view.tile_bits;
@@ -82,10 +84,11 @@ void main() {
     float cull_t = 0.0;
     float det_q = 0.0;
     if (!whole_rect) {
-        center = vec2(projected[splat].center_x, projected[splat].center_y);
-        conic = projected[splat].conic;
-        cull_t = projected[splat].cull_threshold;
-        det_q = projected[splat].det_q;
+        GaussianProjectedSplat shape = UnpackProjectedSplat(projected[splat]);  // loaded here only
+        center = vec2(shape.center_x, shape.center_y);
+        conic = shape.conic;
+        cull_t = shape.cull_threshold;
+        det_q = shape.det_q;
     }
     uint out_index = begin;
     for (uint ty = min_y; ty < max_y && out_index < end; ++ty) {

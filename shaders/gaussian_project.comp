@@ -45,7 +45,7 @@ layout(std430, set = 0, binding = kGeometryStageVisibilityBinding) readonly buff
     uint visibility[];
 };
 layout(std430, set = 0, binding = kGeometryStageProjectedBinding) writeonly buffer ProjectedBlock {
-    GaussianProjectedSplat projected[];
+    GaussianProjectedWords projected[];
 };
 layout(std430, set = 0, binding = kGeometryStageCountersBinding) buffer CountersBlock {
     GaussianGeometryStageCounters counters;
@@ -285,7 +285,7 @@ bool Project(uint i, out float depth, out uint entries) {
     out_splat.rect_max = rect_max.x | (rect_max.y << 16u);
     out_splat.num_entries = num_tiles;
     out_splat.radius = radius;
-    projected[i] = out_splat;
+    projected[i] = PackProjectedSplat(out_splat);
     tile_counts[i] = num_tiles;
     depth = order_depth;
     entries = num_tiles;
