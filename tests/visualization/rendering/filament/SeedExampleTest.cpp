@@ -4,13 +4,9 @@
 // OPEN3D_TEST_GENERATE_REFERENCE=1; on a mismatch actual.png and diff.png are written).
 #include <gtest/gtest.h>
 
-#include <cstdlib>
-#include <filesystem>
-
+#include "GoldenImage.h"
 #include "TestUtility.h"
-#include "open3d/t/geometry/ImageMetrics.h"
 #include "open3d/t/geometry/TriangleMesh.h"
-#include "open3d/t/io/ImageIO.h"
 #include "open3d/visualization/rendering/filament/OffscreenRenderer.h"
 #include "visualization/rendering/filament/FilamentTestFixture.h"
 
@@ -50,30 +46,10 @@ TEST_F(SeedExample, OffscreenRendererWithMaterialRecordsMatchesItsGolden) {
     EXPECT_NEAR(depth.At<float>(2, 2, 0), near / 4.0f, 1e-6f);  // top left: the wall
     EXPECT_NEAR(z.At<float>(2, 2, 0), 4.0f, 1e-3f);
 
-    const std::string golden_path = std::string(OPEN3D_TEST_SOURCE_DIR) +
-                                    "/visualization/rendering/filament/golden/"
-                                    "seed_example_48x32.png";
-    const char* generate = std::getenv("OPEN3D_TEST_GENERATE_REFERENCE");
-    if (generate && std::string(generate) == "1") {
-        t::io::WritePNG(golden_path, actual);
-        GTEST_SKIP() << "regenerated " << golden_path;
-    }
-    ASSERT_TRUE(std::filesystem::exists(golden_path))
-        << golden_path << " is missing: run with OPEN3D_TEST_GENERATE_REFERENCE=1";
-    const t::geometry::Image golden = t::io::ReadPNG(golden_path);
-    ASSERT_EQ(golden.AsTensor().GetShape(), actual.AsTensor().GetShape());
     // 5 LSB per channel, as the other golden: RGBA16F sharing and other GPUs' float
     // rounding move splat pixels by 1-2; a moved mesh edge or lost lighting moves ~100.
-    const auto m = t::geometry::ComputeImageErrorMetrics(actual, golden, 255.0, 0.0);
-    if (m.max_abs_error > 5.0) {
-        const std::string dir = TempDir();
-        t::io::WritePNG(dir + "/actual.png", actual);
-        t::io::WritePNG(
-            dir + "/diff.png",
-            t::geometry::ComputeAbsDifference(actual, golden).ToUInt8(255.0 / m.max_abs_error));
-        ADD_FAILURE() << "max error " << m.max_abs_error << " LSB, PSNR " << m.psnr_db
-                      << " dB; actual and diff (scaled) written to " << dir;
-    }
+    ExpectMatchesGolden(actual, "visualization/rendering/filament/golden/seed_example_48x32.png",
+                        5.0);
 }
 
 }  // namespace
