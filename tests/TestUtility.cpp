@@ -15,6 +15,11 @@ std::string DataPath(const std::string& relative) { return DataDir() + "/" + rel
 
 bool FileExists(const std::string& path) { return std::filesystem::exists(path); }
 
+bool SkipsAreFailures() {
+    const char* ci = std::getenv("CI");
+    return ci != nullptr && std::string(ci) == "true";
+}
+
 std::string TempDir() {
     const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
     std::string name = info ? std::string(info->test_suite_name()) + "." + info->name() : "misc";

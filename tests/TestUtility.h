@@ -1,4 +1,5 @@
-// Shared helpers for tests: where the shared scenes are, temporary files.
+// Shared helpers for tests: where the shared scenes are, temporary files, and the one rule
+// for tests that cannot run here (skip locally, fail in CI).
 #pragma once
 
 #include <gtest/gtest.h>
@@ -16,15 +17,32 @@ std::string DataPath(const std::string& relative);
 bool FileExists(const std::string& path);
 /// A fresh, empty folder for this test under $TMPDIR/open3d_tests (left for inspection).
 std::string TempDir();
+/// True in CI (environment CI=true): there a test that lacks an X display, a Vulkan device,
+/// a tool or a shared scene fails instead of skipping, so the suite cannot pass by skipping.
+bool SkipsAreFailures();
 
 }  // namespace tests
 }  // namespace open3d
 
-/// Skips the current test with a clear message when a shared scene is absent.
-#define OPEN3D_REQUIRE_DATA(relative)                                                     \
-    do {                                                                                  \
-        if (!::open3d::tests::FileExists(::open3d::tests::DataPath(relative))) {          \
-            GTEST_SKIP() << "shared scene " << ::open3d::tests::DataPath(relative)        \
-                         << " is absent (tests read ../shared/data beside the checkout)"; \
-        }                                                                                 \
+/// Ends the current test (or SetUp) because something it needs is unavailable: a skip
+/// with `reason` (a std::string) normally, a failure with it in CI (SkipsAreFailures).
+/// Every skip for a missing display, device, tool or shared scene goes through here;
+/// scripts/test.sh lists the skips of a local run.
+#define OPEN3D_SKIP_OR_FAIL_WHEN_UNAVAILABLE(reason)                                        \
+    do {                                                                                    \
+        const std::string open3d_unavailable_reason_ = (reason);                            \
+        if (::open3d::tests::SkipsAreFailures()) {                                          \
+            FAIL() << "CI=true, so this test may not skip: " << open3d_unavailable_reason_; \
+        }                                                                                   \
+        GTEST_SKIP() << open3d_unavailable_reason_;                                         \
+    } while (0)
+
+/// Skips (fails in CI) the current test with a clear message when a shared scene is absent.
+#define OPEN3D_REQUIRE_DATA(relative)                                            \
+    do {                                                                         \
+        if (!::open3d::tests::FileExists(::open3d::tests::DataPath(relative))) { \
+            OPEN3D_SKIP_OR_FAIL_WHEN_UNAVAILABLE(                                \
+                "shared scene " + ::open3d::tests::DataPath(relative) +          \
+                " is absent (tests read ../shared/data beside the checkout)");   \
+        }                                                                        \
     } while (0)

@@ -19,6 +19,7 @@
 #include "open3d/core/ParallelFor.h"
 #include "open3d/core/Timer.h"
 #include "open3d/t/geometry/ImageMetrics.h"
+#include "open3d/t/io/OutputFiles.h"
 #include "open3d/t/io/PointCloudIO.h"
 #include "open3d/visualization/rendering/gaussian_splat/GaussianSplatBackend.h"
 #include "open3d/visualization/rendering/gaussian_splat/cpu/CpuBackend.h"
@@ -213,7 +214,26 @@ void PrintTable(const std::vector<Row>& rows) {
     }
 }
 
+// Writes the rows as JSON through a temporary renamed when complete, so a failed write
+// (a full disk) fails the run and leaves no truncated file.
+void WriteJson(const std::string& path, const nlohmann::json& rows) {
+    t::io::OutputFileSet files;
+    const std::string temporary = files.Add(path);
+    std::ofstream out(temporary);
+    out << rows.dump(2) << "\n";
+    out.close();
+    if (!out) core::ThrowError("--json '{}': writing failed", path);
+    files.Commit();
+}
+
 int Run(const Options& opt) {
+    // The JSON output is checked before minutes of benchmarking, not after them.
+    if (!opt.json.empty()) {
+        if (t::io::LowerCaseExtension(opt.json) != "json") {
+            core::ThrowError("--json '{}': the file name must end in .json", opt.json);
+        }
+        t::io::CheckOutputPath("--json", opt.json);
+    }
     rendering::vulkan::RegisterVulkanBackend();
     std::vector<SceneJob> jobs;
     if (opt.inputs.empty()) core::ThrowError("--input is required (a .ply or .splat scene)");
@@ -222,6 +242,7 @@ int Run(const Options& opt) {
             core::ThrowError("--grid needs --cameras (view 0 sets the rotation)");
         t::geometry::PointCloud tile;
         t::io::ReadPointCloud(opt.inputs[0], tile);
+        t::io::RequireGaussianSplat(opt.inputs[0], tile);
         const auto view = camera::ReadCamerasJson(opt.cameras[0]).at(0).camera;
         double spacing = 0;
         SceneJob job;
@@ -241,6 +262,7 @@ int Run(const Options& opt) {
         for (size_t i = 0; i < opt.inputs.size(); ++i) {
             SceneJob job;
             t::io::ReadPointCloud(opt.inputs[i], job.cloud);
+            t::io::RequireGaussianSplat(opt.inputs[i], job.cloud);
             job.name = std::filesystem::path(opt.inputs[i]).filename().string();
             std::vector<camera::PinholeCamera> views;
             for (const auto& v : camera::ReadCamerasJson(opt.cameras[i])) views.push_back(v.camera);
@@ -371,7 +393,7 @@ int Run(const Options& opt) {
                 out.back()["p999_abs_error"] = r.p999;
             }
         }
-        std::ofstream(opt.json) << out.dump(2) << "\n";
+        WriteJson(opt.json, out);
         std::printf("\nwrote %s\n", opt.json.c_str());
     }
     return 0;
@@ -403,7 +425,9 @@ int main(int argc, char** argv) {
         ->capture_default_str();
     app.add_option("--grid", opt.grid, "Tiled large scene: K x K copies of the first input")
         ->check(CLI::Range(1, 64));
-    app.add_option("--json", opt.json, "Write machine-readable results here");
+    app.add_option("--json", opt.json,
+                   "Write machine-readable results here (.json; its folder must exist, checked "
+                   "before any work; a failed write fails the run)");
     app.add_option("--repeat", opt.repeat,
                    "Timed frames per view and knob (medians, after warm-up frames until the GPU "
                    "time settles)")

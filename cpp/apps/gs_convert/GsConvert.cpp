@@ -9,6 +9,7 @@
 
 #include "open3d/core/Exception.h"
 #include "open3d/core/Timer.h"
+#include "open3d/t/io/OutputFiles.h"
 #include "open3d/t/io/PointCloudIO.h"
 
 int main(int argc, char** argv) {
@@ -24,12 +25,19 @@ int main(int argc, char** argv) {
         "docs/formats.md gives the error of each.",
         "gs-convert"};
     app.add_option("input", input, "Scene to read")->required();
-    app.add_option("output", output, "File to write; its extension chooses the format")->required();
+    app.add_option("output", output,
+                   "File to write; its extension chooses the format. Its folder must exist; the "
+                   "file appears only once it is complete")
+        ->required();
     app.add_flag("--drop-non-finite", drop_non_finite,
                  "Drop splats with NaN or Inf values instead of refusing the file");
     app.add_flag("-f,--force", force, "Overwrite the output if it exists");
     CLI11_PARSE(app, argc, argv);
     try {
+        // The output is checked before the input is read: a bad extension or folder fails
+        // at once, not after a large scene has been decoded.
+        t::io::PointCloudFileFormatForWriting(output);
+        t::io::CheckOutputPath("output", output);
         std::error_code ec;
         if (!force && std::filesystem::exists(output, ec)) {
             core::ThrowError("'{}' exists; pass --force to overwrite it", output);
@@ -44,7 +52,11 @@ int main(int argc, char** argv) {
                     t::io::PointCloudFileFormatName(format),
                     static_cast<long long>(report.num_points),
                     cloud.IsGaussianSplat() ? cloud.GetGaussianSplatArrays().sh_degree : 0);
-        t::io::WritePointCloud(output, cloud);
+        // Written beside the output and renamed when complete: a failed write leaves no
+        // partial file, and --force onto the input never truncates what is being read.
+        t::io::OutputFileSet files;
+        t::io::WritePointCloud(files.Add(output), cloud);
+        files.Commit();
         std::printf("wrote %s (%llu bytes) in %.0f ms\n", output.c_str(),
                     static_cast<unsigned long long>(std::filesystem::file_size(output)),
                     core::MillisecondsSince(start));

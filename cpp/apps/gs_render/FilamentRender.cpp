@@ -1,9 +1,9 @@
 #include "FilamentRender.h"
 
 #include <cstdio>
+#include <utility>
 
 #include "open3d/t/geometry/TriangleMesh.h"
-#include "open3d/t/io/ImageIO.h"
 #include "open3d/visualization/rendering/filament/FilamentEngine.h"
 #include "open3d/visualization/rendering/filament/Open3DScene.h"
 
@@ -12,9 +12,10 @@ namespace gs_render {
 namespace rendering = open3d::visualization::rendering;
 using namespace open3d;
 
-void RenderWithFilament(const t::geometry::PointCloud& cloud, const camera::PinholeCamera& camera,
-                        const rendering::RenderConfig& config,
-                        const FilamentRenderOptions& options) {
+FilamentImages RenderWithFilament(const t::geometry::PointCloud& cloud,
+                                  const camera::PinholeCamera& camera,
+                                  const rendering::RenderConfig& config,
+                                  const FilamentRenderOptions& options) {
     rendering::FilamentEngine engine;
     rendering::FilamentRenderer renderer(engine);
     rendering::Open3DSceneOptions scene_options;
@@ -68,17 +69,10 @@ void RenderWithFilament(const t::geometry::PointCloud& cloud, const camera::Pinh
         n, sum.total_ms / n, sum.geometry_stage_ms / n, sum.filament_ms / n,
         sum.composite_stage_ms / n, sum.readback_ms / n, last.splat_stats.gpu_project_ms,
         last.splat_stats.gpu_sort_ms, last.splat_stats.gpu_composite_ms);
-    t::io::WriteImage(options.output, image);
-    std::printf("wrote %s\n", options.output.c_str());
-    if (!options.depth_output.empty()) {
-        const t::geometry::Image depth = scene.RenderToDepthImage();
-        if (options.depth_output.ends_with(".npy")) {
-            t::io::WriteNpy(options.depth_output, depth);
-        } else {
-            t::io::WritePNG16(options.depth_output, depth, options.depth_scale);
-        }
-        std::printf("wrote %s (merged splat and mesh depth)\n", options.depth_output.c_str());
-    }
+    FilamentImages images;
+    images.color = std::move(image);
+    if (options.depth) images.depth = scene.RenderToDepthImage();
+    return images;
 }
 
 }  // namespace gs_render

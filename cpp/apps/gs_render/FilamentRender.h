@@ -1,6 +1,7 @@
 // gs-render's Filament path (--sphere, --filament): the splats and an optional red sphere
 // through the whole integration (Open3DScene: Filament meshes, Vulkan geometry and composite stages
-// with the depth test, the blend), with the time of each part of the frame.
+// with the depth test, the blend), with the time of each part of the frame. The images come
+// back to gs-render, which writes every output the same way (temporaries, then renames).
 #pragma once
 
 #include <Eigen/Core>
@@ -8,6 +9,7 @@
 #include <string>
 
 #include "open3d/camera/PinholeCamera.h"
+#include "open3d/t/geometry/Image.h"
 #include "open3d/t/geometry/PointCloud.h"
 #include "open3d/visualization/rendering/gaussian_splat/RenderConfig.h"
 
@@ -19,17 +21,21 @@ struct FilamentRenderOptions {
     Eigen::Vector3d sphere_center = Eigen::Vector3d::Zero();
     double sphere_radius = 1.0;
     Eigen::Vector3d background = Eigen::Vector3d::Zero();
-    int frames = 1;  ///< frames rendered; times are averaged over all but the first
-    std::string output;
-    std::string depth_output;  ///< .png (16-bit, z * depth_scale) or .npy (float)
-    double depth_scale = 1000.0;
+    int frames = 1;      ///< frames rendered; times are averaged over all but the first
+    bool depth = false;  ///< also render the merged splat and mesh depth
 };
 
-/// Renders and writes the images; prints the frame time split into geometry stage, Filament,
-/// Composite stage and readback. Throws core::Open3DError (e.g. no X server: run under xvfb-run).
-void RenderWithFilament(const open3d::t::geometry::PointCloud& cloud,
-                        const open3d::camera::PinholeCamera& camera,
-                        const open3d::visualization::rendering::RenderConfig& config,
-                        const FilamentRenderOptions& options);
+struct FilamentImages {
+    open3d::t::geometry::Image color;  ///< UInt8 [H, W, 3]
+    open3d::t::geometry::Image depth;  ///< Float32 [H, W, 1] view z, 0 where nothing is; empty
+                                       ///< unless FilamentRenderOptions::depth
+};
+
+/// Renders the images; prints the frame time split into geometry stage, Filament, composite
+/// stage and readback. Throws core::Open3DError (e.g. no X server: run under xvfb-run).
+FilamentImages RenderWithFilament(const open3d::t::geometry::PointCloud& cloud,
+                                  const open3d::camera::PinholeCamera& camera,
+                                  const open3d::visualization::rendering::RenderConfig& config,
+                                  const FilamentRenderOptions& options);
 
 }  // namespace gs_render

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <optional>
 #include <string>
 #include <vector>
@@ -16,6 +17,7 @@
 #include "open3d/core/Timer.h"
 #include "open3d/t/geometry/PointCloudStatistics.h"
 #include "open3d/t/io/ImageIO.h"
+#include "open3d/t/io/OutputFiles.h"
 #include "open3d/t/io/PointCloudIO.h"
 #include "open3d/visualization/rendering/gaussian_splat/DefaultScene.h"
 #include "open3d/visualization/rendering/gaussian_splat/GaussianSplatBackend.h"
@@ -54,6 +56,101 @@ struct Options {
 };
 
 Eigen::Vector3d ToVec(const std::vector<double>& v) { return Eigen::Vector3d(v[0], v[1], v[2]); }
+
+// A number check that states the accepted range in words: CLI::PositiveNumber printed
+// "[2.22507e-308 - 1.79769e+308]" with every digit of the double limits.
+CLI::Validator NumberCheck(bool (*accept)(double), const std::string& requirement,
+                           const std::string& help) {
+    return CLI::Validator(
+        [accept, requirement](std::string& text) -> std::string {
+            char* end = nullptr;
+            const double v = std::strtod(text.c_str(), &end);
+            if (text.empty() || *end != '\0' || !accept(v)) {
+                return "'" + text + "' " + requirement;
+            }
+            return "";
+        },
+        help);
+}
+const CLI::Validator kPositive =
+    NumberCheck([](double v) { return v > 0.0; }, "must be > 0", "POSITIVE");
+const CLI::Validator kUnit =
+    NumberCheck([](double v) { return v >= 0.0 && v <= 1.0; }, "must be in 0..1", "0..1");
+
+// Every output is checked before the scene is read: a run that cannot write its result
+// fails at once instead of after loading and rendering, and the extension decides the
+// format (a .jpg depth output was written as PNG bytes).
+void CheckOutputs(const Options& opt) {
+    struct Output {
+        const char* flag;
+        const std::string& path;
+        std::vector<std::string> extensions;
+        const char* formats;
+    };
+    const std::vector<Output> outputs = {
+        {"-o/--output", opt.output, {"png", "npy"}, ".png (8-bit RGB) or .npy (float RGB)"},
+        {"--depth-output",
+         opt.depth_output,
+         {"png", "npy"},
+         ".png (16-bit, view z * --depth-scale) or .npy (float view z)"},
+        {"--float-output", opt.float_output, {"npy"}, ".npy (premultiplied RGBA float32)"},
+    };
+    for (size_t i = 0; i < outputs.size(); ++i) {
+        const Output& o = outputs[i];
+        if (o.path.empty() && i > 0) continue;  // optional outputs not asked for
+        t::io::CheckOutputPath(o.flag, o.path);
+        const std::string ext = t::io::LowerCaseExtension(o.path);
+        if (std::find(o.extensions.begin(), o.extensions.end(), ext) == o.extensions.end()) {
+            core::ThrowError("{} '{}': unknown extension '{}'; use {}", o.flag, o.path,
+                             ext.empty() ? "(none)" : "." + ext, o.formats);
+        }
+        for (size_t j = 0; j < i; ++j) {
+            if (!outputs[j].path.empty() && t::io::SameOutputPath(o.path, outputs[j].path)) {
+                core::ThrowError("{} and {} are the same file '{}'; give each its own path",
+                                 outputs[j].flag, o.flag, o.path);
+            }
+        }
+    }
+    if (!opt.float_output.empty() && (opt.filament || opt.sphere)) {
+        core::ThrowError(
+            "--float-output is not available with --filament/--sphere (the Filament path "
+            "returns 8-bit colour)");
+    }
+}
+
+// Writes every requested image to a temporary beside its output, then renames them all:
+// a failing write leaves neither a partial file nor some of the outputs without the rest.
+void WriteOutputs(const Options& opt, const t::geometry::Image& color,
+                  const t::geometry::Image* depth, const std::string& depth_what,
+                  const t::geometry::Image* float_color) {
+    t::io::OutputFileSet files;
+    t::io::WriteImage(files.Add(opt.output), color);
+    int64_t saturated = 0;
+    const bool depth_npy = t::io::LowerCaseExtension(opt.depth_output) == "npy";
+    if (depth != nullptr) {
+        if (depth_npy) {
+            t::io::WriteNpy(files.Add(opt.depth_output), *depth);
+        } else {
+            saturated = t::io::WritePNG16(files.Add(opt.depth_output), *depth, opt.depth_scale);
+        }
+    }
+    if (float_color != nullptr) t::io::WriteNpy(files.Add(opt.float_output), *float_color);
+    files.Commit();
+    std::printf("wrote %s\n", opt.output.c_str());
+    if (depth != nullptr) {
+        std::printf("wrote %s (%s)\n", opt.depth_output.c_str(), depth_what.c_str());
+        if (saturated > 0) {
+            std::fprintf(stderr,
+                         "gs-render: warning: %lld of %lld depth pixels are farther than %g "
+                         "scene units (65535 / --depth-scale %g) and were saturated to 65535 in "
+                         "'%s'; lower --depth-scale or write .npy for exact depths\n",
+                         static_cast<long long>(saturated),
+                         static_cast<long long>(depth->NumPixels()), 65535.0 / opt.depth_scale,
+                         opt.depth_scale, opt.depth_output.c_str());
+        }
+    }
+    if (float_color != nullptr) std::printf("wrote %s (float RGBA)\n", opt.float_output.c_str());
+}
 
 camera::PinholeCamera ChooseCamera(const Options& opt, const t::geometry::PointCloud& cloud,
                                    bool default_scene) {
@@ -112,6 +209,7 @@ camera::PinholeCamera ChooseCamera(const Options& opt, const t::geometry::PointC
 }
 
 int Run(const Options& opt) {
+    CheckOutputs(opt);
     rendering::vulkan::RegisterVulkanBackend();
     const auto start = std::chrono::steady_clock::now();
     t::geometry::PointCloud cloud;
@@ -120,6 +218,7 @@ int Run(const Options& opt) {
         cloud = rendering::CreateDefaultGaussianSplatScene();
     } else {
         t::io::ReadPointCloud(opt.input, cloud);
+        t::io::RequireGaussianSplat(opt.input, cloud);
     }
     const double load_ms = core::MillisecondsSince(start);
     std::printf("scene: %s, %lld splats, SH degree %d, loaded in %.1f ms\n",
@@ -162,11 +261,12 @@ int Run(const Options& opt) {
                                                                  cloud, fo.sphere_center, 0.8));
         fo.background = config.background;
         fo.frames = opt.frames;
-        fo.output = opt.output;
-        fo.depth_output = opt.depth_output;
-        fo.depth_scale = opt.depth_scale;
+        fo.depth = !opt.depth_output.empty();
         backend.reset();  // the Filament scene makes its own
-        gs_render::RenderWithFilament(cloud, cam, config, fo);
+        const gs_render::FilamentImages images =
+            gs_render::RenderWithFilament(cloud, cam, config, fo);
+        WriteOutputs(opt, images.color, fo.depth ? &images.depth : nullptr,
+                     "merged splat and mesh depth", nullptr);
         std::printf("total time %.1f ms\n", core::MillisecondsSince(start));
         return 0;
     }
@@ -191,21 +291,9 @@ int Run(const Options& opt) {
         static_cast<long long>(s.num_visible), static_cast<long long>(s.num_tile_entries),
         s.error_flags ? ", ENTRIES DROPPED: raise the capacity limits" : "");
 
-    t::io::WriteImage(opt.output, out.color.SelectChannels(0, 3));
-    std::printf("wrote %s\n", opt.output.c_str());
-    if (!opt.depth_output.empty()) {
-        const auto& depth = opt.depth_kind == "median" ? out.depth_median : out.depth_expected;
-        if (opt.depth_output.ends_with(".npy")) {
-            t::io::WriteNpy(opt.depth_output, depth);
-        } else {
-            t::io::WritePNG16(opt.depth_output, depth, opt.depth_scale);
-        }
-        std::printf("wrote %s (%s depth)\n", opt.depth_output.c_str(), opt.depth_kind.c_str());
-    }
-    if (!opt.float_output.empty()) {
-        t::io::WriteNpy(opt.float_output, out.color);
-        std::printf("wrote %s (float RGBA)\n", opt.float_output.c_str());
-    }
+    const auto& depth = opt.depth_kind == "median" ? out.depth_median : out.depth_expected;
+    WriteOutputs(opt, out.color.SelectChannels(0, 3), opt.depth_output.empty() ? nullptr : &depth,
+                 opt.depth_kind + " depth", opt.float_output.empty() ? nullptr : &out.color);
     std::printf("total time %.1f ms\n", core::MillisecondsSince(start));
     return 0;
 }
@@ -240,16 +328,21 @@ int main(int argc, char** argv) {
                        "device exists, unless given explicitly)")
             ->check(CLI::IsMember({"cpu", "vulkan", "placeholder"}))
             ->capture_default_str();
-    app.add_option("-o,--output", opt.output, "Colour image: .png (RGB8) or .npy (float RGB)")
+    app.add_option("-o,--output", opt.output,
+                   "Colour image: .png (RGB8) or .npy (float RGB); other extensions are refused. "
+                   "Every output's folder must exist; outputs appear only when all are written")
         ->capture_default_str();
     app.add_option("--depth-output", opt.depth_output,
-                   "Depth image: .png (16-bit, view z * --depth-scale) or .npy (float)");
+                   "Depth image: .png (16-bit, view z * --depth-scale) or .npy (float); not the "
+                   "same file as --output");
     app.add_option("--depth-kind", opt.depth_kind,
                    "expected: alpha-weighted mean z; median: z where alpha reaches 50%")
         ->check(CLI::IsMember({"expected", "median"}))
         ->capture_default_str();
-    app.add_option("--depth-scale", opt.depth_scale, "16-bit depth PNG units per scene unit")
-        ->check(CLI::PositiveNumber)
+    app.add_option("--depth-scale", opt.depth_scale,
+                   "16-bit depth PNG units per scene unit; depths beyond 65535 / scale saturate "
+                   "to 65535 (a warning gives the count)")
+        ->check(kPositive)
         ->capture_default_str();
     app.add_option("--float-output", opt.float_output, "Premultiplied RGBA float32 dump (.npy)");
     app.add_option("--sh-degree", opt.sh_degree, "Highest SH degree evaluated")
@@ -259,9 +352,10 @@ int main(int argc, char** argv) {
     app.add_option("--background", opt.background,
                    "Background colour r,g,b in 0..1 (default 0,0,0)")
         ->delimiter(',')
-        ->expected(3);
+        ->expected(3)
+        ->check(kUnit);
     app.add_option("--near", opt.near_plane, "Near cull distance (view z)")
-        ->check(CLI::PositiveNumber)
+        ->check(kPositive)
         ->capture_default_str();
     app.add_option("--depth-order", opt.depth_order,
                    "Depth that orders splats: reference (the original 3DGS rasterizer's float32 "
@@ -285,7 +379,7 @@ int main(int argc, char** argv) {
     app.add_option("--sphere-radius", opt.sphere_radius,
                    "Sphere radius (default: 0.3 x the 80th-percentile splat distance from the "
                    "centre; the default scene has its own place for the sphere)")
-        ->check(CLI::PositiveNumber);
+        ->check(kPositive);
     app.add_option("--frames", opt.frames,
                    "With --filament/--sphere: render this many frames, each running the whole "
                    "pipeline, and print the mean time of all but the first")

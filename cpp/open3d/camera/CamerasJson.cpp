@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "open3d/core/Exception.h"
+#include "open3d/core/RegularFile.h"
 
 namespace open3d {
 namespace camera {
@@ -112,6 +113,7 @@ std::vector<CameraView> ParseCamerasJson(const std::string& text, const std::str
 }
 
 std::vector<CameraView> ReadCamerasJson(const std::string& filename) {
+    core::RequireRegularFile(filename);
     std::ifstream in(filename, std::ios::binary);
     if (!in) core::ThrowError("cannot open cameras file '{}'", filename);
     std::stringstream buffer;

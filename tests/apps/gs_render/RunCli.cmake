@@ -1,7 +1,11 @@
-# Runs one gs-render command line and checks its exit status and output.
+# Runs one command line and checks its exit status and output (gs-render's, gs-convert's and
+# gs-bench's checks share it).
 # -DEXE=path -DARGS="a|b|c" (| separates arguments) -DEXPECT=zero|nonzero -DPATTERN=regex
-# -DWORKDIR=folder for output files.
+# -DWORKDIR=folder for output files, emptied first.
+# -DFILES="a.png|b.png" (optional): exactly these files must be in WORKDIR afterwards, hidden
+# ones included ("none": nothing, e.g. a refused run must not leave a partial output).
 string(REPLACE "|" ";" arg_list "${ARGS}")
+file(REMOVE_RECURSE "${WORKDIR}")
 file(MAKE_DIRECTORY "${WORKDIR}")
 execute_process(COMMAND "${EXE}" ${arg_list} WORKING_DIRECTORY "${WORKDIR}"
                 RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
@@ -14,5 +18,19 @@ if(EXPECT STREQUAL "nonzero" AND rc EQUAL 0)
 endif()
 if(NOT all MATCHES "${PATTERN}")
   message(FATAL_ERROR "output does not match '${PATTERN}':\n${all}")
+endif()
+if(DEFINED FILES)
+  file(GLOB found LIST_DIRECTORIES true RELATIVE "${WORKDIR}" "${WORKDIR}/*" "${WORKDIR}/.*")
+  list(REMOVE_DUPLICATES found)
+  list(REMOVE_ITEM found "." "..")
+  list(SORT found)
+  string(REPLACE "|" ";" expected "${FILES}")
+  if(FILES STREQUAL "none")
+    set(expected "")
+  endif()
+  list(SORT expected)
+  if(NOT "${found}" STREQUAL "${expected}")
+    message(FATAL_ERROR "expected the files '${expected}' in ${WORKDIR}, found '${found}':\n${all}")
+  endif()
 endif()
 message(STATUS "exit ${rc}, output matches '${PATTERN}'")

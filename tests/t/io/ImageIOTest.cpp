@@ -40,7 +40,7 @@ TEST(ImageIO, Png16BitDepth) {
     depth.At<float>(0, 1) = 70.0f;    // clamps to 65535
     depth.At<float>(1, 2) = 0.0004f;  // rounds to 0
     depth.At<float>(1, 1) = 0.2561f;
-    t::io::WritePNG16(path, depth, 1000.0);
+    EXPECT_EQ(t::io::WritePNG16(path, depth, 1000.0), 1);  // the 70 m pixel saturated
     const Image back = t::io::ReadPNG(path);
     ASSERT_EQ(back.GetDtype(), core::Dtype::Float32);
     EXPECT_EQ(back.At<float>(0, 0), 1235.0f);

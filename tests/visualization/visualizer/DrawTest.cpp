@@ -2,6 +2,8 @@
 // name, fits the camera and runs (here for a few frames).
 #include <gtest/gtest.h>
 
+#include "TestUtility.h"
+
 #include "open3d/t/geometry/TriangleMesh.h"
 #include "open3d/visualization/rendering/filament/FilamentEngine.h"
 #include "open3d/visualization/rendering/gaussian_splat/DefaultScene.h"
@@ -13,7 +15,7 @@ namespace {
 
 TEST(DrawFunction, ShowsObjectsForTheRequestedFrames) {
     const std::string reason = visualization::rendering::FilamentUnavailableReason();
-    if (!reason.empty()) GTEST_SKIP() << reason;
+    if (!reason.empty()) OPEN3D_SKIP_OR_FAIL_WHEN_UNAVAILABLE(reason);
     std::vector<visualization::DrawObject> objects(2);
     objects[0].name = "splats";
     objects[0].geometry = visualization::rendering::CreateDefaultGaussianSplatScene();

@@ -5,6 +5,7 @@
 #include <cstdlib>
 #include <thread>
 
+#include "TestUtility.h"
 #include "open3d/core/Exception.h"
 #include "open3d/t/geometry/TriangleMesh.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/VulkanBackendRegistry.h"
@@ -39,7 +40,7 @@ void VisualizerTest::TearDownTestSuite() {
 }
 
 void VisualizerTest::SetUp() {
-    if (!skip_reason_.empty()) GTEST_SKIP() << skip_reason_;
+    if (!skip_reason_.empty()) OPEN3D_SKIP_OR_FAIL_WHEN_UNAVAILABLE(skip_reason_);
 }
 
 void VisualizerTest::TearDown() {

@@ -1,7 +1,8 @@
 // One Filament engine and renderer per test binary; each test opens its own small visible
 // Visualizer window on it. Skips with the reason where no X server (run under xvfb-run) or
-// no Vulkan device exists. Scene: a wall of blue splats at z = 4 and a red sphere mesh in
-// front of it at z = 2; the camera looks along +z (world -y up, the 3DGS convention).
+// no Vulkan device exists; fails instead in CI (CI=true). Scene: a wall of blue splats at z = 4 and
+// a red sphere mesh in front of it at z = 2; the camera looks along +z (world -y up, the 3DGS
+// convention).
 #pragma once
 
 #include <gtest/gtest.h>

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "open3d/core/Exception.h"
+#include "open3d/core/RegularFile.h"
 
 namespace open3d {
 namespace t {
@@ -110,15 +111,18 @@ void WritePNG(const std::string& filename, const geometry::Image& image) {
                  static_cast<int>(image.GetChannels()), 8, rows);
 }
 
-void WritePNG16(const std::string& filename, const geometry::Image& image, double scale) {
+int64_t WritePNG16(const std::string& filename, const geometry::Image& image, double scale) {
     if (image.GetDtype() != core::Dtype::Float32 || image.GetChannels() != 1) {
         core::ThrowError("WritePNG16 '{}': image must be Float32 with 1 channel", filename);
     }
     if (image.IsEmpty()) core::ThrowError("WritePNG16 '{}': image is empty", filename);
     std::vector<uint16_t> values(image.NumPixels());
     const float* src = image.Data<float>();
+    int64_t saturated = 0;
     for (size_t i = 0; i < values.size(); ++i) {
-        const double v = std::clamp(static_cast<double>(src[i]) * scale, 0.0, 65535.0);
+        const double scaled = static_cast<double>(src[i]) * scale;
+        saturated += scaled > 65535.5;  // would round above the largest value
+        const double v = std::clamp(scaled, 0.0, 65535.0);
         values[i] = v >= 0.0 ? static_cast<uint16_t>(std::lround(v)) : 0;  // NaN -> 0
     }
     std::vector<png_bytep> rows(image.GetRows());
@@ -127,6 +131,7 @@ void WritePNG16(const std::string& filename, const geometry::Image& image, doubl
     }
     WritePngRows(filename, static_cast<int>(image.GetCols()), static_cast<int>(image.GetRows()), 1,
                  16, rows);
+    return saturated;
 }
 
 namespace {
@@ -168,6 +173,7 @@ bool ReadPngRows(png_structp png, png_bytep* rows) {
 }  // namespace
 
 geometry::Image ReadPNG(const std::string& filename) {
+    core::RequireRegularFile(filename);
     FILE* file = std::fopen(filename.c_str(), "rb");
     if (!file) core::ThrowError("cannot open PNG '{}'", filename);
     unsigned char signature[8] = {0};
@@ -232,6 +238,7 @@ void WriteNpy(const std::string& filename, const geometry::Image& image) {
 }
 
 geometry::Image ReadNpy(const std::string& filename) {
+    core::RequireRegularFile(filename);
     std::ifstream in(filename, std::ios::binary);
     if (!in) core::ThrowError("cannot open '{}'", filename);
     char magic[10] = {0};

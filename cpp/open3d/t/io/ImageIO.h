@@ -16,7 +16,8 @@ void WritePNG(const std::string& filename, const geometry::Image& image);
 
 /// Writes a 1-channel Float32 image as a 16-bit grey PNG: round(clamp(v * scale, 0, 65535)).
 /// With scale = 1000, a value in metres is stored in millimetres (up to 65.535 m).
-void WritePNG16(const std::string& filename, const geometry::Image& image, double scale);
+/// Returns how many pixels were above the range and saturated to 65535 (callers warn).
+int64_t WritePNG16(const std::string& filename, const geometry::Image& image, double scale);
 
 /// Reads a PNG. 8-bit files (palette expanded to RGB/RGBA, low bit depths to 8) come back
 /// as UInt8 with the file's channel count; 16-bit files as Float32 holding the raw

@@ -44,7 +44,7 @@ void CheckOutputPath(const std::string& what, const std::string& path) {
     }
 }
 
-std::string LowerExtension(const std::string& path) {
+std::string LowerCaseExtension(const std::string& path) {
     std::string ext = fs::path(path).extension().string();
     if (!ext.empty()) ext.erase(0, 1);
     std::transform(ext.begin(), ext.end(), ext.begin(),
@@ -53,10 +53,13 @@ std::string LowerExtension(const std::string& path) {
 }
 
 bool SameOutputPath(const std::string& a, const std::string& b) {
+    // weakly_canonical resolves symbolic links and "." / ".." in the part that exists.
     std::error_code ec_a, ec_b;
     const fs::path pa = fs::weakly_canonical(fs::absolute(a), ec_a);
     const fs::path pb = fs::weakly_canonical(fs::absolute(b), ec_b);
-    if (ec_a || ec_b) return fs::absolute(a).lexically_normal() == fs::absolute(b).lexically_normal();
+    if (ec_a || ec_b) {
+        return fs::absolute(a).lexically_normal() == fs::absolute(b).lexically_normal();
+    }
     return pa == pb;
 }
 
@@ -71,9 +74,8 @@ std::string OutputFileSet::Add(const std::string& final_path) {
     // (less the umask) gives the final file the permissions a plain create would.
     for (int attempt = 0; attempt < 100; ++attempt) {
         const std::string temporary =
-            (folder / (".tmp-" + std::to_string(::getpid()) + "-" +
-                       std::to_string(files_.size()) + "-" + std::to_string(attempt) + "-" +
-                       name))
+            (folder / (".tmp-" + std::to_string(::getpid()) + "-" + std::to_string(files_.size()) +
+                       "-" + std::to_string(attempt) + "-" + name))
                 .string();
         const int fd = ::open(temporary.c_str(), O_WRONLY | O_CREAT | O_EXCL, 0666);
         if (fd >= 0) {
@@ -82,8 +84,8 @@ std::string OutputFileSet::Add(const std::string& final_path) {
             return temporary;
         }
         if (errno != EEXIST) {
-            core::ThrowError("cannot create a temporary file in '{}' for '{}': {}",
-                             folder.string(), final_path, std::strerror(errno));
+            core::ThrowError("cannot create a temporary file in '{}' for '{}': {}", folder.string(),
+                             final_path, std::strerror(errno));
         }
     }
     core::ThrowError("cannot create a temporary file in '{}' for '{}': too many exist",

@@ -66,6 +66,20 @@ bool ParseType(const std::string& word, PlyType& type) {
     return false;
 }
 
+// A header line as an error message shows it: binary bytes (a file whose header never
+// ends runs into its data) as \xNN, and at most 80 characters.
+std::string Printable(const std::string& line) {
+    std::string out;
+    for (const unsigned char c : line.substr(0, 80)) {
+        if (c >= 0x20 && c < 0x7f) {
+            out += static_cast<char>(c);
+        } else {
+            out += fmt::format("\\x{:02x}", c);
+        }
+    }
+    return line.size() > 80 ? out + "..." : out;
+}
+
 }  // namespace
 
 PlyHeader ParsePlyHeader(const std::string& filename, const uint8_t* bytes, size_t size) {
@@ -74,6 +88,16 @@ PlyHeader ParsePlyHeader(const std::string& filename, const uint8_t* bytes, size
     const std::string_view text(reinterpret_cast<const char*>(bytes), limit);
     if (text.substr(0, 3) != "ply")
         core::ThrowError("'{}' is not a PLY file (no 'ply' magic)", filename);
+    // Looked for first: without it the line parser below would stop at the first line of
+    // binary data and print it, hiding that the header never ends.
+    const size_t end_line = text.find("\nend_header");
+    if (end_line == std::string_view::npos ||
+        text.find('\n', end_line + 1) == std::string_view::npos) {
+        core::ThrowError(
+            "'{}': the PLY header is incomplete: no 'end_header' line {} {} bytes (the file is "
+            "truncated or its header is damaged)",
+            filename, limit < size ? "within the first" : "in all of its", limit);
+    }
 
     PlyHeader header;
     bool have_format = false;
@@ -93,8 +117,8 @@ PlyHeader ParsePlyHeader(const std::string& filename, const uint8_t* bytes, size
         std::string keyword;
         in >> keyword;
         auto fail = [&](const std::string& why) {
-            core::ThrowError("'{}': PLY header line {} ('{}'): {}", filename, line_number, line,
-                             why);
+            core::ThrowError("'{}': PLY header line {} ('{}'): {}", filename, line_number,
+                             Printable(line), why);
         };
         if (keyword.empty() || keyword == "comment" || keyword == "obj_info") continue;
         if (line_number == 1) {

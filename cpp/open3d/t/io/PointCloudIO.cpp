@@ -8,6 +8,7 @@
 
 #include "open3d/core/Exception.h"
 #include "open3d/core/Logging.h"
+#include "open3d/core/RegularFile.h"
 #include "open3d/t/io/FileFormats.h"
 
 namespace open3d {
@@ -85,9 +86,7 @@ PointCloudFileFormat DetectPointCloudFileFormat(const std::string& filename) {
         core::ThrowError("'{}' is a folder without a SOG meta.json", filename);
     }
     if (!fs::exists(filename, ec)) core::ThrowError("Cannot open '{}': no such file", filename);
-    if (!fs::is_regular_file(filename, ec)) {
-        core::ThrowError("'{}' is not a regular file (a device, FIFO or socket)", filename);
-    }
+    core::RequireRegularFile(filename);
     // The first bytes tell most formats apart; a PLY header is read until end_header to
     // tell the compressed layout (an `element chunk`) from the 3DGS one.
     std::ifstream in(filename, std::ios::binary);
@@ -171,14 +170,47 @@ ReadPointCloudReport ReadPointCloud(const std::string& filename, geometry::Point
     return report;
 }
 
-void WritePointCloud(const std::string& filename, const geometry::PointCloud& cloud,
-                     const WritePointCloudOptions& options) {
+void RequireGaussianSplat(const std::string& filename, const geometry::PointCloud& cloud) {
+    std::string missing;
+    for (const char* name : {geometry::gs_attr::kScale, geometry::gs_attr::kRot,
+                             geometry::gs_attr::kOpacity, geometry::gs_attr::kFDc}) {
+        if (!cloud.HasPointAttr(name)) missing += (missing.empty() ? "" : ", ") + std::string(name);
+    }
+    if (!missing.empty()) {
+        core::ThrowError(
+            "'{}' has no Gaussian splat attributes ({} {} missing{}): it is a plain point "
+            "cloud, not a 3D Gaussian Splatting scene",
+            filename, missing, missing.find(',') == std::string::npos ? "is" : "are",
+            cloud.GetPointAttrNames().size() <= 1 ? "; the file has positions only" : "");
+    }
+    try {
+        cloud.ValidateGaussianSplat();
+    } catch (const core::Open3DError& e) {
+        core::ThrowError("'{}': {}", filename, e.what());
+    }
+}
+
+PointCloudFileFormat PointCloudFileFormatForWriting(const std::string& filename) {
     PointCloudFileFormat format;
     if (!FormatOfExtension(filename, format)) {
         core::ThrowError("'{}': unknown extension '{}' (supported: {})", filename,
                          Lower(fs::path(filename).extension().string()), kSupported);
     }
-    switch (format) {
+    if (format == PointCloudFileFormat::kSog && EndsWith(Lower(filename), "meta.json")) {
+        core::ThrowError("'{}': SOG is written as a bundled .sog file", filename);
+    }
+    if (format == PointCloudFileFormat::kKsplat) {
+        core::ThrowError(
+            "'{}': .ksplat is read only; write .spz, .sog or .compressed.ply "
+            "for a compressed file",
+            filename);
+    }
+    return format;
+}
+
+void WritePointCloud(const std::string& filename, const geometry::PointCloud& cloud,
+                     const WritePointCloudOptions& options) {
+    switch (PointCloudFileFormatForWriting(filename)) {
         case PointCloudFileFormat::kPly:
             WritePly(filename, cloud, options.ply_format);
             break;
@@ -192,9 +224,6 @@ void WritePointCloud(const std::string& filename, const geometry::PointCloud& cl
             WriteSpz(filename, cloud);
             break;
         case PointCloudFileFormat::kSog:
-            if (EndsWith(Lower(filename), "meta.json")) {
-                core::ThrowError("'{}': SOG is written as a bundled .sog file", filename);
-            }
             WriteSog(filename, cloud);
             break;
         case PointCloudFileFormat::kGltf:
@@ -204,10 +233,7 @@ void WritePointCloud(const std::string& filename, const geometry::PointCloud& cl
             WriteGltf(filename, cloud, /*binary=*/true);
             break;
         case PointCloudFileFormat::kKsplat:
-            core::ThrowError(
-                "'{}': .ksplat is read only; write .spz, .sog or .compressed.ply "
-                "for a compressed file",
-                filename);
+            break;  // refused by PointCloudFileFormatForWriting
     }
 }
 

@@ -49,6 +49,11 @@ PointCloudFileFormat DetectPointCloudFileFormat(const std::string& filename);
 ReadPointCloudReport ReadPointCloud(const std::string& filename, geometry::PointCloud& cloud,
                                     const ReadPointCloudOptions& options = {});
 
+/// Throws naming the file and the missing attributes unless `cloud`, read from `filename`,
+/// is a Gaussian splat cloud (renderers need scale, rot, opacity and f_dc; a plain xyz PLY
+/// has positions only).
+void RequireGaussianSplat(const std::string& filename, const geometry::PointCloud& cloud);
+
 enum class PlyFormat { BinaryLittleEndian, BinaryBigEndian, Ascii };
 
 struct WritePointCloudOptions {
@@ -58,6 +63,11 @@ struct WritePointCloudOptions {
 /// Writes the format the extension names (case-insensitive): .ply (3DGS layout,
 /// log-scales), .compressed.ply, .splat, .spz (v4), .sog (bundled, version 2), .glb, .gltf (one
 /// data-URI buffer). Writing SH a format cannot hold (.splat: degree 0) drops it with a warning.
+/// The format WritePointCloud writes to `filename`, from its extension; throws naming the
+/// file for an unknown extension or a read-only format (.ksplat, a SOG meta.json), so a
+/// caller can refuse a bad output before reading anything.
+PointCloudFileFormat PointCloudFileFormatForWriting(const std::string& filename);
+
 void WritePointCloud(const std::string& filename, const geometry::PointCloud& cloud,
                      const WritePointCloudOptions& options = {});
 

@@ -15,6 +15,7 @@
 #include "open3d/core/Exception.h"
 #include "open3d/core/Logging.h"
 #include "open3d/core/ParallelFor.h"
+#include "open3d/core/RegularFile.h"
 
 namespace open3d {
 namespace t {
@@ -38,6 +39,7 @@ void SplatColumns::Allocate(int64_t n, bool gaussian, int degree) {
 }
 
 MappedFile::MappedFile(const std::string& filename) {
+    core::RequireRegularFile(filename);  // before open(), which blocks on a FIFO
     const int fd = ::open(filename.c_str(), O_RDONLY | O_CLOEXEC);
     if (fd < 0)
         core::ThrowError("Cannot open '{}' for reading: {}", filename, std::strerror(errno));

@@ -68,6 +68,16 @@ geometry::PointCloud ReadSplat(const std::string& filename, const ReadPointCloud
             }
         },
         4096);
+    // .splat stores linear scales: a negative one is no Gaussian (the log other formats
+    // store cannot even hold it), so the file is damaged or not a .splat at all.
+    for (int64_t i = 0; i < n * 3; ++i) {
+        if (scale[i] < 0.0f) {
+            core::ThrowError(
+                "'{}': splat {} has a negative scale {} (axis {}); .splat stores linear scales, "
+                "which must be >= 0",
+                filename, i / 3, scale[i], i % 3);
+        }
+    }
     return FinalizeColumns(filename, columns, options, report);
 }
 

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "TestUtility.h"
 #include "open3d/core/Exception.h"
 
 #include "open3d/t/geometry/TriangleMesh.h"
@@ -37,7 +38,7 @@ void FilamentTest::TearDownTestSuite() {
 }
 
 void FilamentTest::SetUp() {
-    if (!skip_reason_.empty()) GTEST_SKIP() << skip_reason_;
+    if (!skip_reason_.empty()) OPEN3D_SKIP_OR_FAIL_WHEN_UNAVAILABLE(skip_reason_);
 }
 
 void FilamentTest::TearDown() {

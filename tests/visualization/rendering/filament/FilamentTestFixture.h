@@ -1,7 +1,7 @@
 // One Filament engine and renderer per test binary (each ctest entry is its own process),
 // skipping with the reason where no X server (run under xvfb-run) or no Vulkan device
-// exists, and small scenes built in code: a wall of splats behind, a red sphere, splats in
-// front. The camera looks along +z from the origin.
+// exists (failing instead in CI: CI=true), and small scenes built in code: a wall of splats behind,
+// a red sphere, splats in front. The camera looks along +z from the origin.
 #pragma once
 
 #include <gtest/gtest.h>

@@ -49,7 +49,9 @@ TEST_F(VulkanBackend, RealScenesMatchTheReference) {
                                {"biker/biker_152k.ply", "biker/cameras.json"}};
     auto backend = MakeBackend();
     for (const SceneCase& c : cases) {
-        if (!FileExists(DataPath(c.scene))) GTEST_SKIP() << DataPath(c.scene) << " is absent";
+        if (!FileExists(DataPath(c.scene))) {
+            OPEN3D_SKIP_OR_FAIL_WHEN_UNAVAILABLE(DataPath(c.scene) + " is absent");
+        }
         t::geometry::PointCloud cloud;
         t::io::ReadPointCloud(DataPath(c.scene), cloud);
         const auto views = camera::ReadCamerasJson(DataPath(c.cameras));

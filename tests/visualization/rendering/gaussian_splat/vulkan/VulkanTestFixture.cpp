@@ -4,6 +4,7 @@
 #include <iostream>
 #include <string_view>
 
+#include "TestUtility.h"
 #include "open3d/core/Exception.h"
 #include "open3d/core/Logging.h"
 
@@ -81,7 +82,7 @@ void VulkanTest::TearDownTestSuite() {
 
 void VulkanTest::SetUp() {
     if (!failure_.empty()) FAIL() << failure_;
-    if (!context_) GTEST_SKIP() << skip_reason_;
+    if (!context_) OPEN3D_SKIP_OR_FAIL_WHEN_UNAVAILABLE(skip_reason_);
     if (!Context().IsValidationEnabled()) {
         std::cerr << "note: Vulkan validation is off (OPEN3D_VULKAN_VALIDATION=0)\n";
     }

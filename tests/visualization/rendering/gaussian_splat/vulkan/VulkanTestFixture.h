@@ -1,10 +1,11 @@
 // Fixture of the Vulkan tests: one headless context per test suite with validation on
-// (creating one per test would cost more than most tests), a GTEST_SKIP with the reason
-// when no Vulkan device exists, and a failure when the validation layer sent any warning
-// or error during a test or while the suite's context was destroyed.
+// (creating one per test would cost more than most tests), a skip with the reason when no
+// Vulkan device exists (a failure in CI: OPEN3D_SKIP_OR_FAIL_WHEN_UNAVAILABLE), and a failure when
+// the validation layer sent any warning or error during a test or while the suite's context was
+// destroyed.
 //
-// Environment: OPEN3D_TEST_REQUIRE_VULKAN=1 turns "no device" into a failure (for CI
-// machines that must run these tests); OPEN3D_VULKAN_VALIDATION=0 runs them without the
+// Environment: CI=true or OPEN3D_TEST_REQUIRE_VULKAN=1 turns "no device" into a failure
+// (machines that must run these tests); OPEN3D_VULKAN_VALIDATION=0 runs them without the
 // validation layer (machines without it, e.g. a GPU box with only the loader).
 #pragma once
 
