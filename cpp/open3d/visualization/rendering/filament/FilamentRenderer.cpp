@@ -73,6 +73,10 @@ void FilamentRenderer::AddView(FilamentScene& scene, FilamentView& view) {
 
 void FilamentRenderer::RemoveView(const FilamentView& view) {
     if (frame_begun_) core::ThrowError("FilamentRenderer::RemoveView: not inside a frame");
+    // The scene's splat renderer forgets the view too: its key (the address) may be reused.
+    for (const ViewEntry& e : views_) {
+        if (e.view == &view) e.scene->GetSplatRenderer().ReleaseView(ViewKey(view));
+    }
     std::erase_if(views_, [&](const ViewEntry& e) { return e.view == &view; });
 }
 
@@ -115,7 +119,6 @@ void FilamentRenderer::BeginFrame(filament::SwapChain* swap_chain) {
     StartFrame(swap_chain);
     for (ViewEntry& entry : views_) {
         entry.geometry_submitted = false;
-        entry.drawn = false;
         SubmitGeometryStage(entry);
     }
 }
@@ -189,7 +192,6 @@ FrameResult FilamentRenderer::Draw(FilamentView& view, const FrameRequest& reque
         result.color = BlendOver(result.splats_drawn ? &splats.color : nullptr, mesh_rgba, h, w);
         result.times.readback_ms = core::MillisecondsSince(t);
     }
-    entry->drawn = true;
     entry->request = request;
     drawn_.push_back(entry);
     result.times.total_ms = result.times.geometry_stage_ms + core::MillisecondsSince(start);
@@ -250,7 +252,6 @@ FrameResult FilamentRenderer::Draw(FilamentScene& scene, FilamentView& view,
     // Only this view's geometry stage: a one-view frame.
     StartFrame(swap_chain);
     entry->geometry_submitted = false;
-    entry->drawn = false;
     FrameResult result;
     try {
         SubmitGeometryStage(*entry);
@@ -258,12 +259,15 @@ FrameResult FilamentRenderer::Draw(FilamentScene& scene, FilamentView& view,
     } catch (...) {
         frame_begun_ = false;
         drawn_.clear();
+        if (entry == &temporary_) scene.GetSplatRenderer().ReleaseView(ViewKey(view));
         temporary_ = ViewEntry{};
         throw;
     }
     const Clock::time_point t = Clock::now();
     result.screen = EndFrame();
     if (swap_chain != nullptr) result.times.compose_ms = core::MillisecondsSince(t);
+    // A view drawn only this way is forgotten with its frame.
+    if (entry == &temporary_) scene.GetSplatRenderer().ReleaseView(ViewKey(view));
     temporary_ = ViewEntry{};
     result.times.total_ms = core::MillisecondsSince(start);
     return result;

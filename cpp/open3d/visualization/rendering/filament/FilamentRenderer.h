@@ -131,7 +131,6 @@ private:
         FilamentScene* scene = nullptr;
         FilamentView* view = nullptr;
         bool geometry_submitted = false;  // this frame
-        bool drawn = false;               // this frame
         double geometry_stage_ms = 0.0;
         FrameRequest request;  // of this frame's Draw (overlays, read_screen)
     };
