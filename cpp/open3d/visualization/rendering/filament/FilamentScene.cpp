@@ -221,6 +221,13 @@ void FilamentScene::DestroyMesh(Mesh& mesh) {
     engine_.destroy(mesh.indices);
 }
 
+void FilamentScene::ReplaceMesh(Mesh& old, Mesh built) {
+    built.visible = old.visible;
+    DestroyMesh(old);
+    if (built.visible) scene_->addEntity(utils::Entity::import(built.entity));
+    old = built;
+}
+
 void FilamentScene::AddMesh(const std::string& name, Mesh built) {
     scene_->addEntity(utils::Entity::import(built.entity));
     meshes_.emplace(name, built);
@@ -267,11 +274,7 @@ void FilamentScene::UpdateGeometry(const std::string& name, const t::geometry::P
     if (it == meshes_.end() || !it->second.points) {
         core::ThrowError("FilamentScene: no point cloud named '{}'", name);
     }
-    Mesh built = BuildPoints(cloud, it->second.look);
-    built.visible = it->second.visible;
-    DestroyMesh(it->second);
-    if (built.visible) scene_->addEntity(utils::Entity::import(built.entity));
-    it->second = built;
+    ReplaceMesh(it->second, BuildPoints(cloud, it->second.look));
 }
 
 void FilamentScene::UpdateGeometry(const std::string& name, const t::geometry::TriangleMesh& mesh) {
@@ -280,11 +283,7 @@ void FilamentScene::UpdateGeometry(const std::string& name, const t::geometry::T
         core::ThrowError("FilamentScene: no mesh named '{}'", name);
     }
     // The material carries over to the new mesh.
-    Mesh built = BuildMesh(mesh, it->second.look);
-    built.visible = it->second.visible;
-    DestroyMesh(it->second);
-    if (built.visible) scene_->addEntity(utils::Entity::import(built.entity));
-    it->second = built;
+    ReplaceMesh(it->second, BuildMesh(mesh, it->second.look));
 }
 
 bool FilamentScene::RemoveGeometry(const std::string& name) {

@@ -113,6 +113,8 @@ private:
     Mesh BuildPoints(const t::geometry::PointCloud& cloud, const MaterialRecord& material);
     void Finish(Mesh& out, int primitive, size_t num_indices);
     void AddMesh(const std::string& name, Mesh built);
+    /// Swaps `old` for `built`, keeping its visibility (its material came from `old`).
+    void ReplaceMesh(Mesh& old, Mesh built);
     void DestroyMesh(Mesh& mesh);
 
     filament::Engine& engine_;
