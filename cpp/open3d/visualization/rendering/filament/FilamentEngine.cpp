@@ -6,9 +6,11 @@
 #include <GLFW/glfw3native.h>
 #include <filament/Engine.h>
 
+#include <chrono>
 #include <cstdlib>
 #include <mutex>
 #include <string>
+#include <thread>
 
 #include "open3d/core/Exception.h"
 #include "open3d/core/Logging.h"
@@ -44,11 +46,19 @@ bool AcquireGlfw(std::string* why) {
         return false;
     }
     glfwSetErrorCallback(OnGlfwError);
-    glfw_error.clear();
-    if (!glfwInit()) {
-        *why =
-            fmt::format("cannot open X display '{}' ({}). {}", display, glfw_error, kRunUnderXvfb);
-        return false;
+    // An X server that is there can still refuse a connection for a moment (seen with Xvfb
+    // while other test processes connect at once): try a few times before giving up.
+    constexpr int kAttempts = 5;
+    for (int attempt = 1;; ++attempt) {
+        glfw_error.clear();
+        if (glfwInit()) break;
+        if (attempt == kAttempts) {
+            *why = fmt::format("cannot open X display '{}' ({}; {} attempts). {}", display,
+                               glfw_error, kAttempts, kRunUnderXvfb);
+            return false;
+        }
+        core::LogWarning("cannot open X display '{}' ({}); trying again", display, glfw_error);
+        std::this_thread::sleep_for(std::chrono::milliseconds(200 * attempt));
     }
     ++glfw_users;
     return true;
