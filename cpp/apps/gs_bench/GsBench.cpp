@@ -1,7 +1,8 @@
 // gs-bench: time against error. For each scene, resolution and accuracy/speed knob it
 // renders the cameras.json views (or the grid scene) with a backend, reports GPU time per
-// stage (timestamp queries), CPU time per frame, memory per splat and the error against
-// the CPU reference rendered in the same run. Runs headless (no window, no Filament).
+// stage (timestamp queries), wall-clock time per frame (the stage path, one submission, frames
+// in flight with and without readback, batches), memory per splat and the error against the
+// CPU reference rendered in the same run. Runs headless (no window, no Filament).
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <chrono>
@@ -14,6 +15,7 @@
 #include <vector>
 
 #include "BenchScenes.h"
+#include "Throughput.h"
 #include "open3d/camera/CamerasJson.h"
 #include "open3d/core/Exception.h"
 #include "open3d/core/ParallelFor.h"
@@ -42,6 +44,8 @@ struct Options {
     std::string knobs = "all";
     int64_t reference_max_splats = 2000000;
     std::string depth = "none";
+    int batch = 0;
+    int frames_in_flight = 2;
 };
 
 struct Knob {
@@ -66,6 +70,15 @@ struct Row {
     double project_ms = 0, sort_ms = 0, composite_ms = 0, gpu_total_ms = 0, cpu_frame_ms = 0;
     double depth_sort_ms = 0, scan_emit_ms = 0, tile_sort_ms = 0;  // parts of sort_ms
     double bytes_per_splat = 0;
+    // Wall clock (Vulkan): one submission per frame waited for, frames in flight without and
+    // with readback (ms per frame), and the host's part of a stage-path / one-submission frame.
+    double frame_ms = 0, pipelined_ms = 0, pipelined_readback_ms = 0;
+    double frame_gpu_ms = 0, frame_job_gpu_ms = 0;
+    rendering::RenderStats stage_host, frame_host;  // host_* fields only
+    // --batch: views per second (colour read back as float32 / uint8, or left on the GPU).
+    double batch_float_vps = 0, batch_uint8_vps = 0, batch_gpu_only_vps = 0;
+    double batch_gpu_ms_per_view = 0;
+    int batch_submissions = 0;
     bool has_error = false;
     double psnr = 0, max_abs = 0, over_1_255 = 0, p999 = 0;
     uint32_t error_flags = 0;
@@ -118,9 +131,30 @@ double Median(std::vector<double> v) {
 
 // Medians over the timed frames of RunTimedFrames.
 struct TimedFrames {
-    rendering::RenderStats gpu;  // every gpu_*_ms field is the median of that pass
-    double cpu_frame_ms = 0.0;   // CPU wall time per frame, submit to fence
+    rendering::RenderStats gpu;     // every gpu_*_ms field is the median of that pass
+    double cpu_frame_ms = 0.0;      // stage path: wall time per frame, first submit to last fence
+    double frame_ms = 0.0;          // submission path: one submission, waited for
+    double frame_gpu_ms = 0.0;      // its passes' GPU time (as gpu, timed in that path)
+    double frame_job_gpu_ms = 0.0;  // its submission's GPU time, first to last command
+    rendering::RenderStats stage_host, frame_host;  // medians of the host_* fields
 };
+
+// Medians of the host_* fields of `frames`.
+rendering::RenderStats MedianHost(const std::vector<rendering::RenderStats>& frames) {
+    std::vector<double> record, submit, wait, readback;
+    for (const auto& s : frames) {
+        record.push_back(s.host_record_ms);
+        submit.push_back(s.host_submit_ms);
+        wait.push_back(s.host_wait_ms);
+        readback.push_back(s.host_readback_ms);
+    }
+    rendering::RenderStats m;
+    m.host_record_ms = Median(record);
+    m.host_submit_ms = Median(submit);
+    m.host_wait_ms = Median(wait);
+    m.host_readback_ms = Median(readback);
+    return m;
+}
 
 // Times `frames` frames (geometry stage + composite stage, no readback) after at least
 // kWarmUpSeconds of the same frames, and returns the median of each GPU pass and of the CPU wall
@@ -166,8 +200,10 @@ TimedFrames RunTimedFrames(rendering::GaussianSplatBackend& backend,
         previous = std::min(previous, median);
     }
     std::vector<double> project, sort, composite, depth_sort, scan_emit, tile_sort, wall;
+    std::vector<rendering::RenderStats> stage_stats;
     for (int i = 0; i < frames; ++i) {
         const rendering::RenderStats s = frame();
+        stage_stats.push_back(s);
         project.push_back(s.gpu_project_ms);
         sort.push_back(s.gpu_sort_ms);
         composite.push_back(s.gpu_composite_ms);
@@ -185,6 +221,24 @@ TimedFrames RunTimedFrames(rendering::GaussianSplatBackend& backend,
     m.gpu.gpu_scan_emit_ms = Median(scan_emit);
     m.gpu.gpu_tile_sort_ms = Median(tile_sort);
     m.cpu_frame_ms = Median(wall);
+    m.stage_host = MedianHost(stage_stats);
+    // The submission path: both stages in one submission (a recording re-submitted), waited for.
+    std::vector<double> one_submission, passes, job;
+    std::vector<rendering::RenderStats> submission_stats;
+    auto* vulkan = dynamic_cast<rendering::vulkan::GaussianSplatVulkanBackend*>(&backend);
+    for (int i = 0; i < frames + 2; ++i) {
+        const auto start = std::chrono::steady_clock::now();
+        const rendering::RenderOutput o = backend.Render(camera, config, no_readback);
+        if (i < 2) continue;  // each frame slot records once
+        one_submission.push_back(core::MillisecondsSince(start));
+        submission_stats.push_back(o.stats);
+        passes.push_back(o.stats.gpu_project_ms + o.stats.gpu_sort_ms + o.stats.gpu_composite_ms);
+        if (vulkan != nullptr) job.push_back(vulkan->GetLastBatchStats().gpu_ms);
+    }
+    m.frame_ms = Median(one_submission);
+    m.frame_gpu_ms = Median(passes);
+    m.frame_job_gpu_ms = Median(job);
+    m.frame_host = MedianHost(submission_stats);
     return m;
 }
 
@@ -195,7 +249,7 @@ void PrintTable(const std::vector<Row>& rows) {
         if (head != last) {
             std::printf("\n%s: %lld splats\n", head.c_str(), static_cast<long long>(r.splats));
             std::printf("%-11s %9s %10s %8s %8s %8s %9s %9s %7s %8s %9s %9s\n", "knob", "visible",
-                        "entries", "proj ms", "sort ms", "comp ms", "GPU ms", "CPU ms", "B/splat",
+                        "entries", "proj ms", "sort ms", "comp ms", "GPU ms", "stage ms", "B/splat",
                         "PSNR dB", "max err", ">1/255 %");
             last = head;
         }
@@ -211,6 +265,23 @@ void PrintTable(const std::vector<Row>& rows) {
             r.project_ms, r.sort_ms, r.composite_ms, r.gpu_total_ms, r.cpu_frame_ms,
             r.bytes_per_splat, err, r.depth_sort_ms, r.scan_emit_ms, r.tile_sort_ms,
             r.error_flags ? "  (entries dropped!)" : "");
+        if (r.pipelined_ms > 0) {
+            std::printf(
+                "%-11s wall ms/frame: one submission %.3f (GPU: passes %.3f, submission %.3f), "
+                "in flight %.3f, in flight + readback %.3f  [host ms, stage path / one "
+                "submission: record %.3f / %.3f, submit %.3f / %.3f, wait %.3f / %.3f]\n",
+                "", r.frame_ms, r.frame_gpu_ms, r.frame_job_gpu_ms, r.pipelined_ms,
+                r.pipelined_readback_ms, r.stage_host.host_record_ms, r.frame_host.host_record_ms,
+                r.stage_host.host_submit_ms, r.frame_host.host_submit_ms, r.stage_host.host_wait_ms,
+                r.frame_host.host_wait_ms);
+        }
+        if (r.batch_float_vps > 0) {
+            std::printf(
+                "%-11s batch: %.0f views/s float32 readback, %.0f uint8 readback, %.0f on the "
+                "GPU only; GPU %.3f ms/view, %d submission(s) per batch\n",
+                "", r.batch_float_vps, r.batch_uint8_vps, r.batch_gpu_only_vps,
+                r.batch_gpu_ms_per_view, r.batch_submissions);
+        }
     }
 }
 
@@ -233,6 +304,9 @@ int Run(const Options& opt) {
             core::ThrowError("--json '{}': the file name must end in .json", opt.json);
         }
         t::io::CheckOutputPath("--json", opt.json);
+    }
+    if (opt.batch > 0 && opt.backend != "vulkan") {
+        core::ThrowError("--batch measures the Vulkan backend's batches: use --backend vulkan");
     }
     rendering::vulkan::RegisterVulkanBackend();
     std::vector<SceneJob> jobs;
@@ -286,8 +360,14 @@ int Run(const Options& opt) {
     if (knobs.empty()) core::ThrowError("--knobs '{}' selects none of the known knobs", opt.knobs);
 
     std::vector<Row> rows;
+    std::string device_name = opt.backend;
     for (SceneJob& job : jobs) {
         auto backend = rendering::CreateGaussianSplatBackend(opt.backend);
+        auto* vulkan = dynamic_cast<rendering::vulkan::GaussianSplatVulkanBackend*>(backend.get());
+        if (vulkan != nullptr) {
+            vulkan->SetFramesInFlight(opt.frames_in_flight);
+            device_name = vulkan->GetContext().GetDeviceInfo().name;
+        }
         backend->SetScene(job.cloud);
         const bool reference =
             opt.reference_max_splats > 0 && job.cloud.NumPoints() <= opt.reference_max_splats;
@@ -324,6 +404,16 @@ int Run(const Options& opt) {
                     row.scan_emit_ms += med.gpu_scan_emit_ms / n;
                     row.tile_sort_ms += med.gpu_tile_sort_ms / n;
                     row.cpu_frame_ms += timed.cpu_frame_ms / n;
+                    row.frame_ms += timed.frame_ms / n;
+                    row.frame_gpu_ms += timed.frame_gpu_ms / n;
+                    row.frame_job_gpu_ms += timed.frame_job_gpu_ms / n;
+                    for (auto [sum, part] : {std::pair{&row.stage_host, &timed.stage_host},
+                                             std::pair{&row.frame_host, &timed.frame_host}}) {
+                        sum->host_record_ms += part->host_record_ms / n;
+                        sum->host_submit_ms += part->host_submit_ms / n;
+                        sum->host_wait_ms += part->host_wait_ms / n;
+                        sum->host_readback_ms += part->host_readback_ms / n;
+                    }
                     row.visible += out.stats.num_visible / static_cast<int64_t>(cams.size());
                     row.entries += out.stats.num_tile_entries / static_cast<int64_t>(cams.size());
                     row.error_flags |= out.stats.error_flags;
@@ -332,6 +422,33 @@ int Run(const Options& opt) {
                     if (reference) images[k].push_back(std::move(out.color));
                 }
                 row.gpu_total_ms = row.project_ms + row.sort_ms + row.composite_ms;
+                if (vulkan != nullptr) {
+                    rendering::BatchOptions colour;  // colour only, as the timed frames
+                    colour.read_back = false;
+                    const int frames = std::max(50, opt.repeat);
+                    row.pipelined_ms =
+                        bench::PipelinedMsPerFrame(*vulkan, cams, config, colour, frames);
+                    colour.read_back = true;
+                    row.pipelined_readback_ms =
+                        bench::PipelinedMsPerFrame(*vulkan, cams, config, colour, frames);
+                    if (opt.batch > 0) {
+                        const int repeats = 5;
+                        rendering::BatchOptions o;
+                        const bench::BatchThroughput f =
+                            bench::MeasureBatch(*vulkan, cams, config, o, opt.batch, repeats);
+                        o.color_uint8 = true;
+                        const bench::BatchThroughput u =
+                            bench::MeasureBatch(*vulkan, cams, config, o, opt.batch, repeats);
+                        o.read_back = false;
+                        const bench::BatchThroughput g =
+                            bench::MeasureBatch(*vulkan, cams, config, o, opt.batch, repeats);
+                        row.batch_float_vps = f.views_per_second;
+                        row.batch_uint8_vps = u.views_per_second;
+                        row.batch_gpu_only_vps = g.views_per_second;
+                        row.batch_gpu_ms_per_view = f.gpu_ms_per_view;
+                        row.batch_submissions = f.submissions_per_batch;
+                    }
+                }
                 rows.push_back(row);
             }
             if (!reference) continue;
@@ -366,6 +483,9 @@ int Run(const Options& opt) {
             }
         }
     }
+    const std::string clock = bench::ReadGpuClockMHz();
+    std::printf("device: %s%s\n", device_name.c_str(),
+                clock.empty() ? "" : (", SM clock " + clock + " MHz (current/max)").c_str());
     PrintTable(rows);
     if (!opt.json.empty()) {
         nlohmann::json out = nlohmann::json::array();
@@ -384,8 +504,36 @@ int Run(const Options& opt) {
                            {"gpu_composite_ms", r.composite_ms},
                            {"gpu_total_ms", r.gpu_total_ms},
                            {"cpu_frame_ms", r.cpu_frame_ms},
+                           {"frame_ms", r.frame_ms},
+                           {"frame_gpu_passes_ms", r.frame_gpu_ms},
+                           {"frame_gpu_submission_ms", r.frame_job_gpu_ms},
+                           {"pipelined_frame_ms", r.pipelined_ms},
+                           {"pipelined_readback_frame_ms", r.pipelined_readback_ms},
+                           {"pipelined_fps", r.pipelined_ms > 0 ? 1000.0 / r.pipelined_ms : 0.0},
+                           {"pipelined_readback_fps",
+                            r.pipelined_readback_ms > 0 ? 1000.0 / r.pipelined_readback_ms : 0.0},
+                           {"host_stage_ms",
+                            {{"record", r.stage_host.host_record_ms},
+                             {"submit", r.stage_host.host_submit_ms},
+                             {"wait", r.stage_host.host_wait_ms},
+                             {"readback", r.stage_host.host_readback_ms}}},
+                           {"host_frame_ms",
+                            {{"record", r.frame_host.host_record_ms},
+                             {"submit", r.frame_host.host_submit_ms},
+                             {"wait", r.frame_host.host_wait_ms},
+                             {"readback", r.frame_host.host_readback_ms}}},
+                           {"device", device_name},
+                           {"gpu_clock_mhz", clock},
                            {"gpu_bytes_per_splat", r.bytes_per_splat},
                            {"error_flags", r.error_flags}});
+            if (r.batch_float_vps > 0) {
+                out.back()["batch"] = {{"views", opt.batch},
+                                       {"views_per_second_float32", r.batch_float_vps},
+                                       {"views_per_second_uint8", r.batch_uint8_vps},
+                                       {"views_per_second_no_readback", r.batch_gpu_only_vps},
+                                       {"gpu_ms_per_view", r.batch_gpu_ms_per_view},
+                                       {"submissions", r.batch_submissions}};
+            }
             if (r.has_error) {
                 out.back()["psnr_db_worst_view"] = r.psnr;
                 out.back()["max_abs_error"] = r.max_abs;
@@ -438,6 +586,14 @@ int main(int argc, char** argv) {
                    "Depth images the timed frames also compute (none: colour only, as the "
                    "original 3DGS forward pass)")
         ->check(CLI::IsMember({"none", "expected", "median", "both"}))
+        ->capture_default_str();
+    app.add_option("--batch", opt.batch,
+                   "Vulkan: also render batches of N views (the chosen views repeated) and report "
+                   "views per second with float32 and uint8 readback and without readback")
+        ->check(CLI::Range(1, 4096));
+    app.add_option("--frames-in-flight", opt.frames_in_flight,
+                   "Vulkan: frame slots of the submission path (1: no overlap)")
+        ->check(CLI::Range(1, 4))
         ->capture_default_str();
     app.add_option("--reference-max-splats", opt.reference_max_splats,
                    "Skip the CPU reference for scenes larger than this (0: never compare)")

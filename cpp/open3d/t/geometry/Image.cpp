@@ -1,5 +1,7 @@
 #include "open3d/t/geometry/Image.h"
 
+#include <utility>
+
 #include <algorithm>
 #include <cmath>
 
@@ -39,6 +41,11 @@ Image::Image(int64_t rows, int64_t cols, int64_t channels, core::Dtype dtype) {
 Image::Image(const core::Tensor& data) {
     CheckShape(data.GetShape());
     data_ = data;
+}
+
+Image::Image(core::Tensor&& data) {
+    CheckShape(data.GetShape());
+    data_ = std::move(data);
 }
 
 Image Image::ToUInt8(double scale) const {

@@ -18,6 +18,9 @@ public:
     Image(int64_t rows, int64_t cols, int64_t channels, core::Dtype dtype);
     /// Wraps a tensor of shape [rows, cols, channels] (copied).
     explicit Image(const core::Tensor& data);
+    /// Takes the tensor's memory (no copy): for images filled through
+    /// core::Tensor::Empty, which skips the zero fill.
+    explicit Image(core::Tensor&& data);
 
     int64_t GetRows() const { return data_.GetShape(0); }
     int64_t GetCols() const { return data_.GetShape(1); }

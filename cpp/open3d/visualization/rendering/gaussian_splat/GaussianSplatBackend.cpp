@@ -1,5 +1,7 @@
 #include "open3d/visualization/rendering/gaussian_splat/GaussianSplatBackend.h"
 
+#include <algorithm>
+#include <cmath>
 #include <map>
 #include <mutex>
 
@@ -31,11 +33,52 @@ Registry& GetRegistry() {
 }  // namespace
 
 RenderOutput GaussianSplatBackend::Render(const camera::PinholeCamera& camera,
-                                          const RenderConfig& config) {
+                                          const RenderConfig& config,
+                                          const CompositeInputs& inputs) {
     RenderGeometryStage(camera, config);
     RenderOutput output;
-    RenderCompositeStage(output);
+    RenderCompositeStage(output, inputs);
     return output;
+}
+
+void CheckBatchCameras(const std::vector<camera::PinholeCamera>& cameras) {
+    for (const camera::PinholeCamera& camera : cameras) {
+        if (camera.width != cameras[0].width || camera.height != cameras[0].height) {
+            core::ThrowError("RenderBatch: every camera must have one size ({}x{}); one is {}x{}",
+                             cameras[0].width, cameras[0].height, camera.width, camera.height);
+        }
+    }
+}
+
+t::geometry::Image ColorToUInt8(const t::geometry::Image& color) {
+    const int64_t h = color.GetRows(), w = color.GetCols();
+    t::geometry::Image out(h, w, 4, core::Dtype::UInt8);
+    const float* src = color.Data<float>();
+    uint8_t* dst = out.Data<uint8_t>();
+    for (int64_t i = 0; i < h * w * 4; ++i) {
+        const float v = std::min(1.0f, std::max(0.0f, src[i]));  // NaN -> 0
+        dst[i] = static_cast<uint8_t>(std::lround(v * 255.0f));
+    }
+    return out;
+}
+
+std::vector<RenderOutput> GaussianSplatBackend::RenderBatch(
+    const std::vector<camera::PinholeCamera>& cameras, const RenderConfig& config,
+    const BatchOptions& options) {
+    CheckBatchCameras(cameras);
+    CompositeInputs inputs;
+    inputs.read_back = options.read_back;
+    inputs.expected_depth = options.expected_depth;
+    inputs.median_depth = options.median_depth;
+    std::vector<RenderOutput> outputs;
+    outputs.reserve(cameras.size());
+    for (const camera::PinholeCamera& camera : cameras) {
+        outputs.push_back(Render(camera, config, inputs));
+        if (options.read_back && options.color_uint8) {
+            outputs.back().color = ColorToUInt8(outputs.back().color);
+        }
+    }
+    return outputs;
 }
 
 void RegisterGaussianSplatBackend(const std::string& name, GaussianSplatBackendFactory factory) {

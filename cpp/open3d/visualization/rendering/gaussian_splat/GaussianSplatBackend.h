@@ -49,6 +49,19 @@ struct CompositeInputs {
     bool median_depth = true;
 };
 
+/// What RenderBatch produces for each view.
+struct BatchOptions {
+    /// Copy the images to host memory. False leaves them on the device (the returned
+    /// outputs carry stats only): benchmarks of the GPU side.
+    bool read_back = true;
+    /// Colour as UInt8 [H, W, 4] (the float result converted to 8-bit unorm by the device's
+    /// rounding; the CPU backend rounds to nearest) instead of Float32 [H, W, 4]: a quarter
+    /// of the bytes to copy.
+    bool color_uint8 = false;
+    bool expected_depth = false;
+    bool median_depth = false;
+};
+
 class GaussianSplatBackend {
 public:
     virtual ~GaussianSplatBackend() = default;
@@ -77,9 +90,25 @@ public:
         return false;
     }
 
-    /// Both stages.
-    RenderOutput Render(const camera::PinholeCamera& camera, const RenderConfig& config);
+    /// Both stages with the images read back. GPU backends may record and submit both in one
+    /// go (the Vulkan backend does unless `inputs` has a scene depth); the result equals
+    /// RenderGeometryStage + RenderCompositeStage.
+    virtual RenderOutput Render(const camera::PinholeCamera& camera, const RenderConfig& config,
+                                const CompositeInputs& inputs = {});
+
+    /// Renders every camera (all of one size) with one config, in order. Each output equals
+    /// Render of that camera with the same images asked for, bit for bit. The Vulkan backend
+    /// records many views into one submission and keeps frames in flight; this default
+    /// renders them one by one. Throws core::Open3DError when the cameras differ in size.
+    virtual std::vector<RenderOutput> RenderBatch(const std::vector<camera::PinholeCamera>& cameras,
+                                                  const RenderConfig& config,
+                                                  const BatchOptions& options = {});
 };
+
+/// Throws core::Open3DError unless every camera has the size of the first.
+void CheckBatchCameras(const std::vector<camera::PinholeCamera>& cameras);
+/// Float32 [H, W, 4] in [0, 1] to UInt8 [H, W, 4], rounding to nearest (clamped; NaN -> 0).
+t::geometry::Image ColorToUInt8(const t::geometry::Image& color);
 
 using GaussianSplatBackendFactory = std::function<std::unique_ptr<GaussianSplatBackend>()>;
 

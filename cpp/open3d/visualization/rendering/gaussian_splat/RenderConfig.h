@@ -70,6 +70,10 @@ struct RenderConfig {
     void Validate() const;
 };
 
+/// Whether two configs give the same geometry stage: every field but the background (a
+/// composite parameter) and reuse_geometry.
+bool SameGeometryConfig(const RenderConfig& a, const RenderConfig& b);
+
 /// Bits of RenderStats::error_flags (the same bits the GPU backends read back).
 inline constexpr uint32_t kEntriesDropped = 1u << 0;
 inline constexpr uint32_t kCountsClamped = 1u << 1;
@@ -89,6 +93,11 @@ struct RenderStats {
     double gpu_merge_ms = 0.0;      ///< depth merge (offscreen depth readback only)
     /// Parts of gpu_sort_ms: depth sort, scan + entry emission, tile sort.
     double gpu_depth_sort_ms = 0.0, gpu_scan_emit_ms = 0.0, gpu_tile_sort_ms = 0.0;
+    /// Host time of the frame in the Vulkan backend: recording commands (0 when a recording
+    /// was submitted again), submitting, waiting for the GPU's fence, copying the images out.
+    /// A batch reports its totals divided by its views. docs/perf/ has the breakdown.
+    double host_record_ms = 0.0, host_submit_ms = 0.0, host_wait_ms = 0.0;
+    double host_readback_ms = 0.0;
     /// Bytes the backend keeps on the GPU for the scene between frames (0 for the CPU).
     int64_t gpu_scene_bytes = 0;
     /// True when geometry stage was reused because neither the scene nor the view changed.

@@ -49,12 +49,6 @@ Bounds MakeBounds(double min_psnr_db, double max_abs, double max_depth_rel) {
 
 class Stress : public VulkanTest {
 protected:
-    std::unique_ptr<GaussianSplatVulkanBackend> MakeBackend() {
-        vulkan::BorrowedVulkanHandles handles = BorrowedHandles();
-        return std::make_unique<GaussianSplatVulkanBackend>(
-            vulkan::VulkanContext::CreateFromBorrowed(handles));
-    }
-
     /// Renders `cloud` with both backends, checks finiteness and geometry stage (culled set, tile
     /// lists, order) against the reference, the same coverage and median depth at every
     /// pixel, prints one line of the docs table and checks `bounds`.

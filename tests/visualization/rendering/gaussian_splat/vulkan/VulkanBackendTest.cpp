@@ -26,14 +26,7 @@ namespace {
 using namespace visualization::rendering;
 using vulkan::GaussianSplatVulkanBackend;
 
-class VulkanBackend : public VulkanTest {
-protected:
-    std::unique_ptr<GaussianSplatVulkanBackend> MakeBackend(uint32_t entry_capacity = 1u << 22) {
-        vulkan::BorrowedVulkanHandles handles = BorrowedHandles();
-        return std::make_unique<GaussianSplatVulkanBackend>(
-            vulkan::VulkanContext::CreateFromBorrowed(handles), entry_capacity);
-    }
-};
+using VulkanBackend = VulkanTest;
 
 struct SceneCase {
     const char* scene;
@@ -81,8 +74,8 @@ TEST_F(VulkanBackend, UnchangedViewReusesGeometryStageAndGivesTheSameImage) {
     const t::geometry::PointCloud cloud = CreateDefaultGaussianSplatScene();
     backend->SetScene(cloud);
     const camera::PinholeCamera cam = GetDefaultSceneCamera().Resized(80, 60);
-    const RenderOutput first = backend->Render(cam, {});
-    const RenderOutput second = backend->Render(cam, {});
+    const RenderOutput first = RenderStages(*backend, cam, {});
+    const RenderOutput second = RenderStages(*backend, cam, {});
     EXPECT_EQ(backend->GetCounters().geometry_runs, 1);
     EXPECT_EQ(backend->GetCounters().geometry_reuses, 1);
     EXPECT_TRUE(second.stats.geometry_reused);
@@ -90,8 +83,8 @@ TEST_F(VulkanBackend, UnchangedViewReusesGeometryStageAndGivesTheSameImage) {
     // Another view, or reuse switched off, runs the geometry stage again.
     RenderConfig no_reuse;
     no_reuse.reuse_geometry = false;
-    backend->Render(cam, no_reuse);
-    backend->Render(cam.Resized(64, 48), {});
+    RenderStages(*backend, cam, no_reuse);
+    RenderStages(*backend, cam.Resized(64, 48), {});
     EXPECT_EQ(backend->GetCounters().geometry_runs, 3);
     EXPECT_EQ(backend->GetCounters().skipped_composites, 0);
 }
@@ -130,7 +123,7 @@ TEST_F(VulkanBackend, DepthImagesAreComputedOnlyWhenAskedFor) {
         SCOPED_TRACE("expected " + std::to_string(expected) + " median " + std::to_string(median));
         // An empty view clears every image first, so an image the composite should write but
         // does not would read back as zeros, not as the full composite's values.
-        ASSERT_EQ(backend->Render(away, {}).stats.num_tile_entries, 0);
+        ASSERT_EQ(RenderStages(*backend, away, {}).stats.num_tile_entries, 0);
         backend->RenderGeometryStage(cam, {});
         CompositeInputs inputs;
         inputs.expected_depth = expected;
@@ -155,25 +148,32 @@ TEST_F(VulkanBackend, DepthImagesAreComputedOnlyWhenAskedFor) {
 
 TEST_F(VulkanBackend, EntryBuffersGrowInsteadOfDroppingEntries) {
     // Start with room for 1,000 entries; the default scene at 80x60 needs ~15,000. The frame
-    // must come out complete (no flag), identical to one rendered with ample buffers.
+    // must come out complete (no flag), identical to one rendered with ample buffers, on
+    // both paths (each keeps its own entry buffers).
     const t::geometry::PointCloud cloud = CreateDefaultGaussianSplatScene();
     const camera::PinholeCamera cam = GetDefaultSceneCamera().Resized(80, 60);
-    auto small = MakeBackend(1000);
-    small->SetScene(cloud);
-    const RenderOutput grown = small->Render(cam, {});
-    EXPECT_EQ(small->GetCounters().capacity_growths, 1);
-    EXPECT_EQ(grown.stats.error_flags, 0u);
-    EXPECT_GT(grown.stats.num_tile_entries, 1000);
     auto ample = MakeBackend();
     ample->SetScene(cloud);
     const RenderOutput reference = ample->Render(cam, {});
-    EXPECT_EQ(grown.stats.num_tile_entries, reference.stats.num_tile_entries);
-    EXPECT_TRUE(grown.color.AsTensor() == reference.color.AsTensor());
-    // The config limit still binds: entries past it are dropped and flagged, not grown.
-    RenderConfig limited;
-    limited.max_tile_entries_total = 500;
-    EXPECT_NE(small->Render(cam, limited).stats.error_flags & kEntriesDropped, 0u);
-    EXPECT_EQ(small->GetCounters().capacity_growths, 1);
+    for (const bool stages : {false, true}) {
+        SCOPED_TRACE(stages ? "stage path" : "submission path");
+        auto small = MakeBackend(1000);
+        small->SetScene(cloud);
+        const auto render = [&](const RenderConfig& config) {
+            return stages ? RenderStages(*small, cam, config) : small->Render(cam, config);
+        };
+        const RenderOutput grown = render({});
+        EXPECT_EQ(small->GetCounters().capacity_growths, 1);
+        EXPECT_EQ(grown.stats.error_flags, 0u);
+        EXPECT_GT(grown.stats.num_tile_entries, 1000);
+        EXPECT_EQ(grown.stats.num_tile_entries, reference.stats.num_tile_entries);
+        EXPECT_TRUE(grown.color.AsTensor() == reference.color.AsTensor());
+        // The config limit still binds: entries past it are dropped and flagged, not grown.
+        RenderConfig limited;
+        limited.max_tile_entries_total = 500;
+        EXPECT_NE(render(limited).stats.error_flags & kEntriesDropped, 0u);
+        EXPECT_EQ(small->GetCounters().capacity_growths, 1);
+    }
 }
 
 TEST_F(VulkanBackend, EntryCapacityStopsAtTheSortLimit) {
@@ -221,14 +221,21 @@ TEST_F(VulkanBackend, EmptyViewIsBackgroundOnly) {
     away.center = Eigen::Vector3d(0, 0, 100);  // looking away from the scene
     RenderConfig config;
     config.background = Eigen::Vector3d(0.25, 0.5, 0.75);
-    const RenderOutput out =
-        backend->Render(camera::PinholeCamera::FromLookAt(away, 33, 17), config);
+    const camera::PinholeCamera cam = camera::PinholeCamera::FromLookAt(away, 33, 17);
+    const RenderOutput out = RenderStages(*backend, cam, config);
     EXPECT_EQ(out.stats.num_visible, 0);
     EXPECT_EQ(out.stats.num_tile_entries, 0);
-    // Nothing to blend: no composite dispatch (the sorts dispatch zero workgroups from the
-    // GPU counts); the images are cleared instead.
+    // Nothing to blend: the stage path records no composite dispatch (the sorts dispatch
+    // zero workgroups from the GPU counts); the images are cleared instead.
     EXPECT_EQ(backend->GetCounters().skipped_composites, 1);
     EXPECT_EQ(out.stats.gpu_composite_ms, 0.0);
+    // The submission path composites zero entries (its recording does not depend on the
+    // counts): the same images, bit for bit.
+    const RenderOutput submitted = backend->Render(cam, config);
+    EXPECT_EQ(submitted.stats.num_tile_entries, 0);
+    EXPECT_TRUE(submitted.color.AsTensor() == out.color.AsTensor());
+    EXPECT_TRUE(submitted.depth_expected.AsTensor() == out.depth_expected.AsTensor());
+    EXPECT_TRUE(submitted.depth_median.AsTensor() == out.depth_median.AsTensor());
     for (int64_t i = 0; i < out.depth_expected.NumPixels(); ++i) {
         ASSERT_EQ(out.depth_expected.Data<float>()[i], 0.0f);
     }

@@ -15,10 +15,24 @@
 #include <string>
 
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/Commands.h"
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/GaussianSplatVulkanBackend.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/VulkanContext.h"
 
 namespace open3d {
 namespace tests {
+
+/// The backend's stage path: the geometry stage submitted on its own, then the composite (what
+/// the Filament integration runs, with its skips). Render and RenderBatch take the
+/// submission path instead.
+inline visualization::rendering::RenderOutput RenderStages(
+    visualization::rendering::vulkan::GaussianSplatVulkanBackend& backend,
+    const camera::PinholeCamera& camera, const visualization::rendering::RenderConfig& config,
+    const visualization::rendering::CompositeInputs& inputs = {}) {
+    backend.RenderGeometryStage(camera, config);
+    visualization::rendering::RenderOutput out;
+    backend.RenderCompositeStage(out, inputs);
+    return out;
+}
 
 class VulkanTest : public ::testing::Test {
 protected:
@@ -39,6 +53,13 @@ protected:
         return handles;
     }
     static visualization::rendering::vulkan::CommandPool& Pool() { return *pool_; }
+    /// A Vulkan backend on the shared device, so the validation check covers it.
+    static std::unique_ptr<visualization::rendering::vulkan::GaussianSplatVulkanBackend>
+    MakeBackend(uint32_t entry_capacity = 1u << 22) {
+        return std::make_unique<visualization::rendering::vulkan::GaussianSplatVulkanBackend>(
+            visualization::rendering::vulkan::VulkanContext::CreateFromBorrowed(BorrowedHandles()),
+            entry_capacity);
+    }
 
     /// Creates a context as the fixture does; on failure returns nullptr and sets
     /// `skip_reason` (no device) or `failure` (device present, validation layer missing).

@@ -7,10 +7,12 @@ namespace visualization {
 namespace rendering {
 namespace vulkan {
 
-void CommandBuffer::Begin() const {
+void CommandBuffer::Begin(bool one_time_submit) const {
     VkCommandBufferBeginInfo info =
         MakeInfo<VkCommandBufferBeginInfo>(VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO);
-    info.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
+    info.flags = one_time_submit
+                     ? VkCommandBufferUsageFlags(VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT)
+                     : VkCommandBufferUsageFlags(0);
     CheckVk(vkBeginCommandBuffer(buffer_, &info), "vkBeginCommandBuffer");
 }
 
@@ -63,6 +65,17 @@ void Submit(const VulkanContext& context, VkCommandBuffer cmd, VkFence fence) {
 void Wait(const VulkanContext& context, VkFence fence) {
     CheckVk(vkWaitForFences(context.GetDevice(), 1, &fence, VK_TRUE, UINT64_MAX),
             "vkWaitForFences");
+}
+
+bool IsSignaled(const VulkanContext& context, VkFence fence) {
+    const VkResult result = vkGetFenceStatus(context.GetDevice(), fence);
+    if (result == VK_NOT_READY) return false;
+    CheckVk(result, "vkGetFenceStatus");
+    return true;
+}
+
+void ResetFence(const VulkanContext& context, VkFence fence) {
+    CheckVk(vkResetFences(context.GetDevice(), 1, &fence), "vkResetFences");
 }
 
 void SubmitAndWait(const VulkanContext& context, const CommandPool& pool,

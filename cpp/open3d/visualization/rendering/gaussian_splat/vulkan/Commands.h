@@ -40,8 +40,8 @@ public:
     }
 
     VkCommandBuffer Get() const { return buffer_; }
-    /// vkBeginCommandBuffer with ONE_TIME_SUBMIT.
-    void Begin() const;
+    /// vkBeginCommandBuffer, with ONE_TIME_SUBMIT unless the recording is submitted again.
+    void Begin(bool one_time_submit = true) const;
     void End() const;
 
 private:
@@ -72,6 +72,12 @@ void Submit(const VulkanContext& context, VkCommandBuffer cmd, VkFence fence);
 
 /// Waits for `fence` (no timeout: a hung GPU surfaces as VK_ERROR_DEVICE_LOST).
 void Wait(const VulkanContext& context, VkFence fence);
+
+/// Whether `fence` is signalled (no wait).
+bool IsSignaled(const VulkanContext& context, VkFence fence);
+
+/// Returns a signalled `fence` to unsignalled, for the next submission that reuses it.
+void ResetFence(const VulkanContext& context, VkFence fence);
 
 /// Records `record` into a fresh command buffer of `pool`, submits it and waits. For setup,
 /// uploads and tests; frames submit without waiting.

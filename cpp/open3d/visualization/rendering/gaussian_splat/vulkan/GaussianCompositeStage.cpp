@@ -94,8 +94,14 @@ void RequireView(VkImageView view, const char* what) {
 }  // namespace
 
 VkFormat ToVkFormat(CompositeColorFormat format) {
-    return format == CompositeColorFormat::kRgba16f ? VK_FORMAT_R16G16B16A16_SFLOAT
-                                                    : VK_FORMAT_R32G32B32A32_SFLOAT;
+    switch (format) {
+        case CompositeColorFormat::kRgba16f:
+            return VK_FORMAT_R16G16B16A16_SFLOAT;
+        case CompositeColorFormat::kRgba8:
+            return VK_FORMAT_R8G8B8A8_UNORM;
+        default:
+            return VK_FORMAT_R32G32B32A32_SFLOAT;
+    }
 }
 
 GaussianCompositeStage::GaussianCompositeStage(const VulkanContext& context) : context_(context) {
@@ -134,18 +140,25 @@ VkDeviceSize GaussianCompositeStage::StateBytes(uint32_t width, uint32_t height)
 
 VkPipeline GaussianCompositeStage::GetCompositePipeline(CompositeColorFormat format,
                                                         const CompositeParams& params) {
-    const bool half = format == CompositeColorFormat::kRgba16f;
     const bool scene_depth = params.scene_depth != nullptr;
     const uint32_t depth_outputs = (params.expected_depth ? kCompositeExpectedDepthBit : 0u) |
                                    (params.median_depth ? kCompositeMedianDepthBit : 0u);
     static_assert(kCompositeExpectedDepthBit == 1u && kCompositeMedianDepthBit == 2u);
+    const uint32_t format_index = static_cast<uint32_t>(format);
     UniquePipeline& pipeline =
-        composite_[(half ? 8u : 0u) + (scene_depth ? 4u : 0u) + depth_outputs];
+        composite_[format_index * 8u + (scene_depth ? 4u : 0u) + depth_outputs];
     if (!pipeline) {
-        pipeline = CreateSpecialised(
-            context_, composite_layout_.Get(),
-            half ? spirv::kGaussianCompositeRgba16f : spirv::kGaussianComposite,
-            half ? "gaussian_composite_rgba16f" : "gaussian_composite", scene_depth, depth_outputs);
+        std::span<const uint32_t> code = spirv::kGaussianComposite;
+        const char* name = "gaussian_composite";
+        if (format == CompositeColorFormat::kRgba16f) {
+            code = spirv::kGaussianCompositeRgba16f;
+            name = "gaussian_composite_rgba16f";
+        } else if (format == CompositeColorFormat::kRgba8) {
+            code = spirv::kGaussianCompositeRgba8;
+            name = "gaussian_composite_rgba8";
+        }
+        pipeline = CreateSpecialised(context_, composite_layout_.Get(), code, name, scene_depth,
+                                     depth_outputs);
     }
     return pipeline.Get();
 }

@@ -29,6 +29,9 @@ enum class CompositeColorFormat {
     /// VK_FORMAT_R16G16B16A16_SFLOAT: the Filament overlay. Its quantisation alone costs
     /// about 77 dB PSNR against the float32 result, below the 80 dB accuracy target.
     kRgba16f,
+    /// VK_FORMAT_R8G8B8A8_UNORM: batched rendering for 8-bit images (a quarter of the bytes
+    /// to read back; the conversion is the device's float-to-unorm rounding).
+    kRgba8,
 };
 
 VkFormat ToVkFormat(CompositeColorFormat format);
@@ -168,8 +171,8 @@ private:
     UniquePipelineLayout merge_layout_;
     UniquePipeline tile_ranges_;
     // [format][scene depth][expected depth][median depth]
-    std::array<UniquePipeline, 16> composite_;
-    std::array<UniquePipeline, 2> merge_;  // [scene depth]
+    std::array<UniquePipeline, 24> composite_;  // format * 8 + scene depth * 4 + outputs
+    std::array<UniquePipeline, 2> merge_;       // [scene depth]
     Image placeholder_depth_;
 };
 

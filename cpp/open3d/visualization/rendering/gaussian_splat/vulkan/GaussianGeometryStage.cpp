@@ -167,7 +167,8 @@ void GaussianGeometryStage::PushBindings(VkCommandBuffer cmd,
 
 void GaussianGeometryStage::Record(VkCommandBuffer cmd, const GeometryStageSceneBuffers& scene,
                                    const GeometryStageViewBuffers& buffers, const PackedView& view,
-                                   const GpuTimestamps* timestamps) {
+                                   const GpuTimestamps* timestamps,
+                                   const BufferRange* params_source) {
     if (timestamps) timestamps->RecordBegin(cmd, TimedPass::kProject);
     const uint32_t n = scene.num_splats;
     const GaussianViewParams& params = view.params;
@@ -188,9 +189,16 @@ void GaussianGeometryStage::Record(VkCommandBuffer cmd, const GeometryStageScene
         return BufferRange{counters, counters_offset + 4 * index, 4};
     };
 
-    // Per-frame inputs, written in the command buffer: no mapped memory, no hidden upload.
-    vkCmdUpdateBuffer(cmd, buffers.view_params.buffer, buffers.view_params.offset, sizeof(params),
-                      &params);
+    // Per-frame inputs, written in the command buffer (no mapped memory, no hidden upload) or
+    // copied from the caller's source when the recording is re-submitted with new cameras.
+    if (params_source != nullptr) {
+        const VkBufferCopy region{params_source->offset, buffers.view_params.offset,
+                                  sizeof(params)};
+        vkCmdCopyBuffer(cmd, params_source->buffer, buffers.view_params.buffer, 1, &region);
+    } else {
+        vkCmdUpdateBuffer(cmd, buffers.view_params.buffer, buffers.view_params.offset,
+                          sizeof(params), &params);
+    }
     // Counters start at zero but for N, the element count of the exact mode's depth sort
     // (the sorter reads counts from GPU memory). In the exact order the scan and the emit
     // run over all N slots of the depth-sorted list (culled splats sort last and count no

@@ -112,9 +112,15 @@ public:
     /// COMPUTE_SHADER storage writes (the counters also) for the caller to barrier.
     /// With `timestamps` (reset by the caller in this command buffer), the projection and
     /// its dispatch arguments are timed as TimedPass::kProject and everything after as kSort.
+    ///
+    /// With `params_source` (sizeof(shader::GaussianViewParams) bytes, e.g. a host-mapped
+    /// buffer written before each submission) view.params is copied from it when the
+    /// command buffer runs instead of being baked into it: one recording then serves every
+    /// camera of the same resolution, scene and config.
     void Record(VkCommandBuffer cmd, const GeometryStageSceneBuffers& scene,
                 const GeometryStageViewBuffers& buffers, const PackedView& view,
-                const GpuTimestamps* timestamps = nullptr);
+                const GpuTimestamps* timestamps = nullptr,
+                const BufferRange* params_source = nullptr);
 
 private:
     VkPipeline GetProjectPipeline(uint32_t sh_degree, bool antialias, SplatPrecision precision,

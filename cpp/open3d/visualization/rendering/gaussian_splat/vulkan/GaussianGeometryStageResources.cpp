@@ -52,8 +52,7 @@ void GeometryStageResources::UploadScene(const VulkanContext& context, const Com
     layout_.center_min = packed.center_min;
     layout_.center_max = packed.center_max;
     // The per-view buffers are sized for a splat count: a new scene needs new ones.
-    projected = Buffer();
-    entry_capacity_ = 0;
+    view_ = GeometryStageViewResources();
 }
 
 void GeometryStageResources::UploadVisibility(const VulkanContext& context, const CommandPool& pool,
@@ -67,7 +66,11 @@ void GeometryStageResources::UploadVisibility(const VulkanContext& context, cons
 }
 
 void GeometryStageResources::AllocateView(const VulkanContext& context, uint32_t entry_capacity) {
-    const uint32_t n = static_cast<uint32_t>(layout_.num_splats);
+    view_.Allocate(context, static_cast<uint32_t>(layout_.num_splats), entry_capacity);
+}
+
+void GeometryStageViewResources::Allocate(const VulkanContext& context, uint32_t n,
+                                          uint32_t entry_capacity) {
     const GeometryStageStorageRequirements need =
         GaussianGeometryStage::GetStorageRequirements(n, entry_capacity);
     const auto make = [&](VkDeviceSize bytes, VkBufferUsageFlags usage) {
@@ -87,6 +90,7 @@ void GeometryStageResources::AllocateView(const VulkanContext& context, uint32_t
     values_alt = make(need.sort.values_alt_bytes, need.sort.scratch_usage);
     histogram = make(need.sort.histogram_bytes, need.sort.scratch_usage);
     sort_params = make(need.sort.params_bytes, need.sort.params_usage);
+    num_splats_ = n;
     entry_capacity_ = entry_capacity;
 }
 
@@ -103,7 +107,9 @@ GeometryStageSceneBuffers GeometryStageResources::Scene() const {
     return scene;
 }
 
-GeometryStageViewBuffers GeometryStageResources::View() const {
+GeometryStageViewBuffers GeometryStageResources::View() const { return view_.Buffers(); }
+
+GeometryStageViewBuffers GeometryStageViewResources::Buffers() const {
     GeometryStageViewBuffers view;
     view.view_params = view_params.Range();
     view.projected = projected.Range();
@@ -121,12 +127,18 @@ GeometryStageViewBuffers GeometryStageResources::View() const {
 
 PackedView GeometryStageResources::ViewParams(const camera::PinholeCamera& camera,
                                               const RenderConfig& config) const {
+    return ViewParams(camera, config, view_.EntryCapacity());
+}
+
+PackedView GeometryStageResources::ViewParams(const camera::PinholeCamera& camera,
+                                              const RenderConfig& config,
+                                              uint32_t entry_capacity) const {
     ViewPackingInputs inputs;
     inputs.num_splats = layout_.num_splats;
     inputs.packed_sh_degree = layout_.sh_degree;
     inputs.precision = layout_.precision;
     inputs.sh_words_per_splat = layout_.sh_words_per_splat;
-    inputs.entry_capacity = entry_capacity_;
+    inputs.entry_capacity = entry_capacity;
     inputs.center_min = layout_.center_min;
     inputs.center_max = layout_.center_max;
     return PackGaussianView(camera, config, inputs);

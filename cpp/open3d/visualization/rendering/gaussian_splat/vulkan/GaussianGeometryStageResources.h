@@ -23,6 +23,26 @@ namespace vulkan {
 Buffer UploadStorageBuffer(const VulkanContext& context, const CommandPool& pool, const void* data,
                            VkDeviceSize bytes);
 
+/// One view's geometry-stage outputs and scratch, sized for a splat count and an entry
+/// capacity. The backend keeps one per frame slot, so frames in flight never share them.
+class GeometryStageViewResources {
+public:
+    /// (Re)allocates every buffer for `num_splats` splats and `entry_capacity` entries.
+    void Allocate(const VulkanContext& context, uint32_t num_splats, uint32_t entry_capacity);
+    /// Bindings for GaussianGeometryStage::Record.
+    GeometryStageViewBuffers Buffers() const;
+    uint32_t EntryCapacity() const { return entry_capacity_; }
+    uint32_t NumSplats() const { return num_splats_; }
+    explicit operator bool() const { return static_cast<bool>(projected); }
+
+    Buffer view_params, projected, counters, depth_keys, splat_indices, tile_counts, scan;
+    Buffer entry_keys, entry_values, keys_alt, values_alt, histogram, sort_params;
+
+private:
+    uint32_t num_splats_ = 0;
+    uint32_t entry_capacity_ = 0;
+};
+
 class GeometryStageResources {
 public:
     /// Uploads the packed attributes (a degree-0 scene gets a 16-byte SH placeholder: the
@@ -41,23 +61,25 @@ public:
     /// The view parameters of `camera` for this scene and view allocation, with the choices
     /// GaussianGeometryStage::Record picks its pipelines from.
     PackedView ViewParams(const camera::PinholeCamera& camera, const RenderConfig& config) const;
+    /// The same for view buffers of `entry_capacity` entries (a frame slot's).
+    PackedView ViewParams(const camera::PinholeCamera& camera, const RenderConfig& config,
+                          uint32_t entry_capacity) const;
 
     /// The packing's sizes (its attribute vectors are empty).
     const PackedGaussianSplats& Layout() const { return layout_; }
-    uint32_t EntryCapacity() const { return entry_capacity_; }
-    bool HasView() const { return static_cast<bool>(projected); }
+    uint32_t EntryCapacity() const { return view_.EntryCapacity(); }
+    bool HasView() const { return static_cast<bool>(view_); }
+    const GeometryStageViewResources& ViewResources() const { return view_; }
     /// Bytes of the scene on the GPU: positions + shape + SH (if any) + visibility mask.
     uint64_t SceneBytes() const { return scene_bytes_; }
 
     // Scene.
     Buffer positions, shape, sh, visibility;
-    // View: geometry stage's outputs (projected splats, counters, sorted entries) and scratch.
-    Buffer view_params, projected, counters, depth_keys, splat_indices, tile_counts, scan;
-    Buffer entry_keys, entry_values, keys_alt, values_alt, histogram, sort_params;
 
 private:
     PackedGaussianSplats layout_;
-    uint32_t entry_capacity_ = 0;
+    // One view's outputs (projected splats, counters, sorted entries) and scratch.
+    GeometryStageViewResources view_;
     uint64_t scene_bytes_ = 0;
 };
 

@@ -23,13 +23,6 @@ bool SameCamera(const camera::PinholeCamera& a, const camera::PinholeCamera& b) 
            a.cx == b.cx && a.cy == b.cy && a.world_to_camera == b.world_to_camera;
 }
 
-bool SameConfig(const RenderConfig& a, const RenderConfig& b) {
-    return a.near_plane == b.near_plane && a.sh_degree == b.sh_degree &&
-           a.antialias == b.antialias && a.max_tiles_per_splat == b.max_tiles_per_splat &&
-           a.max_tile_entries_total == b.max_tile_entries_total && a.sort_mode == b.sort_mode &&
-           a.depth_order == b.depth_order && a.compact_storage == b.compact_storage;
-}
-
 // After the composite (compute writes) or the empty-frame clear (transfer writes).
 void ToTransferSrc(VkCommandBuffer cmd, const Image& image, VkPipelineStageFlags2 stage,
                    VkAccessFlags2 access) {
@@ -43,14 +36,22 @@ double PassMs(const std::vector<double>& ms, TimedPass pass) {
     return std::max(0.0, ms[static_cast<uint32_t>(pass)]);
 }
 
-const char* FlagMessage(uint32_t bit) {
-    return bit == kEntriesDropped
-               ? "tile entries were dropped (a splat touches more than max_tiles_per_splat "
-                 "tiles or the entries exceed max_tile_entries_total)"
-               : "Geometry stage counts were clamped to the allocated tile-entry capacity";
-}
-
 }  // namespace
+
+void GaussianSplatVulkanBackend::WarnNewFlags(uint32_t flags) {
+    const uint32_t new_flags = flags & ~warned_flags_;
+    if (new_flags & kEntriesDropped) {
+        core::LogWarning(
+            "Gaussian splat Vulkan backend: tile entries were dropped (a splat touches more "
+            "than max_tiles_per_splat tiles or the entries exceed max_tile_entries_total)");
+    }
+    if (new_flags & kCountsClamped) {
+        core::LogWarning(
+            "Gaussian splat Vulkan backend: geometry stage counts were clamped to the "
+            "allocated tile-entry capacity");
+    }
+    warned_flags_ |= flags;
+}
 
 uint32_t GaussianSplatVulkanBackend::MaxEntryCapacity(const RenderConfig& config) {
     return static_cast<uint32_t>(std::min<uint64_t>(
@@ -65,11 +66,14 @@ GaussianSplatVulkanBackend::GaussianSplatVulkanBackend(std::unique_ptr<VulkanCon
       composite_stage_(*context_),
       geometry_stage_timestamps_(*context_),
       composite_stage_timestamps_(*context_),
-      initial_entry_capacity_(std::max(1u, initial_entry_capacity)) {}
+      initial_entry_capacity_(std::max(1u, initial_entry_capacity)) {
+    SetFramesInFlight(2);
+}
 
 GaussianSplatVulkanBackend::~GaussianSplatVulkanBackend() {
     // Nothing may still run on buffers we are about to free.
     if (geometry_.in_flight) Wait(*context_, geometry_stage_fence_.Get());
+    WaitAllSlots();
 }
 
 void GaussianSplatVulkanBackend::SetScene(const t::geometry::PointCloud& cloud) {
@@ -82,6 +86,8 @@ void GaussianSplatVulkanBackend::SetScene(const t::geometry::PointCloud& cloud) 
 }
 
 void GaussianSplatVulkanBackend::UploadScene(SplatPrecision precision) {
+    RetireSceneBuffers(false);
+    ++scene_serial_;
     PackedGaussianSplats packed = PackGaussianSplatAttrs(*cloud_, precision);
     if (!visibility_mask_.empty()) packed.visibility = visibility_mask_;
     geometry_stage_resources_.UploadScene(*context_, pool_, packed);
@@ -92,6 +98,8 @@ void GaussianSplatVulkanBackend::SetVisibility(const std::vector<uint32_t>& mask
     if (!cloud_) core::ThrowError("Vulkan backend: SetVisibility before SetScene");
     if (geometry_.in_flight) Wait(*context_, geometry_stage_fence_.Get());
     geometry_.in_flight = false;
+    RetireSceneBuffers(true);
+    ++scene_serial_;
     geometry_stage_resources_.UploadVisibility(*context_, pool_, mask);
     visibility_mask_ = mask;
     geometry_.valid = false;  // hidden splats change geometry stage's output
@@ -99,6 +107,8 @@ void GaussianSplatVulkanBackend::SetVisibility(const std::vector<uint32_t>& mask
 
 void GaussianSplatVulkanBackend::ReleaseResources() {
     if (geometry_.in_flight) Wait(*context_, geometry_stage_fence_.Get());
+    SetFramesInFlight(GetFramesInFlight());  // waits for the slots and empties them
+    deferred_.Clear();
     geometry_ = GeometryState{};
     cloud_.reset();
     visibility_mask_.clear();
@@ -165,7 +175,7 @@ void GaussianSplatVulkanBackend::RenderGeometryStage(const camera::PinholeCamera
         geometry_.valid = false;
     }
     if (config.reuse_geometry && geometry_.valid && SameCamera(camera, geometry_.camera) &&
-        SameConfig(config, geometry_.config)) {
+        SameGeometryConfig(config, geometry_.config)) {
         geometry_.reused = true;
         ++counters_.geometry_reuses;
         return;
@@ -177,6 +187,7 @@ void GaussianSplatVulkanBackend::RenderGeometryStage(const camera::PinholeCamera
 
     const PackedView view = geometry_stage_resources_.ViewParams(camera, config);
 
+    const auto record_start = std::chrono::steady_clock::now();
     geometry_stage_cmd_ = pool_.Allocate();
     VkCommandBuffer cmd = geometry_stage_cmd_.Get();
     geometry_stage_cmd_.Begin();
@@ -189,12 +200,15 @@ void GaussianSplatVulkanBackend::RenderGeometryStage(const camera::PinholeCamera
                         VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, VK_PIPELINE_STAGE_2_COPY_BIT,
                         VK_ACCESS_2_TRANSFER_READ_BIT);
     const VkBufferCopy counters_region{0, 0, counters_readback_.GetSize()};
-    vkCmdCopyBuffer(cmd, geometry_stage_resources_.counters.Get(), counters_readback_.Get(), 1,
-                    &counters_region);
+    vkCmdCopyBuffer(cmd, geometry_stage_resources_.ViewResources().counters.Get(),
+                    counters_readback_.Get(), 1, &counters_region);
     geometry_stage_cmd_.End();
     geometry_stage_fence_ = CreateFence(*context_);
+    const double record_ms = core::MillisecondsSince(record_start);
+    const auto submit_start = std::chrono::steady_clock::now();
     // Fire and forget: composite stage (or the next geometry stage) waits on the fence.
     Submit(*context_, cmd, geometry_stage_fence_.Get());
+    const double submit_ms = core::MillisecondsSince(submit_start);
     ++counters_.geometry_runs;
     geometry_.camera = camera;
     geometry_.config = config;
@@ -203,6 +217,8 @@ void GaussianSplatVulkanBackend::RenderGeometryStage(const camera::PinholeCamera
     geometry_.reused = false;
     geometry_.times = RenderStats{};
     geometry_.times.geometry_ms = core::MillisecondsSince(start);
+    geometry_.times.host_record_ms = record_ms;
+    geometry_.times.host_submit_ms = submit_ms;
 }
 
 // RenderCompositeStage's sink: the backend's RGBA32F colour image, the scene depth uploaded
@@ -301,10 +317,9 @@ void GaussianSplatVulkanBackend::RenderCompositeStage(RenderOutput& output,
                                                       const CompositeInputs& inputs) {
     if (!geometry_.valid)
         core::ThrowError("Vulkan backend: RenderCompositeStage before RenderGeometryStage");
-    if (inputs.read_back) {
-        EnsureReadback(static_cast<uint32_t>(geometry_.camera.width),
-                       static_cast<uint32_t>(geometry_.camera.height));
-    }
+    // The colour target exists with or without readback (the composite writes it).
+    EnsureReadback(static_cast<uint32_t>(geometry_.camera.width),
+                   static_cast<uint32_t>(geometry_.camera.height));
     ReadbackSink sink(*this, inputs, output);
     output.stats = RenderComposite(sink);
 }
@@ -334,7 +349,9 @@ RenderStats GaussianSplatVulkanBackend::RenderComposite(CompositeSink& sink) {
         core::ThrowError("Vulkan backend: the composite targets are {}x{}, the camera is {}x{}",
                          color.GetWidth(), color.GetHeight(), w, h);
     }
+    const auto geometry_wait_start = std::chrono::steady_clock::now();
     WaitForGeometry();
+    const double geometry_wait_ms = core::MillisecondsSince(geometry_wait_start);
     EnsureTargets(w, h);
     shader::GaussianGeometryStageCounters gpu_counters{};
     std::memcpy(&gpu_counters, counters_readback_.GetMapped(), sizeof(gpu_counters));
@@ -347,6 +364,7 @@ RenderStats GaussianSplatVulkanBackend::RenderComposite(CompositeSink& sink) {
         params.background[c] = static_cast<float>(geometry_.config.background[c]);
     sink.AdjustParams(params);
 
+    const auto record_start = std::chrono::steady_clock::now();
     CommandBuffer cmd_buffer = pool_.Allocate();
     VkCommandBuffer cmd = cmd_buffer.Get();
     cmd_buffer.Begin();
@@ -388,10 +406,10 @@ RenderStats GaussianSplatVulkanBackend::RenderComposite(CompositeSink& sink) {
         ++counters_.skipped_composites;
     } else {
         CompositeStageInputs inputs;
-        inputs.projected = geometry_stage_resources_.projected.Range();
-        inputs.entry_keys = geometry_stage_resources_.entry_keys.Range();
-        inputs.entry_values = geometry_stage_resources_.entry_values.Range();
-        inputs.entry_count = geometry_stage_resources_.counters.Range(
+        inputs.projected = geometry_stage_resources_.ViewResources().projected.Range();
+        inputs.entry_keys = geometry_stage_resources_.ViewResources().entry_keys.Range();
+        inputs.entry_values = geometry_stage_resources_.ViewResources().entry_values.Range();
+        inputs.entry_count = geometry_stage_resources_.ViewResources().counters.Range(
             offsetof(shader::GaussianGeometryStageCounters, entry_count), sizeof(uint32_t));
         inputs.entry_capacity = geometry_stage_resources_.EntryCapacity();
         CompositeStageTargets targets;
@@ -411,8 +429,13 @@ RenderStats GaussianSplatVulkanBackend::RenderComposite(CompositeSink& sink) {
     sink.RecordAfter(frame);
     cmd_buffer.End();
     UniqueFence fence = CreateFence(*context_);
+    const double record_ms = core::MillisecondsSince(record_start);
+    const auto submit_start = std::chrono::steady_clock::now();
     Submit(*context_, cmd, fence.Get());
+    const double submit_ms = core::MillisecondsSince(submit_start);
+    const auto wait_start = std::chrono::steady_clock::now();
     Wait(*context_, fence.Get());
+    const double wait_ms = core::MillisecondsSince(wait_start);
     ++counters_.composites;
 
     // The allocation, not the config, cut this frame short: grow the entry buffers to what
@@ -433,12 +456,8 @@ RenderStats GaussianSplatVulkanBackend::RenderComposite(CompositeSink& sink) {
         growing_ = false;
         return stats;
     }
-    const uint32_t new_flags = gpu_counters.error_flags & ~warned_flags_;
-    for (uint32_t bit : {kEntriesDropped, kCountsClamped}) {
-        if (new_flags & bit)
-            core::LogWarning("Gaussian splat Vulkan backend: {}", FlagMessage(bit));
-    }
-    warned_flags_ |= gpu_counters.error_flags;
+    WarnNewFlags(gpu_counters.error_flags);
+    const auto readback_start = std::chrono::steady_clock::now();
     sink.ReadBack();
 
     // A reused geometry stage did no work this frame: its times stay 0.
@@ -453,6 +472,11 @@ RenderStats GaussianSplatVulkanBackend::RenderComposite(CompositeSink& sink) {
     s.gpu_composite_ms = empty ? 0.0 : PassMs(ms, TimedPass::kComposite);
     s.gpu_merge_ms = PassMs(ms, TimedPass::kDepthMerge);
     s.gpu_scene_bytes = static_cast<int64_t>(geometry_stage_resources_.SceneBytes());
+    // The geometry stage's recording and submission (0 when reused), then this frame's.
+    s.host_record_ms += record_ms;
+    s.host_submit_ms += submit_ms;
+    s.host_wait_ms = geometry_wait_ms + wait_ms;
+    s.host_readback_ms = core::MillisecondsSince(readback_start);
     return s;
 }
 

@@ -1,19 +1,28 @@
 // The Vulkan compute backend ("vulkan"): uploads a splat scene once, then renders views
 // headless with geometry stage (GaussianGeometryStage) and composite stage
-// (GaussianCompositeStage), reads the images back and reports GPU time per pass. Geometry stage is
-// skipped when the scene, the camera and the config are unchanged (RenderConfig::reuse_geometry).
-// The Filament integration composites into images shared with GL instead (GaussianSplatInterop.h)
-// through the same frame logic (CompositeSink).
+// (GaussianCompositeStage), reads the images back and reports GPU time per pass.
+//
+// Two paths. The submission path (Render, RenderBatch, SubmitBatch / WaitBatch) records both
+// stages of one or many views into one command buffer per frame slot, submits it once and
+// keeps up to GetFramesInFlight() frames on the GPU; a recording is submitted again while
+// scene, config, size and outputs are unchanged (FrameSlot.h). The stage path
+// (RenderGeometryStage, then RenderCompositeStage or the Filament integration's
+// RenderCompositeToInterop through a CompositeSink) submits the geometry stage early so GL
+// work overlaps it, and skips it when scene, camera and config are unchanged
+// (RenderConfig::reuse_geometry).
 #pragma once
 
 #include <memory>
 #include <optional>
+#include <vector>
 
 #include "open3d/camera/PinholeCamera.h"
 #include "open3d/visualization/rendering/gaussian_splat/GaussianSplatBackend.h"
 #include "open3d/visualization/rendering/gaussian_splat/GaussianSplatDataPacking.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/Buffer.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/Commands.h"
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/DeferredRelease.h"
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/FrameSlot.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/GaussianCompositeStage.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/GaussianGeometryStage.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/GaussianGeometryStageResources.h"
@@ -84,6 +93,43 @@ public:
                              const RenderConfig& config) override;
     void RenderCompositeStage(RenderOutput& output, const CompositeInputs& inputs = {}) override;
 
+    /// One submission for both stages (the stage path when `inputs` has a scene depth).
+    RenderOutput Render(const camera::PinholeCamera& camera, const RenderConfig& config,
+                        const CompositeInputs& inputs = {}) override;
+    /// Splits the cameras into submissions of at most MaxViewsPerSubmission views and keeps
+    /// GetFramesInFlight() of them on the GPU while the host copies the previous ones out.
+    std::vector<RenderOutput> RenderBatch(const std::vector<camera::PinholeCamera>& cameras,
+                                          const RenderConfig& config,
+                                          const BatchOptions& options = {}) override;
+
+    /// Submits `cameras` (one size, at most MaxViewsPerSubmission) as one submission and
+    /// returns at once with its ticket for WaitBatch. Throws core::Open3DError when they do not
+    /// fit or when every frame slot holds a batch that WaitBatch has not collected yet.
+    uint64_t SubmitBatch(const std::vector<camera::PinholeCamera>& cameras,
+                         const RenderConfig& config, const BatchOptions& options = {});
+    /// Waits for the batch of `ticket` and returns its outputs (images when read back, stats
+    /// always). A batch whose entries outgrew the slot's buffers is rendered again with larger
+    /// ones before it returns. Throws for a ticket that is not pending.
+    std::vector<RenderOutput> WaitBatch(uint64_t ticket);
+
+    /// Frame slots of the submission path: 1 (no overlap) to 4; default 2. Waits for the
+    /// slots' work and drops what they hold.
+    void SetFramesInFlight(int count);
+    int GetFramesInFlight() const { return static_cast<int>(slots_.size()); }
+    /// Device bytes of per-view images one submission may hold (default 1 GiB).
+    void SetBatchBudget(uint64_t bytes);
+    /// The most views of `width` x `height` with `options` in one submission (>= 1).
+    uint32_t MaxViewsPerSubmission(uint32_t width, uint32_t height,
+                                   const BatchOptions& options) const;
+
+    /// The last completed batch (or Render) of the submission path.
+    struct BatchStats {
+        double gpu_ms = -1.0;  ///< GPU time of its submissions; negative when not measured
+        int submissions = 0;   ///< 1, or 2 when it was rendered again with larger buffers
+        bool recording_reused = false;
+    };
+    const BatchStats& GetLastBatchStats() const { return last_batch_; }
+
     /// Replaces the visibility mask: bit i of word i / 32 shows splat i ([ceil(N / 32)]).
     void SetVisibility(const std::vector<uint32_t>& mask);
     bool SetVisibilityMask(const std::vector<uint32_t>& mask) override {
@@ -104,6 +150,9 @@ public:
         int64_t composites = 0;          ///< composite stage recorded
         int64_t capacity_growths = 0;    ///< frames re-rendered with larger entry buffers
         int64_t skipped_composites = 0;  ///< frames with no tile entry: images cleared instead
+        int64_t submissions = 0;         ///< submission path: command buffers submitted
+        int64_t recordings = 0;          ///< submission path: command buffers recorded
+        int64_t deferred_releases = 0;   ///< resources retired while frames were in flight
     };
     const Counters& GetCounters() const { return counters_; }
     const VulkanContext& GetContext() const { return *context_; }
@@ -115,6 +164,22 @@ public:
 
 private:
     class ReadbackSink;
+
+    // Submission path (GaussianSplatVulkanBackendFrames.cpp).
+    FrameSlot& AcquireSlot();
+    void PrepareSlot(FrameSlot& slot, const FrameRecordingKey& key);
+    void RecordSlot(FrameSlot& slot, const FrameRecordingKey& key);
+    void SubmitSlot(FrameSlot& slot);
+    void WaitSlot(FrameSlot& slot);
+    void WaitAllSlots();
+    FrameRecordingKey MakeKey(const std::vector<camera::PinholeCamera>& cameras,
+                              const RenderConfig& config, const BatchOptions& options,
+                              uint32_t entry_capacity) const;
+    void EnsureScenePrecision(const RenderConfig& config);
+    void RetireSceneBuffers(bool visibility_only);
+    bool AnySlotBusy() const;
+    /// Logs each error flag the first time a frame reports it.
+    void WarnNewFlags(uint32_t flags);
 
     void UploadScene(SplatPrecision precision);
     void EnsureViewBuffers(uint32_t entry_capacity);
@@ -160,6 +225,14 @@ private:
     uint32_t warned_flags_ = 0;
     uint32_t initial_entry_capacity_ = 0;
     bool growing_ = false;
+
+    std::vector<std::unique_ptr<FrameSlot>> slots_;
+    DeferredReleaseQueue deferred_;
+    uint64_t next_serial_ = 1;       ///< serial of the next submission of the submission path
+    uint64_t completed_serial_ = 0;  ///< every submission up to it has completed
+    uint64_t scene_serial_ = 1;      ///< bumped by every scene upload (recordings bind buffers)
+    uint64_t batch_budget_ = uint64_t(1) << 30;
+    BatchStats last_batch_;
 };
 
 }  // namespace vulkan

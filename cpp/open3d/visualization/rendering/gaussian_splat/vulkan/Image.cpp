@@ -169,8 +169,9 @@ void RecordImageBarrier(VkCommandBuffer cmd, VkImage image, VkImageAspectFlags a
 }
 
 void RecordCopyToBuffer(VkCommandBuffer cmd, const Image& image, VkImageLayout layout,
-                        VkBuffer buffer) {
+                        VkBuffer buffer, VkDeviceSize offset) {
     VkBufferImageCopy region{};
+    region.bufferOffset = offset;
     region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
     region.imageExtent = {image.GetWidth(), image.GetHeight(), 1};
     vkCmdCopyImageToBuffer(cmd, image.Get(), layout, buffer, 1, &region);

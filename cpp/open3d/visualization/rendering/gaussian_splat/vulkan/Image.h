@@ -100,9 +100,9 @@ void RecordImageBarrier(VkCommandBuffer cmd, VkImage image, VkImageAspectFlags a
                         uint32_t dst_queue_family = VK_QUEUE_FAMILY_IGNORED);
 
 /// Records the copy of a colour image (in `layout`: TRANSFER_SRC_OPTIMAL or GENERAL) into
-/// `buffer`, tightly packed, row 0 first.
+/// `buffer` from `offset` on (a multiple of the texel size), tightly packed, row 0 first.
 void RecordCopyToBuffer(VkCommandBuffer cmd, const Image& image, VkImageLayout layout,
-                        VkBuffer buffer);
+                        VkBuffer buffer, VkDeviceSize offset = 0);
 
 /// IEEE binary16 bits to float (exact), for reading back RGBA16F images.
 float HalfToFloat(uint16_t bits);

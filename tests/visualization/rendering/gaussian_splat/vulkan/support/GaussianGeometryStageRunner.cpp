@@ -91,8 +91,8 @@ GeometryStageReadback GaussianGeometryStageRunner::Run(const camera::PinholeCame
         cmd.Begin();
         geometry_stage_.Record(cmd.Get(), scene, view, packed_view);
         ComputeToTransferBarrier(cmd.Get());
-        RecordCopy(context_, cmd.Get(), resources_.counters, sizeof(out.counters), &out.counters,
-                   pending);
+        RecordCopy(context_, cmd.Get(), resources_.ViewResources().counters, sizeof(out.counters),
+                   &out.counters, pending);
         cmd.End();
         UniqueFence fence = CreateFence(context_);
         const auto start = std::chrono::steady_clock::now();
@@ -118,14 +118,14 @@ GeometryStageReadback GaussianGeometryStageRunner::Run(const camera::PinholeCame
     out.entry_splats.resize(entries);
     if (read_projected) out.projected.resize(resources_.Layout().num_splats);
     SubmitAndWait(context_, pool_, [&](VkCommandBuffer cmd) {
-        RecordCopy(context_, cmd, resources_.splat_indices, VkDeviceSize(visible) * 4,
-                   out.visible_in_depth_order.data(), pending);
-        RecordCopy(context_, cmd, resources_.entry_keys, VkDeviceSize(entries) * 4,
+        RecordCopy(context_, cmd, resources_.ViewResources().splat_indices,
+                   VkDeviceSize(visible) * 4, out.visible_in_depth_order.data(), pending);
+        RecordCopy(context_, cmd, resources_.ViewResources().entry_keys, VkDeviceSize(entries) * 4,
                    out.entry_tiles.data(), pending);
-        RecordCopy(context_, cmd, resources_.entry_values, VkDeviceSize(entries) * 4,
-                   out.entry_splats.data(), pending);
+        RecordCopy(context_, cmd, resources_.ViewResources().entry_values,
+                   VkDeviceSize(entries) * 4, out.entry_splats.data(), pending);
         if (read_projected) {
-            RecordCopy(context_, cmd, resources_.projected,
+            RecordCopy(context_, cmd, resources_.ViewResources().projected,
                        out.projected.size() * sizeof(shader::GaussianProjectedSplat),
                        out.projected.data(), pending);
         }

@@ -1,0 +1,40 @@
+// Wall-clock measurements of gs-bench beside the GPU times: frames in flight through the
+// Vulkan backend's submission path, with and without readback, and batches of many views
+// (docs/benchmark.md "Wall clock").
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "open3d/camera/PinholeCamera.h"
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/GaussianSplatVulkanBackend.h"
+
+namespace open3d {
+namespace bench {
+
+/// Wall milliseconds per frame over `frames` single-view frames of `cameras` (cycled), with
+/// the backend's frames in flight kept full: frame k + depth is submitted once frame k is
+/// collected.
+double PipelinedMsPerFrame(visualization::rendering::vulkan::GaussianSplatVulkanBackend& backend,
+                           const std::vector<camera::PinholeCamera>& cameras,
+                           const visualization::rendering::RenderConfig& config,
+                           const visualization::rendering::BatchOptions& options, int frames);
+
+struct BatchThroughput {
+    double views_per_second = 0.0;
+    double gpu_ms_per_view = 0.0;  ///< the batches' GPU time over their views
+    int submissions_per_batch = 0;
+};
+
+/// RenderBatch of `batch` views (`cameras` repeated) `repeats` times after one warm-up batch.
+BatchThroughput MeasureBatch(visualization::rendering::vulkan::GaussianSplatVulkanBackend& backend,
+                             const std::vector<camera::PinholeCamera>& cameras,
+                             const visualization::rendering::RenderConfig& config,
+                             const visualization::rendering::BatchOptions& options, int batch,
+                             int repeats);
+
+/// "current/max" SM clock in MHz from nvidia-smi, or "" where it is not available.
+std::string ReadGpuClockMHz();
+
+}  // namespace bench
+}  // namespace open3d

@@ -1,0 +1,79 @@
+// One frame in flight of the Vulkan backend's submission path (SubmitBatch / Render): its own
+// geometry-stage buffers, composite targets, per-view output buffers and a command buffer that
+// is recorded once and submitted again while the scene, the config, the size and the outputs
+// stay the same (a new camera is a write into `params_upload`). Two or three slots let the
+// host prepare frame k + 1 while the GPU runs frame k; nothing here is shared between slots
+// but the scene, so a slot's buffers are only touched after its own fence.
+#pragma once
+
+#include <chrono>
+#include <cstdint>
+#include <vector>
+
+#include "open3d/camera/PinholeCamera.h"
+#include "open3d/visualization/rendering/gaussian_splat/GaussianSplatBackend.h"
+#include "open3d/visualization/rendering/gaussian_splat/RenderConfig.h"
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/Buffer.h"
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/Commands.h"
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/GaussianCompositeStage.h"
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/GaussianGeometryStageResources.h"
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/GpuTimestamps.h"
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/Image.h"
+
+namespace open3d {
+namespace visualization {
+namespace rendering {
+namespace vulkan {
+
+/// What a recording depends on. Equal keys: the recorded command buffer is submitted again.
+struct FrameRecordingKey {
+    uint32_t views = 0, width = 0, height = 0;
+    uint32_t entry_capacity = 0;
+    uint64_t scene_serial = 0;  ///< bumped by every scene, mask or precision upload
+    GeometryStageChoices choices;
+    RenderConfig config;
+    BatchOptions options;
+    bool operator==(const FrameRecordingKey& other) const;
+};
+
+struct FrameSlot {
+    explicit FrameSlot(const VulkanContext& context)
+        : pass_timestamps(context), job_timestamps(context, 1) {}
+
+    GeometryStageViewResources view;
+    // Composite targets of the slot's size (one set: the views of a job run one after another).
+    Image color, depth, alpha, median;
+    Buffer composite_state;
+    uint32_t width = 0, height = 0;
+    CompositeColorFormat color_format = CompositeColorFormat::kRgba32f;
+
+    // Per view of the job: parameters written by the host, counters read back, the images on
+    // the device (one buffer per kind, view i at i * image bytes) and their host copies.
+    Buffer params_upload, counters_readback;
+    Buffer device_color, device_depth, device_median;
+    Buffer host_color, host_depth, host_median;
+    uint32_t view_capacity = 0;  ///< views the per-view buffers hold
+
+    CommandBuffer cmd;
+    UniqueFence fence;
+    uint64_t serial = 0;            ///< of the last submission
+    bool in_flight = false;         ///< submitted, fence not waited for yet
+    GpuTimestamps pass_timestamps;  ///< per pass, for one-view jobs
+    GpuTimestamps job_timestamps;   ///< the whole job
+    FrameRecordingKey recorded;
+    bool has_recording = false;
+
+    // The batch in the slot, from SubmitBatch until its WaitBatch.
+    bool pending = false;
+    uint64_t ticket = 0;  ///< the serial of its first submission
+    bool recording_reused = false;
+    std::vector<camera::PinholeCamera> cameras;
+    RenderConfig config;
+    BatchOptions options;
+    double record_ms = 0.0, submit_ms = 0.0;
+};
+
+}  // namespace vulkan
+}  // namespace rendering
+}  // namespace visualization
+}  // namespace open3d
