@@ -48,19 +48,27 @@ TEST_F(SubmissionPath, OneSubmissionEqualsTheStagePath) {
     backend->SetScene(CreateDefaultGaussianSplatScene());
     RenderConfig config;
     config.background = Eigen::Vector3d(0.1, 0.2, 0.3);
-    for (const camera::PinholeCamera& cam : SlidingViews(3, 72, 40)) {
-        const RenderOutput submitted = backend->Render(cam, config);
-        ASSERT_FALSE(submitted.color.IsEmpty());
-        ASSERT_FALSE(submitted.depth_expected.IsEmpty());
-        ASSERT_FALSE(submitted.depth_median.IsEmpty());
-        EXPECT_GT(submitted.stats.num_tile_entries, 1000);
-        ExpectSameImages(submitted, RenderStages(*backend, cam, config));
+    const auto views = SlidingViews(3, 72, 40);
+    std::vector<RenderOutput> submitted;
+    for (const camera::PinholeCamera& cam : views) {
+        submitted.push_back(backend->Render(cam, config));
+        ASSERT_FALSE(submitted.back().color.IsEmpty());
+        ASSERT_FALSE(submitted.back().depth_expected.IsEmpty());
+        ASSERT_FALSE(submitted.back().depth_median.IsEmpty());
+        EXPECT_GT(submitted.back().stats.num_tile_entries, 1000);
     }
     // One recording per frame slot served the three cameras.
     EXPECT_EQ(backend->GetFramesInFlight(), 2);
     EXPECT_EQ(backend->GetCounters().recordings, 2);
     EXPECT_EQ(backend->GetCounters().submissions, 3);
     EXPECT_TRUE(backend->GetLastBatchStats().recording_reused);
+    // The stage path records its geometry stage once too and submits it again per camera.
+    for (size_t i = 0; i < views.size(); ++i) {
+        SCOPED_TRACE("view " + std::to_string(i));
+        ExpectSameImages(submitted[i], RenderStages(*backend, views[i], config));
+    }
+    EXPECT_EQ(backend->GetCounters().recordings, 3);
+    EXPECT_EQ(backend->GetCounters().geometry_runs, 3);
 }
 
 TEST_F(SubmissionPath, AResubmittedRecordingWithANewCameraEqualsAFreshRecording) {

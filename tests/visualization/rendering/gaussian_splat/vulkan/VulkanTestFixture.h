@@ -50,6 +50,9 @@ protected:
         handles.device = Context().GetDevice();
         handles.queue = Context().GetQueue();
         handles.queue_family_index = Context().GetQueueFamilyIndex();
+        // Readback copies then take the copy engines where the device has them (NVIDIA).
+        handles.transfer_queue = Context().GetTransferQueue();
+        handles.transfer_queue_family_index = Context().GetTransferQueueFamilyIndex();
         return handles;
     }
     static visualization::rendering::vulkan::CommandPool& Pool() { return *pool_; }

@@ -11,7 +11,7 @@ namespace rendering {
 namespace vulkan {
 
 Buffer::Buffer(const VulkanContext& context, VkDeviceSize size, VkBufferUsageFlags usage,
-               MemoryUsage memory)
+               MemoryUsage memory, bool shared_with_transfer)
     : size_(size) {
     assert(size > 0 && "Vulkan buffers cannot be empty");
     VkDevice device = context.GetDevice();
@@ -20,6 +20,13 @@ Buffer::Buffer(const VulkanContext& context, VkDeviceSize size, VkBufferUsageFla
     buffer_info.size = size;
     buffer_info.usage = usage;
     buffer_info.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
+    const uint32_t families[2] = {context.GetQueueFamilyIndex(),
+                                  context.GetTransferQueueFamilyIndex()};
+    if (shared_with_transfer && context.HasTransferQueue() && families[0] != families[1]) {
+        buffer_info.sharingMode = VK_SHARING_MODE_CONCURRENT;
+        buffer_info.queueFamilyIndexCount = 2;
+        buffer_info.pQueueFamilyIndices = families;
+    }
     VkBuffer buffer = VK_NULL_HANDLE;
     CheckVk(vkCreateBuffer(device, &buffer_info, nullptr, &buffer), "vkCreateBuffer");
     buffer_ = UniqueBuffer(device, buffer);

@@ -38,8 +38,10 @@ public:
     Buffer() = default;
     /// Creates a buffer of `size` bytes (> 0) with `usage` and binds fresh memory to it.
     /// Throws core::Open3DError when the allocation fails.
+    /// With `shared_with_transfer` the buffer is usable from the context's transfer queue
+    /// too (concurrent sharing of the two families, when the context has that queue).
     Buffer(const VulkanContext& context, VkDeviceSize size, VkBufferUsageFlags usage,
-           MemoryUsage memory);
+           MemoryUsage memory, bool shared_with_transfer = false);
 
     Buffer(Buffer&& other) noexcept
         : memory_(std::move(other.memory_)),

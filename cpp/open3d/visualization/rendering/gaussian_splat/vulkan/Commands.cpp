@@ -23,11 +23,14 @@ void CommandBuffer::Reset() {
     buffer_ = VK_NULL_HANDLE;
 }
 
-CommandPool::CommandPool(const VulkanContext& context) {
+CommandPool::CommandPool(const VulkanContext& context)
+    : CommandPool(context, context.GetQueueFamilyIndex()) {}
+
+CommandPool::CommandPool(const VulkanContext& context, uint32_t queue_family_index) {
     VkCommandPoolCreateInfo info =
         MakeInfo<VkCommandPoolCreateInfo>(VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO);
     info.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
-    info.queueFamilyIndex = context.GetQueueFamilyIndex();
+    info.queueFamilyIndex = queue_family_index;
     VkCommandPool pool = VK_NULL_HANDLE;
     CheckVk(vkCreateCommandPool(context.GetDevice(), &info, nullptr, &pool), "vkCreateCommandPool");
     pool_ = UniqueCommandPool(context.GetDevice(), pool);
@@ -53,13 +56,40 @@ UniqueFence CreateFence(const VulkanContext& context) {
 }
 
 void Submit(const VulkanContext& context, VkCommandBuffer cmd, VkFence fence) {
+    SubmitToQueue(context.GetQueue(), cmd, fence, VK_NULL_HANDLE, VK_PIPELINE_STAGE_2_NONE,
+                  VK_NULL_HANDLE);
+}
+
+void SubmitToQueue(VkQueue queue, VkCommandBuffer cmd, VkFence fence, VkSemaphore wait,
+                   VkPipelineStageFlags2 wait_stages, VkSemaphore signal) {
     VkCommandBufferSubmitInfo cmd_info =
         MakeInfo<VkCommandBufferSubmitInfo>(VK_STRUCTURE_TYPE_COMMAND_BUFFER_SUBMIT_INFO);
     cmd_info.commandBuffer = cmd;
+    VkSemaphoreSubmitInfo wait_info =
+        MakeInfo<VkSemaphoreSubmitInfo>(VK_STRUCTURE_TYPE_SEMAPHORE_SUBMIT_INFO);
+    wait_info.semaphore = wait;
+    wait_info.stageMask = wait_stages;
+    VkSemaphoreSubmitInfo signal_info =
+        MakeInfo<VkSemaphoreSubmitInfo>(VK_STRUCTURE_TYPE_SEMAPHORE_SUBMIT_INFO);
+    signal_info.semaphore = signal;
+    signal_info.stageMask = VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT;
     VkSubmitInfo2 submit = MakeInfo<VkSubmitInfo2>(VK_STRUCTURE_TYPE_SUBMIT_INFO_2);
     submit.commandBufferInfoCount = 1;
     submit.pCommandBufferInfos = &cmd_info;
-    CheckVk(vkQueueSubmit2(context.GetQueue(), 1, &submit, fence), "vkQueueSubmit2");
+    submit.waitSemaphoreInfoCount = wait != VK_NULL_HANDLE ? 1u : 0u;
+    submit.pWaitSemaphoreInfos = &wait_info;
+    submit.signalSemaphoreInfoCount = signal != VK_NULL_HANDLE ? 1u : 0u;
+    submit.pSignalSemaphoreInfos = &signal_info;
+    CheckVk(vkQueueSubmit2(queue, 1, &submit, fence), "vkQueueSubmit2");
+}
+
+UniqueSemaphore CreateBinarySemaphore(const VulkanContext& context) {
+    VkSemaphoreCreateInfo info =
+        MakeInfo<VkSemaphoreCreateInfo>(VK_STRUCTURE_TYPE_SEMAPHORE_CREATE_INFO);
+    VkSemaphore semaphore = VK_NULL_HANDLE;
+    CheckVk(vkCreateSemaphore(context.GetDevice(), &info, nullptr, &semaphore),
+            "vkCreateSemaphore");
+    return UniqueSemaphore(context.GetDevice(), semaphore);
 }
 
 void Wait(const VulkanContext& context, VkFence fence) {

@@ -56,6 +56,8 @@ private:
 class CommandPool {
 public:
     explicit CommandPool(const VulkanContext& context);
+    /// A pool of another family of the device (the transfer queue's).
+    CommandPool(const VulkanContext& context, uint32_t queue_family_index);
     /// A primary command buffer that can be reset and re-recorded.
     CommandBuffer Allocate() const;
     VkCommandPool Get() const { return pool_.Get(); }
@@ -69,6 +71,14 @@ UniqueFence CreateFence(const VulkanContext& context);
 
 /// Submits one command buffer to the context's queue, signalling `fence` when done.
 void Submit(const VulkanContext& context, VkCommandBuffer cmd, VkFence fence);
+
+/// Submits one command buffer to `queue`: waits for `wait` (if any) before `wait_stages`,
+/// signals `signal` (if any) and `fence` (if any) when done.
+void SubmitToQueue(VkQueue queue, VkCommandBuffer cmd, VkFence fence, VkSemaphore wait,
+                   VkPipelineStageFlags2 wait_stages, VkSemaphore signal);
+
+/// A binary semaphore.
+UniqueSemaphore CreateBinarySemaphore(const VulkanContext& context);
 
 /// Waits for `fence` (no timeout: a hung GPU surfaces as VK_ERROR_DEVICE_LOST).
 void Wait(const VulkanContext& context, VkFence fence);

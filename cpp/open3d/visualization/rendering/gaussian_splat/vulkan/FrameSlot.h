@@ -55,7 +55,12 @@ struct FrameSlot {
     uint32_t view_capacity = 0;  ///< views the per-view buffers hold
 
     CommandBuffer cmd;
-    UniqueFence fence;
+    // With a transfer queue and readback: the copies to host memory run on the copy engines
+    // (transfer_cmd, after `rendered`), overlapping the next submission's compute work.
+    CommandBuffer transfer_cmd;
+    UniqueSemaphore rendered;
+    bool uses_transfer = false;     ///< of the recording
+    UniqueFence fence;              ///< the last submission of the job
     uint64_t serial = 0;            ///< of the last submission
     bool in_flight = false;         ///< submitted, fence not waited for yet
     GpuTimestamps pass_timestamps;  ///< per pass, for one-view jobs

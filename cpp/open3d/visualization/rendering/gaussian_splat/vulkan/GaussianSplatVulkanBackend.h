@@ -189,6 +189,7 @@ private:
 
     std::unique_ptr<VulkanContext> context_;
     CommandPool pool_;
+    std::unique_ptr<CommandPool> transfer_pool_;  ///< when the context has a transfer queue
     GaussianGeometryStage geometry_stage_;
     GaussianCompositeStage composite_stage_;
     GpuTimestamps geometry_stage_timestamps_;
@@ -220,8 +221,13 @@ private:
         /// gpu_sort_ms and its parts (the rest stays 0).
         RenderStats times;
     } geometry_;
+    // Recorded once per FrameRecordingKey (one view) and submitted again with the camera
+    // written into stage_params_upload_.
     CommandBuffer geometry_stage_cmd_;
     UniqueFence geometry_stage_fence_;
+    Buffer stage_params_upload_;
+    FrameRecordingKey stage_recorded_;
+    bool stage_recording_valid_ = false;
     uint32_t warned_flags_ = 0;
     uint32_t initial_entry_capacity_ = 0;
     bool growing_ = false;

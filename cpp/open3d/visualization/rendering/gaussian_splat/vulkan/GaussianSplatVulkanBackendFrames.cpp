@@ -230,7 +230,9 @@ void GaussianSplatVulkanBackend::PrepareSlot(FrameSlot& slot, const FrameRecordi
     if (!same_outputs) {
         const VkDeviceSize pixels = VkDeviceSize(key.width) * key.height;
         const auto per_view = [&](bool wanted, VkDeviceSize bytes, MemoryUsage memory) {
-            return wanted ? Buffer(context, bytes * key.views, kTransfer, memory) : Buffer();
+            return wanted ? Buffer(context, bytes * key.views, kTransfer, memory,
+                                   /*shared_with_transfer=*/true)
+                          : Buffer();
         };
         const BatchOptions& o = key.options;
         const VkDeviceSize color_bytes = pixels * ColorBytesPerPixel(o);
@@ -335,10 +337,22 @@ void GaussianSplatVulkanBackend::RecordSlot(FrameSlot& slot, const FrameRecordin
                                i * bytes);
         }
     }
-    if (key.options.read_back) {
-        // The whole batch to host memory: one linear copy per kind.
+    // The host reads the counters (and, without a transfer queue, the images) after the fence.
+    slot.uses_transfer = key.options.read_back && context_->HasTransferQueue();
+    VkCommandBuffer copy_cmd = cmd;
+    if (slot.uses_transfer) {
+        if (slot.transfer_cmd.Get() == VK_NULL_HANDLE)
+            slot.transfer_cmd = transfer_pool_->Allocate();
+        if (!slot.rendered) slot.rendered = CreateBinarySemaphore(*context_);
+        slot.transfer_cmd.Begin(/*one_time_submit=*/false);
+        copy_cmd = slot.transfer_cmd.Get();
+    } else if (key.options.read_back) {
         RecordMemoryBarrier(cmd, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
                             VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_READ_BIT);
+    }
+    if (key.options.read_back) {
+        // The whole batch to host memory: one linear copy per kind, on the copy engines when
+        // the context has a transfer queue (the semaphore orders it after the rendering).
         const std::pair<const Buffer*, const Buffer*> readbacks[] = {
             {&slot.device_color, &slot.host_color},
             {&slot.device_depth, &slot.host_depth},
@@ -346,12 +360,16 @@ void GaussianSplatVulkanBackend::RecordSlot(FrameSlot& slot, const FrameRecordin
         for (const auto& [device, host] : readbacks) {
             if (!*host) continue;
             const VkBufferCopy region{0, 0, device->GetSize()};
-            vkCmdCopyBuffer(cmd, device->Get(), host->Get(), 1, &region);
+            vkCmdCopyBuffer(copy_cmd, device->Get(), host->Get(), 1, &region);
         }
     }
-    // The host reads the counters and images after the fence.
     RecordMemoryBarrier(cmd, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
                         VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT);
+    if (slot.uses_transfer) {
+        RecordMemoryBarrier(copy_cmd, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                            VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT);
+        slot.transfer_cmd.End();
+    }
     slot.job_timestamps.RecordEnd(cmd, 0u);
     slot.cmd.End();
     slot.recorded = key;
@@ -365,7 +383,14 @@ void GaussianSplatVulkanBackend::SubmitSlot(FrameSlot& slot) {
     } else {
         ResetFence(*context_, slot.fence.Get());
     }
-    Submit(*context_, slot.cmd.Get(), slot.fence.Get());
+    if (slot.uses_transfer) {
+        SubmitToQueue(context_->GetQueue(), slot.cmd.Get(), VK_NULL_HANDLE, VK_NULL_HANDLE,
+                      VK_PIPELINE_STAGE_2_NONE, slot.rendered.Get());
+        SubmitToQueue(context_->GetTransferQueue(), slot.transfer_cmd.Get(), slot.fence.Get(),
+                      slot.rendered.Get(), VK_PIPELINE_STAGE_2_COPY_BIT, VK_NULL_HANDLE);
+    } else {
+        Submit(*context_, slot.cmd.Get(), slot.fence.Get());
+    }
     slot.serial = next_serial_++;
     slot.in_flight = true;
     ++counters_.submissions;

@@ -149,6 +149,16 @@ struct DeviceQuery {
         return std::nullopt;
     }
 
+    /// A family that copies but neither draws nor computes: NVIDIA's copy engines.
+    std::optional<uint32_t> FindTransferFamily() const {
+        constexpr VkQueueFlags kOther = VK_QUEUE_GRAPHICS_BIT | VK_QUEUE_COMPUTE_BIT;
+        for (uint32_t i = 0; i < queue_families.size(); ++i) {
+            const VkQueueFlags flags = queue_families[i].queueFlags;
+            if ((flags & VK_QUEUE_TRANSFER_BIT) && !(flags & kOther)) return i;
+        }
+        return std::nullopt;
+    }
+
     /// Empty when the device can run the shaders, otherwise why not.
     std::string WhyUnsuitable() const {
         std::vector<std::string> missing;
@@ -287,8 +297,11 @@ std::unique_ptr<VulkanContext> VulkanContext::CreateHeadless(const VulkanContext
         core::ThrowError("Vulkan: no usable device.{}\n{}", rejected, kInstallHint);
     }
     const DeviceQuery chosen(best);
+    const char* transfer_env = std::getenv("OPEN3D_VULKAN_TRANSFER_QUEUE");
+    const bool transfer_wanted = transfer_env == nullptr || std::string(transfer_env) != "0";
     context->InitDevice(best, *chosen.FindQueueFamily(),
-                        chosen.HasExtension(VK_KHR_EXTERNAL_MEMORY_FD_EXTENSION_NAME));
+                        chosen.HasExtension(VK_KHR_EXTERNAL_MEMORY_FD_EXTENSION_NAME),
+                        transfer_wanted ? chosen.FindTransferFamily() : std::nullopt);
     return context;
 }
 
@@ -317,13 +330,21 @@ std::unique_ptr<VulkanContext> VulkanContext::CreateFromBorrowed(
     context->physical_device_ = handles.physical_device;
     context->device_ = handles.device;
     context->queue_ = handles.queue;
+    if (handles.transfer_queue != VK_NULL_HANDLE) {
+        if (handles.transfer_queue_family_index >= query.queue_families.size()) {
+            core::ThrowError("Vulkan: borrowed transfer queue family {} does not exist",
+                             handles.transfer_queue_family_index);
+        }
+        context->transfer_queue_ = handles.transfer_queue;
+        context->transfer_family_ = handles.transfer_queue_family_index;
+    }
     context->InitDevice(handles.physical_device, handles.queue_family_index,
                         handles.external_memory_fd_enabled);
     return context;
 }
 
 void VulkanContext::InitDevice(VkPhysicalDevice physical_device, uint32_t queue_family_index,
-                               bool external_memory_fd) {
+                               bool external_memory_fd, std::optional<uint32_t> transfer_family) {
     physical_device_ = physical_device;
     DeviceQuery query(physical_device);
     if (owns_handles_) {
@@ -332,11 +353,16 @@ void VulkanContext::InitDevice(VkPhysicalDevice physical_device, uint32_t queue_
                                             std::end(kRequiredDeviceExtensions));
         if (external_memory_fd) extensions.push_back(VK_KHR_EXTERNAL_MEMORY_FD_EXTENSION_NAME);
         const float priority = 1.0f;
-        VkDeviceQueueCreateInfo queue_info =
+        std::vector<VkDeviceQueueCreateInfo> queue_infos(1);
+        queue_infos[0] =
             MakeInfo<VkDeviceQueueCreateInfo>(VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO);
-        queue_info.queueFamilyIndex = queue_family_index;
-        queue_info.queueCount = 1;
-        queue_info.pQueuePriorities = &priority;
+        queue_infos[0].queueFamilyIndex = queue_family_index;
+        queue_infos[0].queueCount = 1;
+        queue_infos[0].pQueuePriorities = &priority;
+        if (transfer_family && *transfer_family != queue_family_index) {
+            queue_infos.push_back(queue_infos[0]);
+            queue_infos[1].queueFamilyIndex = *transfer_family;
+        }
         // maintenance4: glslang's vulkan1.3 SPIR-V declares workgroup sizes with
         // LocalSizeId, which the validation layer rejects without it.
         VkPhysicalDeviceVulkan13Features features13 = MakeInfo<VkPhysicalDeviceVulkan13Features>(
@@ -349,12 +375,16 @@ void VulkanContext::InitDevice(VkPhysicalDevice physical_device, uint32_t queue_
         VkDeviceCreateInfo device_info =
             MakeInfo<VkDeviceCreateInfo>(VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO);
         device_info.pNext = &features;
-        device_info.queueCreateInfoCount = 1;
-        device_info.pQueueCreateInfos = &queue_info;
+        device_info.queueCreateInfoCount = static_cast<uint32_t>(queue_infos.size());
+        device_info.pQueueCreateInfos = queue_infos.data();
         device_info.enabledExtensionCount = static_cast<uint32_t>(extensions.size());
         device_info.ppEnabledExtensionNames = extensions.data();
         CheckVk(vkCreateDevice(physical_device, &device_info, nullptr, &device_), "vkCreateDevice");
         vkGetDeviceQueue(device_, queue_family_index, 0, &queue_);
+        if (queue_infos.size() > 1) {
+            transfer_family_ = *transfer_family;
+            vkGetDeviceQueue(device_, transfer_family_, 0, &transfer_queue_);
+        }
     }
     vkGetPhysicalDeviceMemoryProperties(physical_device, &memory_properties_);
 
@@ -406,10 +436,11 @@ void VulkanContext::LoadDeviceFunctions(bool external_memory_fd) {
 void VulkanContext::ReportDevice() const {
     core::LogInfo(
         "Vulkan device: {} ({}), driver {} [{}], Vulkan {}, subgroup size {} (range {}..{}), "
-        "{} KiB shared memory, queue family {}, memory export {}, validation {}{}",
+        "{} KiB shared memory, queue family {}{}, memory export {}, validation {}{}",
         info_.name, info_.type, info_.driver_name, info_.driver_info,
         VersionString(info_.api_version), info_.subgroup_size, info_.min_subgroup_size,
         info_.max_subgroup_size, info_.max_compute_shared_memory / 1024, info_.queue_family_index,
+        HasTransferQueue() ? fmt::format(" (+ transfer family {})", transfer_family_) : "",
         SupportsExternalMemoryFd() ? "on" : "off", IsValidationEnabled() ? "on" : "off",
         owns_handles_ ? "" : ", handles borrowed from the host application");
 }

@@ -9,6 +9,7 @@
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 
 namespace open3d {
@@ -42,6 +43,10 @@ struct BorrowedVulkanHandles {
     /// The host created the device with VK_KHR_external_memory_fd (a context cannot ask a
     /// device which extensions it was created with): enables exporting image memory.
     bool external_memory_fd_enabled = false;
+    /// Optional: a queue of a transfer-only family (copy engines) that readback copies may
+    /// use beside `queue`; VK_NULL_HANDLE for none.
+    VkQueue transfer_queue = VK_NULL_HANDLE;
+    uint32_t transfer_queue_family_index = 0;
 };
 
 /// What the device is, as reported in the log at creation.
@@ -95,6 +100,13 @@ public:
     VkDevice GetDevice() const { return device_; }
     VkQueue GetQueue() const { return queue_; }
     uint32_t GetQueueFamilyIndex() const { return info_.queue_family_index; }
+    /// A queue of a transfer-only family (the copy engines) beside the compute queue, so
+    /// that copies to host memory overlap compute work. Headless contexts create one when
+    /// the device has such a family (NVIDIA does; lavapipe does not) unless the environment
+    /// sets OPEN3D_VULKAN_TRANSFER_QUEUE=0; borrowed ones use the host's, if given.
+    bool HasTransferQueue() const { return transfer_queue_ != VK_NULL_HANDLE; }
+    VkQueue GetTransferQueue() const { return transfer_queue_; }
+    uint32_t GetTransferQueueFamilyIndex() const { return transfer_family_; }
     const VulkanDeviceInfo& GetDeviceInfo() const { return info_; }
     /// False for a context made from borrowed handles.
     bool OwnsHandles() const { return owns_handles_; }
@@ -123,7 +135,8 @@ public:
 private:
     VulkanContext();
     void InitDevice(VkPhysicalDevice physical_device, uint32_t queue_family_index,
-                    bool external_memory_fd);
+                    bool external_memory_fd,
+                    std::optional<uint32_t> transfer_family = std::nullopt);
     void LoadDeviceFunctions(bool external_memory_fd);
     void ReportDevice() const;
 
@@ -135,6 +148,8 @@ private:
     VkPhysicalDevice physical_device_ = VK_NULL_HANDLE;
     VkDevice device_ = VK_NULL_HANDLE;
     VkQueue queue_ = VK_NULL_HANDLE;
+    VkQueue transfer_queue_ = VK_NULL_HANDLE;
+    uint32_t transfer_family_ = 0;
     VkPhysicalDeviceMemoryProperties memory_properties_{};
     PFN_vkCmdPushDescriptorSetKHR push_descriptor_set_ = nullptr;
     PFN_vkGetMemoryFdKHR get_memory_fd_ = nullptr;
