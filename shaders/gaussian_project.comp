@@ -238,9 +238,11 @@ bool Project(uint i, out float depth, out uint entries) {
     float det_raw = dot(u_cross, u_cross);
 
     // Low-pass dilation, conic, antialias factor, 3-sigma radius (ComputeScreenEllipse with
-    // det_raw): det(cov + 0.3 I) expanded, >= 0.09 unless not finite.
+    // det_raw): det(cov + 0.3 I) expanded, >= 0.09 unless not finite. A covariance past the
+    // float range (an astronomically large splat: the determinant grows as the 4th power of
+    // its screen size) is culled, as the CPU reference does (docs/accuracy.md "Extremes").
     float det = det_raw + 0.3 * (cov_a + cov_c) + 0.09;
-    if (!(det > 0.0)) return false;
+    if (!(det > 0.0) || isinf(det)) return false;
     float half_diff = 0.5 * (cov_a - cov_c);
     cov_a += 0.3;
     cov_c += 0.3;

@@ -3,6 +3,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "open3d/core/Exception.h"
 #include "open3d/core/ParallelFor.h"
@@ -69,7 +70,10 @@ ScreenEllipse ComputeScreenEllipse(double cov_a, double cov_b, double cov_c, dou
     // positive semi-definite covariance, so only a non-finite one is culled here (3DGS culls
     // det == 0, which exact arithmetic never reaches).
     const double det = det_raw + kDilation * (cov_a + cov_c) + kDilation * kDilation;
-    if (!(det > 0.0)) {
+    // Past the float32 range the GPU's determinant is infinite: such a splat (its screen
+    // extent beyond ~1e9 px) is culled by both renderers instead of each doing what its own
+    // arithmetic gives (docs/accuracy.md "Extremes").
+    if (!(det > 0.0) || !(det <= double(std::numeric_limits<float>::max()))) {
         e.degenerate = true;
         return e;
     }

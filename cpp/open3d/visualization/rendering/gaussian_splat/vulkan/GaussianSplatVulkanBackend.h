@@ -112,8 +112,9 @@ public:
     /// ones before it returns. Throws for a ticket that is not pending.
     std::vector<RenderOutput> WaitBatch(uint64_t ticket);
 
-    /// Frame slots of the submission path: 1 (no overlap) to 4; default 2. Waits for the
-    /// slots' work and drops what they hold.
+    /// Frame slots of the submission path: 1 (no overlap) to 4; default 2, 1 on a CPU device
+    /// (lavapipe), where a second frame competes for the same cores. Waits for the slots'
+    /// work and drops what they hold.
     void SetFramesInFlight(int count);
     int GetFramesInFlight() const { return static_cast<int>(slots_.size()); }
     /// Device bytes of per-view images one submission may hold (default 1 GiB).
