@@ -23,6 +23,9 @@ namespace shader {
 
 // GLSL's uvec4 as std430 lays it out.
 struct alignas(16) uvec4 {
+    uvec4() = default;  // constructors for clang 14, as vec4's (GaussianSplatShared.h)
+    constexpr uvec4(uint32_t x_, uint32_t y_, uint32_t z_, uint32_t w_)
+        : x(x_), y(y_), z(z_), w(w_) {}
     uint32_t x, y, z, w;
 };
 // GLSL's vec3: std430 aligns it to 16 bytes but it takes 12, so a 4-byte scalar may follow

@@ -19,6 +19,10 @@ namespace shader {
 
 using uint = uint32_t;
 struct alignas(16) vec4 {  // GLSL's vec4 (EllipseBandReach returns one)
+    // Constructors, not aggregate initialisation: clang 14 (the fuzz build) does not take
+    // C++20's parenthesised aggregate initialisation that GLSL-style `vec4(a, b, c, d)` needs.
+    vec4() = default;
+    constexpr vec4(float x_, float y_, float z_, float w_) : x(x_), y(y_), z(z_), w(w_) {}
     float x, y, z, w;
 };
 inline uint floatBitsToUint(float value) { return std::bit_cast<uint>(value); }

@@ -128,6 +128,13 @@ public:
         PostRedraw();
         return scene_->GetSplatConfig();
     }
+    /// The same settings, read only (no redraw: the panel reads them every frame, and an
+    /// idle viewer must not draw).
+    const rendering::RenderConfig& GetSplatConfig() const { return scene_->GetSplatConfig(); }
+    void SetSplatConfig(const rendering::RenderConfig& config) {
+        PostRedraw();
+        scene_->GetSplatConfig() = config;
+    }
     void ShowSettings(bool show) {
         show_settings_ = show;
         PostRedraw();

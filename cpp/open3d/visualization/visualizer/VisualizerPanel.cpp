@@ -3,6 +3,7 @@
 #include <imgui.h>
 
 #include <filesystem>
+#include <utility>
 
 #include <fmt/format.h>
 
@@ -52,9 +53,12 @@ void SplatSection(const Visualizer& vis) {
 }
 
 void RenderingSection(Visualizer& vis) {
-    rendering::RenderConfig& config = vis.GetSplatConfig();
-    ImGui::SliderInt("SH degree cap", &config.sh_degree, 0, 3);
-    ImGui::Checkbox("Antialias", &config.antialias);
+    // A copy, written back only when a widget changed it: the non-const accessor asks for a
+    // redraw, and calling it every frame kept the viewer drawing forever.
+    rendering::RenderConfig config = std::as_const(vis).GetSplatConfig();
+    bool changed = ImGui::SliderInt("SH degree cap", &config.sh_degree, 0, 3);
+    changed |= ImGui::Checkbox("Antialias", &config.antialias);
+    if (changed) vis.SetSplatConfig(config);
     const Eigen::Vector4f& bg = vis.GetBackground();
     float rgb[3] = {bg[0], bg[1], bg[2]};
     if (ImGui::ColorEdit3("Background", rgb)) {

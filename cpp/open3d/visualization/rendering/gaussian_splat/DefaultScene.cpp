@@ -14,7 +14,6 @@ namespace rendering {
 
 namespace {
 
-constexpr int kDegree = 3;
 constexpr int kRest = 15;  // (3 + 1)^2 - 1 coefficients per channel
 
 // Accumulates splats in the attribute layout of t::geometry::PointCloud.
