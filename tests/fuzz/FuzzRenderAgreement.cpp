@@ -55,8 +55,8 @@ rendering::vulkan::VulkanContext& Context() {
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     Bytes in(data, size);
     const int n = 1 + in.Next() % 6;
-    std::vector<tests::RawSplat> splats(n);
-    for (tests::RawSplat& s : splats) {
+    std::vector<tests::stress::RawSplat> splats(n);
+    for (tests::stress::RawSplat& s : splats) {
         // Mostly in front of the camera (z > 0), at any distance.
         s.position = Eigen::Vector3d(in.Magnitude(), in.Magnitude(), std::abs(in.Magnitude()));
         s.scale = Eigen::Vector3d(std::abs(in.Magnitude()), std::abs(in.Magnitude()),
@@ -69,8 +69,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     const double focal = std::pow(10.0, in.Unit() * 5.0);  // 1 .. 1e5 px
     rendering::RenderConfig config;
     config.antialias = in.Next() & 1;
-    const t::geometry::PointCloud cloud = tests::MakeRawCloud(splats);
-    const camera::PinholeCamera camera = tests::MakeCamera(width, height, focal);
+    const t::geometry::PointCloud cloud = tests::stress::MakeRawCloud(splats);
+    const camera::PinholeCamera camera = tests::stress::MakeCamera(width, height, focal);
     try {
         cloud.ValidateGaussianSplat();  // what a reader would refuse never reaches a renderer
     } catch (const core::Open3DError&) {

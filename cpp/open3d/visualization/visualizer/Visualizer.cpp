@@ -10,6 +10,7 @@
 #include "open3d/core/Exception.h"
 #include "open3d/core/Logging.h"
 #include "open3d/core/Timer.h"
+#include "open3d/core/WaitCallback.h"
 #include "open3d/t/io/ImageIO.h"
 #include "open3d/visualization/rendering/filament/FilamentEngine.h"
 #include "open3d/visualization/rendering/filament/FilamentRenderer.h"
@@ -189,25 +190,49 @@ bool Visualizer::BuildOverlay() {
     return false;
 }
 
+bool Visualizer::DeferDuringFrame(std::function<void()> handler) {
+    if (!in_frame_) return false;
+    deferred_.push_back(std::move(handler));
+    return true;
+}
+
 rendering::FrameResult Visualizer::DrawToWindow(bool read_screen) {
     scene_->SetupCamera(view_control_.GetCamera());
     rendering::FrameRequest request;
     request.read_screen = read_screen;
     if (show_settings_) request.overlay_views.push_back(overlay_->GetView());
-    // The seed's frame: the geometry stage of every view, Filament's draw and the
-    // composite, then the compose and overlay views presented.
-    renderer_->BeginFrame(window_->GetSwapChain());
+    // A close asked for during this frame (Q, Esc, the window's close button) skips its
+    // composite and present; one asked for before it does not (a last screenshot at exit).
+    const bool closing_before = window_->ShouldClose();
+    request.cancelled = [this, closing_before] {
+        return !closing_before && window_->ShouldClose();
+    };
     rendering::FrameResult result;
-    try {
-        result = renderer_->Draw(scene_->GetView(), request);
-    } catch (...) {
-        renderer_->EndFrame();
-        throw;
+    {
+        // The frame's GPU waits poll window events; the handlers keep them for after it.
+        struct InFrame {
+            bool& flag;
+            explicit InFrame(bool& f) : flag(f) { flag = true; }
+            ~InFrame() { flag = false; }
+        } in_frame(in_frame_);
+        core::ScopedWaitCallback poll([] { VisualizerWindow::PollEvents(); });
+        // The seed's frame: the geometry stage of every view, Filament's draw and the
+        // composite, then the compose and overlay views presented.
+        renderer_->BeginFrame(window_->GetSwapChain());
+        try {
+            result = renderer_->Draw(scene_->GetView(), request);
+        } catch (...) {
+            renderer_->EndFrame();
+            throw;
+        }
+        const auto compose_start = std::chrono::steady_clock::now();
+        result.screen = renderer_->EndFrame();
+        result.times.compose_ms = core::MillisecondsSince(compose_start);
+        result.times.total_ms += result.times.compose_ms;
     }
-    const auto compose_start = std::chrono::steady_clock::now();
-    result.screen = renderer_->EndFrame();
-    result.times.compose_ms = core::MillisecondsSince(compose_start);
-    result.times.total_ms += result.times.compose_ms;
+    std::vector<std::function<void()>> events;
+    events.swap(deferred_);
+    for (const std::function<void()>& event : events) event();
     return result;
 }
 
@@ -222,23 +247,39 @@ bool Visualizer::RenderFrame() {
     const bool settled = BuildOverlay();
     const bool screenshot = settled && !pending_screenshot_.empty();
     last_frame_ = DrawToWindow(screenshot);
+    if (last_frame_.cancelled) {
+        last_present_s_ = -1.0;  // nothing was presented
+        return true;
+    }
     const double now = NowSeconds();
     if (last_present_s_ >= 0.0)
         frame_stats_.Add(1000.0 * (now - last_present_s_), last_frame_.times);
     last_present_s_ = now;
-    if (screenshot) {
-        const std::string path = std::move(pending_screenshot_);
-        pending_screenshot_.clear();
+    if (screenshot) WriteScreenshot(DropAlpha(last_frame_.screen));
+    return true;
+}
+
+void Visualizer::WriteScreenshot(const t::geometry::Image& rgb) {
+    const std::string path = std::move(pending_screenshot_);
+    pending_screenshot_.clear();
+    // Written under another name, then renamed: a watcher never sees half a file. A failure
+    // (a folder that cannot be made, a full disk) is a message; the viewer goes on.
+    const std::string partial = path + ".part";
+    try {
         const std::filesystem::path folder = std::filesystem::path(path).parent_path();
         if (!folder.empty()) std::filesystem::create_directories(folder);
-        // Written under another name, then renamed: a watcher never sees half a file.
-        const std::string partial = path + ".part";
-        t::io::WritePNG(partial, DropAlpha(last_frame_.screen));
+        t::io::WritePNG(partial, rgb);
         std::filesystem::rename(partial, path);
-        last_screenshot_ = path;
-        core::LogInfo("Saved screenshot {}", path);
+    } catch (const std::exception& e) {
+        std::error_code ignored;
+        std::filesystem::remove(partial, ignored);
+        screenshot_error_ = fmt::format("Screenshot not saved: {}", e.what());
+        core::LogWarning("{}", screenshot_error_);
+        return;
     }
-    return true;
+    screenshot_error_.clear();
+    last_screenshot_ = path;
+    core::LogInfo("Saved screenshot {}", path);
 }
 
 void Visualizer::Run(const RunOptions& options) {
@@ -304,6 +345,7 @@ bool Visualizer::PanelContains(double x, double y) const {
 }
 
 void Visualizer::OnMouseButton(int button, bool pressed, int mods) {
+    if (DeferDuringFrame([=, this] { OnMouseButton(button, pressed, mods); })) return;
     PostRedraw();
     if (!pressed) {
         overlay_->OnMouseButton(button, false);
@@ -322,6 +364,7 @@ void Visualizer::OnMouseButton(int button, bool pressed, int mods) {
 }
 
 void Visualizer::OnCursorPos(double x, double y) {
+    if (DeferDuringFrame([=, this] { OnCursorPos(x, y); })) return;
     const double dx = x - cursor_x_, dy = y - cursor_y_;
     cursor_x_ = x;
     cursor_y_ = y;
@@ -332,6 +375,7 @@ void Visualizer::OnCursorPos(double x, double y) {
 }
 
 void Visualizer::OnScroll(double dx, double dy) {
+    if (DeferDuringFrame([=, this] { OnScroll(dx, dy); })) return;
     PostRedraw();
     if (PanelContains(cursor_x_, cursor_y_)) {
         overlay_->OnScroll(dx, dy);
@@ -341,6 +385,11 @@ void Visualizer::OnScroll(double dx, double dy) {
 }
 
 void Visualizer::OnKey(int key, bool pressed, bool repeat, int mods) {
+    if (in_frame_ && pressed && !repeat && (key == GLFW_KEY_ESCAPE || key == GLFW_KEY_Q) &&
+        !overlay_->WantsTextInput()) {
+        Close();  // now, so the frame in flight stops before its composite
+    }
+    if (DeferDuringFrame([=, this] { OnKey(key, pressed, repeat, mods); })) return;
     overlay_->OnKey(key, pressed, mods);
     PostRedraw();
     if (!pressed || overlay_->WantsTextInput()) return;
@@ -396,11 +445,13 @@ void Visualizer::OnKey(int key, bool pressed, bool repeat, int mods) {
 }
 
 void Visualizer::OnChar(unsigned int codepoint) {
+    if (DeferDuringFrame([=, this] { OnChar(codepoint); })) return;
     overlay_->OnChar(codepoint);
     PostRedraw();
 }
 
 void Visualizer::OnFramebufferSize(int width, int height) {
+    if (DeferDuringFrame([=, this] { OnFramebufferSize(width, height); })) return;
     if (width == fb_width_ && height == fb_height_) return;
     PostRedraw();
     fb_width_ = std::max(width, 0);
@@ -409,6 +460,25 @@ void Visualizer::OnFramebufferSize(int width, int height) {
     // while minimised (0 x 0) nothing is drawn and the camera keeps its last size.
     scene_->GetView().ReleaseTargets();
     if (fb_width_ > 0 && fb_height_ > 0) view_control_.SetViewSize(fb_width_, fb_height_);
+}
+
+void Visualizer::OnDrop(const std::vector<std::string>& paths) {
+    if (DeferDuringFrame([=, this] { OnDrop(paths); })) return;
+    OpenFiles(paths);
+}
+
+void Visualizer::OpenFiles(const std::vector<std::string>& paths) {
+    if (paths.empty()) return;
+    if (!open_callback_) {
+        SetStatus("Opening files is not enabled in this viewer", true);
+        return;
+    }
+    try {
+        open_callback_(paths);
+    } catch (const std::exception& e) {
+        SetStatus(e.what(), true);
+        core::LogWarning("{}", e.what());
+    }
 }
 
 void Draw(const std::vector<DrawObject>& objects, const VisualizerOptions& options,

@@ -168,6 +168,9 @@ public:
     void SetScreenshotDir(const std::string& dir) { screenshot_dir_ = dir.empty() ? "." : dir; }
     /// Path of the last screenshot written, empty before the first.
     const std::string& GetLastScreenshotPath() const { return last_screenshot_; }
+    /// Why the last screenshot could not be written (shown in the panel; the viewer goes
+    /// on), empty when it was.
+    const std::string& GetLastScreenshotError() const { return screenshot_error_; }
     /// Offscreen render of the same scene and camera: UInt8 [H, W, 3] (or 4 with alpha).
     t::geometry::Image RenderToImage(bool with_alpha = false);
     /// Offscreen depth (Open3DScene::RenderToDepthImage: near / far default to the view's).
@@ -204,6 +207,21 @@ public:
     }
     /// Extra panel widgets, drawn at the end of the settings panel (ImGui calls).
     void SetPanelCallback(std::function<void()> callback) { panel_callback_ = std::move(callback); }
+    /// Opening files: called with the paths dropped on the window or typed into the panel's
+    /// "Open" field (shown only while a callback is set). The callback decides what to load
+    /// (GaussianSplat replaces its scene); errors it throws are shown in the panel.
+    void SetOpenCallback(std::function<void(const std::vector<std::string>& paths)> callback) {
+        open_callback_ = std::move(callback);
+        PostRedraw();
+    }
+    /// A line shown at the top of the panel (loading progress, errors); empty: none.
+    /// `warning` draws it in the warning colour.
+    void SetStatus(const std::string& text, bool warning = false) {
+        status_ = text;
+        status_warning_ = warning;
+        PostRedraw();
+    }
+    const std::string& GetStatus() const { return status_; }
 
     // WindowEventHandler: GLFW's callbacks arrive here; tests may inject events.
     void OnMouseButton(int button, bool pressed, int mods) override;
@@ -212,6 +230,7 @@ public:
     void OnKey(int key, bool pressed, bool repeat, int mods) override;
     void OnChar(unsigned int codepoint) override;
     void OnFramebufferSize(int width, int height) override;
+    void OnDrop(const std::vector<std::string>& paths) override;
 
 private:
     enum class Drag { kNone, kRotate, kPan, kPanel };
@@ -223,7 +242,11 @@ private:
     /// Runs the panel's ImGui frame (when shown); false while input is still pending.
     bool BuildOverlay();
     rendering::FrameResult DrawToWindow(bool read_screen);
-    void WriteScreenshot(const t::geometry::Image& rgba);
+    /// While a frame is in flight its GPU waits poll window events (docs/viewer.md):
+    /// handlers then keep the event for after the frame. True when `handler` was kept.
+    bool DeferDuringFrame(std::function<void()> handler);
+    void OpenFiles(const std::vector<std::string>& paths);
+    void WriteScreenshot(const t::geometry::Image& rgb);
 
     std::unique_ptr<rendering::FilamentEngine> owned_engine_;
     std::unique_ptr<rendering::FilamentRenderer> owned_renderer_;
@@ -246,6 +269,14 @@ private:
     int screenshot_index_ = 0;
     std::string pending_screenshot_;  // path to write at the next drawn frame
     std::string last_screenshot_;
+    std::string screenshot_error_;
+
+    bool in_frame_ = false;                        // DrawToWindow is running
+    std::vector<std::function<void()>> deferred_;  // events that arrived during it
+    std::function<void(const std::vector<std::string>&)> open_callback_;
+    char open_field_[1024] = {};  // the panel's "Open" text field
+    std::string status_;
+    bool status_warning_ = false;
 
     rendering::FrameResult last_frame_;
     FrameStatistics frame_stats_;

@@ -93,6 +93,23 @@ void Visualizer::BuildPanel() {
         return ImGui::CollapsingHeader(label);
     };
     ImGui::Text("%s backend, %d x %d", GetBackendName().c_str(), fb_width_, fb_height_);
+    // Messages wrap at a fixed width: the panel sizes itself to its contents.
+    ImGui::PushTextWrapPos(ImGui::GetFontSize() * 22.0f);
+    if (!status_.empty()) {
+        if (status_warning_) ImGui::PushStyleColor(ImGuiCol_Text, kWarning);
+        ImGui::TextWrapped("%s", status_.c_str());
+        if (status_warning_) ImGui::PopStyleColor();
+    }
+    if (open_callback_) {
+        ImGui::SetNextItemWidth(ImGui::GetFontSize() * 16.0f);
+        const bool enter = ImGui::InputTextWithHint("##open", "file to open (or drop one)",
+                                                    open_field_, sizeof(open_field_),
+                                                    ImGuiInputTextFlags_EnterReturnsTrue);
+        ImGui::SameLine();
+        if ((ImGui::Button("Open") || enter) && open_field_[0] != '\0') {
+            OpenFiles({std::string(open_field_)});
+        }
+    }
     if (header("Frame", true)) FrameSection(*this);
     if (header("GPU passes", roomy)) GpuSection(*this);
     if (header("Splats", roomy)) SplatSection(*this);
@@ -101,9 +118,14 @@ void Visualizer::BuildPanel() {
     if (ImGui::Button("Reset camera (R)")) ResetCamera();
     ImGui::SameLine();
     if (ImGui::Button("Screenshot (P)")) RequestScreenshot();
-    if (!last_screenshot_.empty()) {
+    if (!screenshot_error_.empty()) {
+        ImGui::PushStyleColor(ImGuiCol_Text, kWarning);
+        ImGui::TextWrapped("%s", screenshot_error_.c_str());
+        ImGui::PopStyleColor();
+    } else if (!last_screenshot_.empty()) {
         ImGui::Text("Saved %s", std::filesystem::path(last_screenshot_).filename().c_str());
     }
+    ImGui::PopTextWrapPos();
     if (header("Controls", false)) {
         ImGui::TextUnformatted(
             "Left drag: orbit\n"

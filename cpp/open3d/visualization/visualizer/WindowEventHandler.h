@@ -3,6 +3,9 @@
 // inject input exactly as GLFW would deliver it.
 #pragma once
 
+#include <string>
+#include <vector>
+
 namespace open3d {
 namespace visualization {
 
@@ -16,6 +19,8 @@ public:
     virtual void OnChar(unsigned int codepoint) = 0;
     /// The drawable size changed; 0 x 0 while minimised.
     virtual void OnFramebufferSize(int width, int height) = 0;
+    /// Files dropped on the window (drag and drop from a file manager).
+    virtual void OnDrop(const std::vector<std::string>& paths) = 0;
 };
 
 }  // namespace visualization

@@ -5,6 +5,7 @@
 #define GLFW_EXPOSE_NATIVE_GLX
 #include <GLFW/glfw3native.h>
 #include <filament/Engine.h>
+#include <filament/Fence.h>
 
 #include <chrono>
 #include <cstdlib>
@@ -14,6 +15,7 @@
 
 #include "open3d/core/Exception.h"
 #include "open3d/core/Logging.h"
+#include "open3d/core/WaitCallback.h"
 
 namespace open3d {
 namespace visualization {
@@ -123,6 +125,21 @@ FilamentEngine::~FilamentEngine() {
 }
 
 void FilamentEngine::MakeContextCurrent() const { glfwMakeContextCurrent(window_); }
+
+void FilamentEngine::FlushAndWait() const {
+    if (core::HasWaitCallback()) {
+        // A fence after the work so far, waited for in slices; flushAndWait then returns at
+        // once and runs the completion callbacks as it always does.
+        filament::Fence* fence = engine_->createFence();
+        constexpr uint64_t kSliceNs = uint64_t(core::kWaitCallbackPeriodMs) * 1000000u;
+        while (fence->wait(filament::Fence::Mode::FLUSH, kSliceNs) ==
+               filament::backend::FenceStatus::TIMEOUT_EXPIRED) {
+            core::CallWaitCallback();
+        }
+        engine_->destroy(fence);
+    }
+    engine_->flushAndWait();
+}
 
 }  // namespace rendering
 }  // namespace visualization

@@ -29,6 +29,9 @@ public:
     FilamentEngine& operator=(const FilamentEngine&) = delete;
 
     filament::Engine& GetEngine() const { return *engine_; }
+    /// Engine::flushAndWait, calling the thread's core::WaitCallback while Filament's
+    /// thread works (the viewer's window stays responsive during long frames).
+    void FlushAndWait() const;
     /// The hidden window whose context shares objects with Filament's.
     GLFWwindow* GetSharedContextWindow() const { return window_; }
     /// Makes the shared context current on this thread (the engine's thread).

@@ -94,7 +94,7 @@ void FilamentRenderer::StartFrame(filament::SwapChain* swap_chain) {
     swap_chain_ = swap_chain;
     drawn_.clear();
     // The previous frame's GL work on the shared images is done before Vulkan reuses them.
-    engine_.GetEngine().flushAndWait();
+    engine_.FlushAndWait();
     Report(FrameEvent::kBeginFrame, nullptr);
 }
 
@@ -128,7 +128,6 @@ FrameResult FilamentRenderer::Draw(FilamentView& view, const FrameRequest& reque
     ViewEntry* entry = FindView(view);
     if (entry == nullptr) core::ThrowError("FilamentRenderer::Draw: the view was not added");
     const Clock::time_point start = Clock::now();
-    filament::Engine& engine = engine_.GetEngine();
     FilamentScene& scene = *entry->scene;
     FrameResult result;
     if (!entry->geometry_submitted) SubmitGeometryStage(*entry);
@@ -158,9 +157,15 @@ FrameResult FilamentRenderer::Draw(FilamentView& view, const FrameRequest& reque
                                                      filament::backend::PixelDataFormat::RGBA,
                                                      filament::backend::PixelDataType::UBYTE));
     }
-    engine.flushAndWait();
+    engine_.FlushAndWait();
     result.times.filament_ms = core::MillisecondsSince(t);
     Report(FrameEvent::kFilamentDraw, &view);
+    if (request.cancelled && request.cancelled()) {
+        // The geometry stage stays submitted; its next user waits for its fence.
+        result.cancelled = true;
+        result.times.total_ms = result.times.geometry_stage_ms + core::MillisecondsSince(start);
+        return result;
+    }
 
     t = Clock::now();
     SplatFrame splats;
@@ -226,7 +231,7 @@ t::geometry::Image FilamentRenderer::EndFrame() {
         }
         renderer_->endFrame();
         if (w > 0) {
-            engine_.GetEngine().flushAndWait();
+            engine_.FlushAndWait();
             screen_image = t::geometry::Image(h, w, 4, core::Dtype::UInt8);
             std::memcpy(screen_image.Data<uint8_t>(), screen.data(), screen.size());
         }

@@ -49,6 +49,10 @@ struct FrameRequest {
     bool read_depth = false;
     float depth_near = 0.01f;  ///< normalisation of normalized_depth
     float depth_far = 1000.0f;
+    /// Asked once the meshes are drawn: true skips the rest of the view's frame (the
+    /// composite, the readbacks, the compose view) and sets FrameResult::cancelled. The
+    /// viewer's Q during a frame of seconds on a software device.
+    std::function<bool()> cancelled;
 };
 
 /// The steps of a frame, in the order the seed's design fixes (reported to a listener).
@@ -87,6 +91,7 @@ struct FrameResult {
     bool splats_drawn =
         false;  ///< some splat cloud was visible (geometry and composite stages ran)
     bool scene_depth_used = false;  ///< a mesh was visible, so splats were depth-tested
+    bool cancelled = false;         ///< FrameRequest::cancelled said so: nothing was presented
     FrameTimes times;
 };
 

@@ -34,6 +34,9 @@ void InstallCallbacks(GLFWwindow* window) {
     glfwSetFramebufferSizeCallback(window, [](GLFWwindow* w, int width, int height) {
         HandlerOf(w)->OnFramebufferSize(width, height);
     });
+    glfwSetDropCallback(window, [](GLFWwindow* w, int count, const char** paths) {
+        HandlerOf(w)->OnDrop(std::vector<std::string>(paths, paths + count));
+    });
 }
 
 }  // namespace

@@ -1,5 +1,6 @@
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/Commands.h"
 
+#include "open3d/core/WaitCallback.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/VulkanContext.h"
 
 namespace open3d {
@@ -93,8 +94,19 @@ UniqueSemaphore CreateBinarySemaphore(const VulkanContext& context) {
 }
 
 void Wait(const VulkanContext& context, VkFence fence) {
-    CheckVk(vkWaitForFences(context.GetDevice(), 1, &fence, VK_TRUE, UINT64_MAX),
-            "vkWaitForFences");
+    if (!core::HasWaitCallback()) {
+        CheckVk(vkWaitForFences(context.GetDevice(), 1, &fence, VK_TRUE, UINT64_MAX),
+                "vkWaitForFences");
+        return;
+    }
+    // In slices, with the thread's wait callback between them (the viewer polls events).
+    constexpr uint64_t kSliceNs = uint64_t(core::kWaitCallbackPeriodMs) * 1000000u;
+    for (;;) {
+        const VkResult result = vkWaitForFences(context.GetDevice(), 1, &fence, VK_TRUE, kSliceNs);
+        if (result == VK_SUCCESS) return;
+        if (result != VK_TIMEOUT) CheckVk(result, "vkWaitForFences");
+        core::CallWaitCallback();
+    }
 }
 
 bool IsSignaled(const VulkanContext& context, VkFence fence) {
