@@ -102,9 +102,9 @@ void Visualizer::BuildPanel() {
     }
     if (open_callback_) {
         ImGui::SetNextItemWidth(ImGui::GetFontSize() * 16.0f);
-        const bool enter = ImGui::InputTextWithHint("##open", "file to open (or drop one)",
-                                                    open_field_, sizeof(open_field_),
-                                                    ImGuiInputTextFlags_EnterReturnsTrue);
+        const bool enter =
+            ImGui::InputTextWithHint("##open", "file to open (or drop one)", open_field_,
+                                     sizeof(open_field_), ImGuiInputTextFlags_EnterReturnsTrue);
         ImGui::SameLine();
         if ((ImGui::Button("Open") || enter) && open_field_[0] != '\0') {
             OpenFiles({std::string(open_field_)});
