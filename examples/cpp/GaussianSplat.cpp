@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -17,6 +18,7 @@
 #include "open3d/t/io/PointCloudIO.h"
 #include "open3d/visualization/rendering/filament/FilamentEngine.h"
 #include "open3d/visualization/rendering/gaussian_splat/DefaultScene.h"
+#include "open3d/visualization/visualizer/BackgroundCloudReader.h"
 #include "open3d/visualization/visualizer/Visualizer.h"
 
 namespace {
@@ -45,6 +47,33 @@ struct Options {
     double spin_degrees = 0.0;
     bool continuous = false;
 };
+
+// Puts `cloud` into the viewer as the scene (replacing the one shown, if any) with the red
+// sphere at its centre unless --no-sphere.
+void ShowScene(vis::Visualizer& viewer, const t::geometry::PointCloud& cloud,
+               const std::string& name, bool default_scene, const Options& opt) {
+    for (const std::string& old : std::vector<std::string>(viewer.GetGeometryNames())) {
+        viewer.RemoveGeometry(old);
+    }
+    viewer.AddGeometry(name, cloud);
+    if (opt.no_sphere) return;
+    Eigen::Vector3d center;
+    double radius = 0.0;
+    if (default_scene) {
+        center = rendering::GetDefaultSceneMeshSphere().center;
+        radius = rendering::GetDefaultSceneMeshSphere().radius;
+    } else {
+        center = t::geometry::ComputeMedianCenter(cloud);
+        radius = 0.3 * t::geometry::ComputeDistanceQuantile(cloud, center, 0.8);
+    }
+    if (opt.sphere_radius > 0.0) radius = opt.sphere_radius;
+    t::geometry::TriangleMesh sphere = t::geometry::TriangleMesh::CreateSphere(radius, 40);
+    sphere.Translate(center);
+    rendering::MaterialRecord red;
+    red.shader = rendering::kShaderDefaultLit;
+    red.base_color = Eigen::Vector4f(1.0f, 0.0f, 0.0f, 1.0f);
+    viewer.AddGeometry("sphere", sphere, red);
+}
 
 int Run(const Options& opt) {
     // Fail before reading a large scene when no window can be opened.
@@ -84,25 +113,7 @@ int Run(const Options& opt) {
     vo.show_settings = !opt.hide_panel;
     vo.screenshot_dir = opt.screenshot_dir;
     vis::Visualizer viewer(vo);
-    viewer.AddGeometry(name, cloud);
-    if (!opt.no_sphere) {
-        Eigen::Vector3d center;
-        double radius = 0.0;
-        if (default_scene) {
-            center = rendering::GetDefaultSceneMeshSphere().center;
-            radius = rendering::GetDefaultSceneMeshSphere().radius;
-        } else {
-            center = t::geometry::ComputeMedianCenter(cloud);
-            radius = 0.3 * t::geometry::ComputeDistanceQuantile(cloud, center, 0.8);
-        }
-        if (opt.sphere_radius > 0.0) radius = opt.sphere_radius;
-        t::geometry::TriangleMesh sphere = t::geometry::TriangleMesh::CreateSphere(radius, 40);
-        sphere.Translate(center);
-        rendering::MaterialRecord red;
-        red.shader = rendering::kShaderDefaultLit;
-        red.base_color = Eigen::Vector4f(1.0f, 0.0f, 0.0f, 1.0f);
-        viewer.AddGeometry("sphere", sphere, red);
-    }
+    ShowScene(viewer, cloud, name, default_scene, opt);
     viewer.GetSplatConfig().sh_degree = opt.sh_degree;
     viewer.GetSplatConfig().antialias = opt.antialias;
     viewer.SetBackground(Eigen::Vector4f(0.1f, 0.1f, 0.12f, 1.0f));
@@ -124,7 +135,41 @@ int Run(const Options& opt) {
         viewer.GetHeight(), viewer.GetBackendName().c_str());
     std::fflush(stdout);
 
+    // Another file (dropped on the window or typed into the panel) is read on a worker
+    // thread: the viewer keeps drawing the current scene and shows the read's progress.
+    vis::BackgroundCloudReader reader;
+    viewer.SetOpenCallback([&](const std::vector<std::string>& paths) {
+        reader.Start(paths.front());
+        viewer.SetStatus(reader.Describe());
+    });
+    double last_status_s = 0.0;
     vis::RunOptions run;
+    run.poll = [&] {
+        if (!reader.IsBusy()) return;
+        try {
+            if (std::optional<t::geometry::PointCloud> loaded = reader.TakeResult()) {
+                const std::string stem = std::filesystem::path(reader.GetPath()).stem().string();
+                ShowScene(viewer, *loaded, stem, false, opt);
+                viewer.ResetCamera();
+                viewer.SetStatus("");
+                std::printf("GaussianSplat: opened %s, %lld splats\n", reader.GetPath().c_str(),
+                            static_cast<long long>(loaded->NumPoints()));
+                std::fflush(stdout);
+                return;
+            }
+        } catch (const std::exception& e) {
+            viewer.SetStatus(e.what(), true);
+            std::fprintf(stderr, "GaussianSplat: %s\n", e.what());
+            return;
+        }
+        const double now =
+            std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch())
+                .count();
+        if (now - last_status_s >= 0.5) {  // the panel's progress, twice a second
+            viewer.SetStatus(reader.Describe());
+            last_status_s = now;
+        }
+    };
     run.continuous = opt.continuous || opt.frames > 0 || opt.spin_degrees != 0.0;
     run.max_frames = opt.frames;
     run.max_seconds = opt.exit_after_seconds;

@@ -52,13 +52,14 @@ void VisualizerTest::TearDown() {
     vis_.reset();
 }
 
-visualization::Visualizer& VisualizerTest::MakeVisualizer(int width, int height,
-                                                          bool show_settings) {
+visualization::Visualizer& VisualizerTest::MakeVisualizer(int width, int height, bool show_settings,
+                                                          double interactive_frame_ms) {
     visualization::VisualizerOptions options;
     options.title = ::testing::UnitTest::GetInstance()->current_test_info()->name();
     options.width = width;
     options.height = height;
     options.show_settings = show_settings;
+    options.interactive_frame_ms = interactive_frame_ms;
     options.scene.backend = "vulkan";
     vis_ = std::make_unique<visualization::Visualizer>(*renderer_, options);
     return *vis_;

@@ -29,8 +29,10 @@ protected:
 
     /// A visible window of width x height on the shared engine (owned until TearDown,
     /// which checks that the Vulkan validation layer stayed quiet).
+    /// `interactive_frame_ms` 0: every frame at full resolution (the tests compare pictures).
     visualization::Visualizer& MakeVisualizer(int width = 240, int height = 160,
-                                              bool show_settings = false);
+                                              bool show_settings = false,
+                                              double interactive_frame_ms = 0.0);
     /// Adds "wall" (splats) and "sphere" (mesh), in that order, and fits the camera.
     void AddWallAndSphere(visualization::Visualizer& vis);
     /// Polls events until the framebuffer is width x height (false after ~5 s).

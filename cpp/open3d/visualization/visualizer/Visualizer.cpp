@@ -57,6 +57,7 @@ void Visualizer::Init(const VisualizerOptions& options) {
     view_control_.SetViewSize(options.width, options.height);
     show_settings_ = options.show_settings;
     screenshot_dir_ = options.screenshot_dir.empty() ? "." : options.screenshot_dir;
+    interactive_frame_ms_ = options.interactive_frame_ms;
     rendering::FilamentEngine& engine = renderer_->GetEngine();
     window_ = std::make_unique<VisualizerWindow>(engine, options.title, options.width,
                                                  options.height, this);
@@ -196,8 +197,25 @@ bool Visualizer::DeferDuringFrame(std::function<void()> handler) {
     return true;
 }
 
-rendering::FrameResult Visualizer::DrawToWindow(bool read_screen) {
-    scene_->SetupCamera(view_control_.GetCamera());
+bool Visualizer::IsCameraMoving() const {
+    return drag_ == Drag::kRotate || drag_ == Drag::kPan || NowSeconds() - last_motion_s_ < 0.25;
+}
+
+void Visualizer::NoteCameraMotion() { last_motion_s_ = NowSeconds(); }
+
+int Visualizer::InteractiveDivisor() const {
+    if (interactive_frame_ms_ <= 0.0 || !IsCameraMoving()) return 1;
+    // The frame's cost follows its pixel count: half of each side is a quarter of the time.
+    const double over = full_frame_ms_ / interactive_frame_ms_;
+    return over <= 1.0 ? 1 : over <= 4.0 ? 2 : 4;
+}
+
+rendering::FrameResult Visualizer::DrawToWindow(bool read_screen, int divisor) {
+    const camera::PinholeCamera camera = view_control_.GetCamera();
+    scene_->SetupCamera(divisor > 1 ? camera.Resized(std::max(1, camera.width / divisor),
+                                                     std::max(1, camera.height / divisor))
+                                    : camera);
+    scene_->GetView().SetPresentSize(fb_width_, fb_height_);
     rendering::FrameRequest request;
     request.read_screen = read_screen;
     if (show_settings_) request.overlay_views.push_back(overlay_->GetView());
@@ -246,11 +264,14 @@ bool Visualizer::RenderFrame() {
     // shows the state after everything that came before the request.
     const bool settled = BuildOverlay();
     const bool screenshot = settled && !pending_screenshot_.empty();
-    last_frame_ = DrawToWindow(screenshot);
+    const int divisor = screenshot ? 1 : InteractiveDivisor();  // screenshots: full size
+    last_frame_ = DrawToWindow(screenshot, divisor);
     if (last_frame_.cancelled) {
         last_present_s_ = -1.0;  // nothing was presented
         return true;
     }
+    last_divisor_ = divisor;
+    if (divisor == 1) full_frame_ms_ = last_frame_.times.total_ms;
     const double now = NowSeconds();
     if (last_present_s_ >= 0.0)
         frame_stats_.Add(1000.0 * (now - last_present_s_), last_frame_.times);
@@ -286,6 +307,9 @@ void Visualizer::Run(const RunOptions& options) {
     const double start = NowSeconds();
     int64_t frames = 0;
     while (PollEvents()) {
+        if (options.poll) options.poll();
+        // A reduced frame while the camera moved is refined once it stops.
+        if (last_divisor_ > 1 && !IsCameraMoving()) PostRedraw();
         if (fb_width_ <= 0 || fb_height_ <= 0 || !(options.continuous || redraw_frames_ > 0)) {
             // Minimised or idle: sleep until input. The gap is not a frame time.
             last_present_s_ = -1.0;
@@ -305,7 +329,10 @@ t::geometry::Image Visualizer::CaptureScreenImage() {
         core::ThrowError("CaptureScreenImage: the window is minimised (nothing is drawn)");
     }
     BuildOverlay();
-    last_frame_ = DrawToWindow(true);
+    const int divisor = InteractiveDivisor();
+    last_frame_ = DrawToWindow(true, divisor);
+    last_divisor_ = divisor;
+    if (divisor == 1) full_frame_ms_ = last_frame_.times.total_ms;
     return DropAlpha(last_frame_.screen);
 }
 
@@ -372,6 +399,7 @@ void Visualizer::OnCursorPos(double x, double y) {
     if (drag_ != Drag::kNone || show_settings_) PostRedraw();  // camera or panel hover
     if (drag_ == Drag::kRotate) view_control_.Rotate(dx, dy);
     if (drag_ == Drag::kPan) view_control_.Pan(dx, dy);
+    if (drag_ == Drag::kRotate || drag_ == Drag::kPan) NoteCameraMotion();
 }
 
 void Visualizer::OnScroll(double dx, double dy) {
@@ -381,6 +409,7 @@ void Visualizer::OnScroll(double dx, double dy) {
         overlay_->OnScroll(dx, dy);
     } else {
         view_control_.Zoom(dy);  // wheel up: closer
+        NoteCameraMotion();
     }
 }
 
@@ -396,26 +425,30 @@ void Visualizer::OnKey(int key, bool pressed, bool repeat, int mods) {
     if (!repeat && key_callback_ && key_callback_(key, mods)) return;
     const double step = view_control_.GetHeight() / 36.0;  // 5 degrees of orbit
     const bool shift = (mods & GLFW_MOD_SHIFT) != 0;
-    switch (key) {
+    switch (key) {  // the camera keys count as motion (reduced frames on slow devices)
         case GLFW_KEY_LEFT:
         case GLFW_KEY_RIGHT: {
             const double d = key == GLFW_KEY_LEFT ? -step : step;
             shift ? view_control_.Pan(d, 0.0) : view_control_.Rotate(d, 0.0);
+            NoteCameraMotion();
             return;
         }
         case GLFW_KEY_UP:
         case GLFW_KEY_DOWN: {
             const double d = key == GLFW_KEY_UP ? -step : step;
             shift ? view_control_.Pan(0.0, d) : view_control_.Rotate(0.0, d);
+            NoteCameraMotion();
             return;
         }
         case GLFW_KEY_EQUAL:
         case GLFW_KEY_KP_ADD:
             view_control_.Zoom(1.0);
+            NoteCameraMotion();
             return;
         case GLFW_KEY_MINUS:
         case GLFW_KEY_KP_SUBTRACT:
             view_control_.Zoom(-1.0);
+            NoteCameraMotion();
             return;
         default:
             break;

@@ -56,6 +56,10 @@ struct VisualizerOptions {
     bool show_settings = true;
     /// Where SaveScreenshot and the P key write screenshot_NNNN.png.
     std::string screenshot_dir = ".";
+    /// While the camera moves, a frame whose last full-resolution time exceeded this many
+    /// milliseconds is drawn at 1/2 (up to 4x over) or 1/4 of each side and scaled up; the
+    /// full-resolution frame follows when the motion stops. 0: always full resolution.
+    double interactive_frame_ms = 100.0;
 };
 
 struct RunOptions {
@@ -69,6 +73,9 @@ struct RunOptions {
     double max_seconds = 0.0;
     /// Called before each frame is drawn (animation, scripted input; with continuous).
     std::function<void()> before_frame;
+    /// Called on every loop iteration, drawn or idle (about ten times a second while idle):
+    /// background work reports here (a finished load, progress in SetStatus).
+    std::function<void()> poll;
 };
 
 class Visualizer : public WindowEventHandler {
@@ -193,6 +200,11 @@ public:
     // State for the panel, tests and logs.
     /// The last frame drawn to the window or offscreen (times, splat stats).
     const rendering::FrameResult& GetLastFrame() const { return last_frame_; }
+    /// 1 when the last frame drawn to the window had the window's resolution, 2 or 4 when it
+    /// was drawn at that fraction of each side (the camera was moving).
+    int GetLastFrameDivisor() const { return last_divisor_; }
+    /// A drag is orbiting or panning, or the camera moved by key or wheel in the last 0.25 s.
+    bool IsCameraMoving() const;
     const FrameStatistics& GetFrameStatistics() const { return frame_stats_; }
     std::string GetBackendName() const;
     /// The scene behind the window (asks for a redraw).
@@ -241,7 +253,10 @@ private:
     void BuildPanel();
     /// Runs the panel's ImGui frame (when shown); false while input is still pending.
     bool BuildOverlay();
-    rendering::FrameResult DrawToWindow(bool read_screen);
+    rendering::FrameResult DrawToWindow(bool read_screen, int divisor);
+    /// The resolution divisor of the next frame (VisualizerOptions::interactive_frame_ms).
+    int InteractiveDivisor() const;
+    void NoteCameraMotion();
     /// While a frame is in flight its GPU waits poll window events (docs/viewer.md):
     /// handlers then keep the event for after the frame. True when `handler` was kept.
     bool DeferDuringFrame(std::function<void()> handler);
@@ -264,6 +279,10 @@ private:
     bool show_settings_ = true;
     int redraw_frames_ = 2;               // frames Run still draws without new input
     float panel_rect_[4] = {0, 0, 0, 0};  // x, y, w, h of the panel in the last frame
+    double interactive_frame_ms_ = 100.0;
+    double full_frame_ms_ = 0.0;   // time of the last full-resolution frame
+    double last_motion_s_ = -1e9;  // steady clock seconds of the last key/wheel motion
+    int last_divisor_ = 1;
 
     std::string screenshot_dir_;
     int screenshot_index_ = 0;

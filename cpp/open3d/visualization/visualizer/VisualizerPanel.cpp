@@ -20,6 +20,9 @@ void FrameSection(const Visualizer& vis) {
     const FrameStatistics& stats = vis.GetFrameStatistics();
     const double frame_ms = stats.GetSmoothedFrameMs();
     ImGui::Text("Frame %.1f ms (%.1f fps)", frame_ms, frame_ms > 0.0 ? 1000.0 / frame_ms : 0.0);
+    if (vis.GetLastFrameDivisor() > 1) {
+        ImGui::TextDisabled("Drawn at 1/%d size while moving", vis.GetLastFrameDivisor());
+    }
     const rendering::FrameTimes& t = stats.GetSmoothedParts();
     ImGui::Text("Renderer %.1f ms: geometry %.1f", t.total_ms, t.geometry_stage_ms);
     ImGui::Text("  Filament %.1f, composite %.1f, compose %.1f", t.filament_ms,

@@ -14,6 +14,7 @@
 
 #include "open3d/core/Exception.h"
 #include "open3d/core/Timer.h"
+#include "open3d/core/WaitCallback.h"
 #include "open3d/visualization/rendering/filament/FilamentEngine.h"
 #include "open3d/visualization/rendering/filament/FilamentMaterials.h"
 #include "open3d/visualization/rendering/filament/FilamentScene.h"
@@ -160,11 +161,22 @@ FrameResult FilamentRenderer::Draw(FilamentView& view, const FrameRequest& reque
     engine_.FlushAndWait();
     result.times.filament_ms = core::MillisecondsSince(t);
     Report(FrameEvent::kFilamentDraw, &view);
-    if (request.cancelled && request.cancelled()) {
-        // The geometry stage stays submitted; its next user waits for its fence.
-        result.cancelled = true;
-        result.times.total_ms = result.times.geometry_stage_ms + core::MillisecondsSince(start);
-        return result;
+    if (request.cancelled) {
+        // The geometry stage is waited for here, in slices with the thread's wait callback
+        // between them, so that a close asked for while it runs (seconds for a large scene
+        // on a software device) stops the frame before the composite is submitted. A
+        // cancelled geometry stage stays submitted; its next user waits for its fence.
+        bool cancel = request.cancelled();
+        while (!cancel && result.splats_drawn &&
+               !scene.GetBackend().WaitGeometryStage(core::kWaitCallbackPeriodMs)) {
+            core::CallWaitCallback();
+            cancel = request.cancelled();
+        }
+        if (cancel) {
+            result.cancelled = true;
+            result.times.total_ms = result.times.geometry_stage_ms + core::MillisecondsSince(start);
+            return result;
+        }
     }
 
     t = Clock::now();
@@ -217,8 +229,8 @@ t::geometry::Image FilamentRenderer::EndFrame() {
             for (filament::View* overlay : entry->request.overlay_views) renderer_->render(overlay);
             Report(FrameEvent::kOverlay, entry->view);
             if (entry->request.read_screen) {
-                w = entry->view->GetCamera().width;
-                h = entry->view->GetCamera().height;
+                w = entry->view->GetPresentWidth();
+                h = entry->view->GetPresentHeight();
             }
         }
         if (w > 0) {

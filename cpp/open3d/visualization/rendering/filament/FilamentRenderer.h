@@ -49,9 +49,11 @@ struct FrameRequest {
     bool read_depth = false;
     float depth_near = 0.01f;  ///< normalisation of normalized_depth
     float depth_far = 1000.0f;
-    /// Asked once the meshes are drawn: true skips the rest of the view's frame (the
-    /// composite, the readbacks, the compose view) and sets FrameResult::cancelled. The
-    /// viewer's Q during a frame of seconds on a software device.
+    /// Asked once the meshes are drawn and while the splat geometry stage is waited for
+    /// (then in slices of core::kWaitCallbackPeriodMs with the thread's wait callback
+    /// between): true skips the rest of the view's frame (the composite, the readbacks, the
+    /// compose view) and sets FrameResult::cancelled. The viewer's Q during a frame of
+    /// seconds on a software device.
     std::function<bool()> cancelled;
 };
 

@@ -160,7 +160,8 @@ void FilamentView::PrepareTargets(FilamentScene& scene) {
         ++target_builds_;
     }
     mesh_view_->setViewport({0, 0, w, h});
-    compose_view_->setViewport({0, 0, w, h});
+    compose_view_->setViewport({0, 0, static_cast<uint32_t>(GetPresentWidth()),
+                                static_cast<uint32_t>(GetPresentHeight())});
     SetFilamentCamera(*mesh_camera_, camera_, mesh_near_);
 }
 

@@ -41,6 +41,15 @@ public:
     /// the size-dependent targets first.
     void SetCamera(const camera::PinholeCamera& camera);
     const camera::PinholeCamera& GetCamera() const { return camera_; }
+    /// Size the compose view covers on the swap chain; 0 x 0 (the default): the camera's.
+    /// Larger than the camera, the picture is scaled up (nearest texel): the viewer draws
+    /// frames at a reduced resolution while the camera moves on a slow device.
+    void SetPresentSize(int width, int height) {
+        present_width_ = width;
+        present_height_ = height;
+    }
+    int GetPresentWidth() const { return present_width_ > 0 ? present_width_ : camera_.width; }
+    int GetPresentHeight() const { return present_height_ > 0 ? present_height_ : camera_.height; }
     /// Near plane of the mesh projection (meshes closer are clipped); default 0.01. The
     /// projection has no far plane (Filament's depth is near / z).
     void SetMeshNearPlane(double near) { mesh_near_ = near; }
@@ -78,6 +87,7 @@ private:
     const FilamentMaterials& materials_;
     SplatSharing sharing_;
     camera::PinholeCamera camera_;
+    int present_width_ = 0, present_height_ = 0;
     double mesh_near_ = 0.01;
     double far_ = 1000.0;
     RenderConfig splat_config_;

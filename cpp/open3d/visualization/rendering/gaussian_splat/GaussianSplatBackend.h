@@ -81,6 +81,14 @@ public:
     /// Composite stage: composite the sorted tiles of the last geometry stage into `output`
     /// (images are (re)allocated to the view size). Throws when no geometry stage ran.
     virtual void RenderCompositeStage(RenderOutput& output, const CompositeInputs& inputs = {}) = 0;
+    /// Waits up to `timeout_ms` for a geometry stage that still runs on the device; true
+    /// once none does. Backends that finish RenderGeometryStage before returning (the CPU
+    /// reference) return true at once. The viewer waits in slices so that a close asked for
+    /// meanwhile stops the frame before its composite.
+    virtual bool WaitGeometryStage(double timeout_ms) {
+        (void)timeout_ms;
+        return true;
+    }
 
     /// Hides splats without a new upload: bit i of word i / 32 shows splat i
     /// ([ceil(N / 32)] words; empty shows all). Backends without a mask return false and

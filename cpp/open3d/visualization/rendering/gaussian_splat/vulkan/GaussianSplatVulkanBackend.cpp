@@ -1,6 +1,7 @@
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/GaussianSplatVulkanBackend.h"
 #include "open3d/core/Timer.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstddef>
@@ -166,6 +167,17 @@ void GaussianSplatVulkanBackend::EnsureReadback(uint32_t width, uint32_t height)
     color_readback_ = readback(16);
     depth_readback_ = readback(4);
     median_readback_ = readback(4);
+}
+
+bool GaussianSplatVulkanBackend::WaitGeometryStage(double timeout_ms) {
+    if (!geometry_.in_flight) return true;
+    // The fence stays signalled: the composite stage's own wait returns at once.
+    VkFence fence = geometry_stage_fence_.Get();
+    const VkResult result = vkWaitForFences(context_->GetDevice(), 1, &fence, VK_TRUE,
+                                            static_cast<uint64_t>(std::max(0.0, timeout_ms) * 1e6));
+    if (result == VK_TIMEOUT) return false;
+    CheckVk(result, "vkWaitForFences");
+    return true;
 }
 
 void GaussianSplatVulkanBackend::RenderGeometryStage(const camera::PinholeCamera& camera,

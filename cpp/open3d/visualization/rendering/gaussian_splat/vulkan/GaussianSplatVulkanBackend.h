@@ -91,6 +91,7 @@ public:
     void ReleaseResources() override;
     void RenderGeometryStage(const camera::PinholeCamera& camera,
                              const RenderConfig& config) override;
+    bool WaitGeometryStage(double timeout_ms) override;
     void RenderCompositeStage(RenderOutput& output, const CompositeInputs& inputs = {}) override;
 
     /// One submission for both stages (the stage path when `inputs` has a scene depth).
