@@ -32,5 +32,22 @@ std::string TempDir() {
     return dir.string();
 }
 
+ScopedEnvironment::ScopedEnvironment(const std::string& name, const std::string& value)
+    : name_(name) {
+    if (const char* old = std::getenv(name.c_str())) {
+        saved_ = old;
+        was_set_ = true;
+    }
+    setenv(name.c_str(), value.c_str(), 1);
+}
+
+ScopedEnvironment::~ScopedEnvironment() {
+    if (was_set_) {
+        setenv(name_.c_str(), saved_.c_str(), 1);
+    } else {
+        unsetenv(name_.c_str());
+    }
+}
+
 }  // namespace tests
 }  // namespace open3d

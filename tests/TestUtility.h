@@ -21,6 +21,19 @@ std::string TempDir();
 /// a tool or a shared scene fails instead of skipping, so the suite cannot pass by skipping.
 bool SkipsAreFailures();
 
+/// Sets an environment variable for the scope of a test, then restores it (or unsets it).
+class ScopedEnvironment {
+public:
+    ScopedEnvironment(const std::string& name, const std::string& value);
+    ~ScopedEnvironment();
+    ScopedEnvironment(const ScopedEnvironment&) = delete;
+    ScopedEnvironment& operator=(const ScopedEnvironment&) = delete;
+
+private:
+    std::string name_, saved_;
+    bool was_set_ = false;
+};
+
 }  // namespace tests
 }  // namespace open3d
 

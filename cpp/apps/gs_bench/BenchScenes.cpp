@@ -1,9 +1,13 @@
 #include "BenchScenes.h"
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 
+#include <fmt/format.h>
+
 #include "open3d/core/Exception.h"
+#include "open3d/core/HostMemory.h"
 
 namespace open3d {
 namespace bench {
@@ -24,6 +28,21 @@ t::geometry::PointCloud MakeGridScene(const t::geometry::PointCloud& tile, int k
     if (k < 1) core::ThrowError("--grid needs K >= 1, got {}", k);
     tile.ValidateGaussianSplat();
     const int64_t n = tile.NumPoints();
+    {
+        // Checked before the copies are made (--grid 64 once grew past 12 GB and on).
+        uint64_t tile_bytes = 0;
+        for (const std::string& name : tile.GetPointAttrNames()) {
+            tile_bytes += tile.GetPointAttr(name).NumBytes();
+        }
+        const uint64_t per_copy = std::max<uint64_t>(tile_bytes, 1);
+        const uint64_t available = core::AvailableHostMemory();
+        const int fits = int(std::sqrt(double(available / per_copy)));
+        core::RequireHostMemory(
+            per_copy * uint64_t(k) * uint64_t(k),
+            fmt::format("--grid {}: {} x {} copies of {} splats ({} splats)", k, k, k, n,
+                        int64_t(k) * k * n),
+            fits >= 1 ? fmt::format("--grid {} fits", fits) : "not even one copy fits");
+    }
     const float* p = tile.GetPointPositions().Data<float>();
     double lo[3], hi[3];
     for (int c = 0; c < 3; ++c) {

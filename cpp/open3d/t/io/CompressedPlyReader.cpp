@@ -174,7 +174,7 @@ geometry::PointCloud ReadCompressedPly(const std::string& filename,
     }
 
     SplatColumns columns;
-    columns.Allocate(n, /*gaussian=*/true, degree);
+    columns.Allocate(filename, n, /*gaussian=*/true, degree);
     float* positions = columns.positions.Data<float>();
     float* scale = columns.scale.Data<float>();
     float* rot = columns.rot.Data<float>();

@@ -481,7 +481,7 @@ geometry::PointCloud SceneReader::Read(const ReadPointCloudOptions& options,
                          ignored, kExtension);
     }
     SplatColumns columns;
-    columns.Allocate(total, /*gaussian=*/true, degree);
+    columns.Allocate(doc_.Filename(), total, /*gaussian=*/true, degree);
     const int nc = geometry::NumSHRestCoeffs(degree);
     float* f_rest = columns.f_rest.NumBytes() > 0 ? columns.f_rest.Data<float>() : nullptr;
     int64_t start = 0;

@@ -260,7 +260,7 @@ geometry::PointCloud ReadKsplat(const std::string& filename, const ReadPointClou
     }
 
     SplatColumns columns;
-    columns.Allocate(total, /*gaussian=*/true, degree);
+    columns.Allocate(filename, total, /*gaussian=*/true, degree);
     float* positions = columns.positions.Data<float>();
     float* scale = columns.scale.Data<float>();
     float* rot = columns.rot.Data<float>();

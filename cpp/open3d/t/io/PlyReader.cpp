@@ -112,7 +112,7 @@ std::vector<Field> PlanFields(const std::string& filename, const PlyElement& ver
                          filename, num_rest);
     }
 
-    columns.Allocate(vertex.count, gaussian, degree);
+    columns.Allocate(filename, vertex.count, gaussian, degree);
     std::vector<Field> fields;
     auto add = [&](const std::string& name, core::Tensor& column, int stride, int index,
                    bool exp = false) {

@@ -269,7 +269,7 @@ geometry::PointCloud ReadSog(const std::string& filename, const ReadPointCloudOp
     {
         const Plane lo = load(means_files[0], "means.files[0]");
         const Plane hi = load(means_files[1], "means.files[1]");
-        columns.Allocate(count, /*gaussian=*/true, degree);
+        columns.Allocate(filename, count, /*gaussian=*/true, degree);
         float* positions = columns.positions.Data<float>();
         core::ParallelFor(count, [&](int64_t i) {
             const uint8_t* l = lo.Texel(i);

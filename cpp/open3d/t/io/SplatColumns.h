@@ -26,7 +26,9 @@ struct SplatColumns {
     core::Tensor f_rest;     // [N, Nc, 3]
 
     /// Sizes every column for n points, uninitialised (positions only when !gaussian).
-    void Allocate(int64_t n, bool gaussian, int degree);
+    /// Throws naming `filename`, the bytes needed and the splat count that would fit when
+    /// the columns need more than the available host memory (core::RequireHostMemory).
+    void Allocate(const std::string& filename, int64_t n, bool gaussian, int degree);
 };
 
 /// A read-only view of a whole file (memory-mapped). Throws naming the file when it

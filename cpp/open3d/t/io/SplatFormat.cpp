@@ -41,7 +41,7 @@ geometry::PointCloud ReadSplat(const std::string& filename, const ReadPointCloud
     }
     const int64_t n = size / kSplatBytes;
     SplatColumns columns;
-    columns.Allocate(n, /*gaussian=*/true, /*degree=*/0);
+    columns.Allocate(filename, n, /*gaussian=*/true, /*degree=*/0);
     float* positions = columns.positions.Data<float>();
     float* scale = columns.scale.Data<float>();
     float* f_dc = columns.f_dc.Data<float>();

@@ -110,7 +110,7 @@ geometry::PointCloud DecodeSplats(const std::string& filename, const Header& h,
     const int nc = geometry::NumSHRestCoeffs(degree),
               file_nc = geometry::NumSHRestCoeffs(h.sh_degree);
     SplatColumns c;
-    c.Allocate(n, /*gaussian=*/true, degree);
+    c.Allocate(filename, n, /*gaussian=*/true, degree);
     float* positions = c.positions.Data<float>();
     float* scale = c.scale.Data<float>();
     float* rot = c.rot.Data<float>();

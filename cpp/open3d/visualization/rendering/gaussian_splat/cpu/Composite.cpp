@@ -1,9 +1,12 @@
 #include "open3d/visualization/rendering/gaussian_splat/cpu/Composite.h"
 
 #include <algorithm>
+
+#include <fmt/format.h>
 #include <cmath>
 
 #include "open3d/core/Exception.h"
+#include "open3d/core/HostMemory.h"
 #include "open3d/core/ParallelFor.h"
 
 namespace open3d {
@@ -58,6 +61,16 @@ void CompositeTiles(const std::vector<ProjectedSplat>& splats, const TileLists& 
         (scene_depth->GetRows() != height || scene_depth->GetCols() != width ||
          scene_depth->GetChannels() != 1 || scene_depth->GetDtype() != core::Dtype::Float32)) {
         core::ThrowError("CompositeTiles: scene depth must be Float32 [{}, {}, 1]", height, width);
+    }
+    {
+        // The colour (RGBA32F) and the two depths (float32) of every pixel.
+        const uint64_t per_pixel = 4 * 4 + 4 + 4;
+        const uint64_t need = per_pixel * uint64_t(width) * height;
+        const uint64_t available = core::AvailableHostMemory();
+        const double scale = need > available ? std::sqrt(double(available) / need) * 0.9 : 1.0;
+        core::RequireHostMemory(need, fmt::format("cpu backend: a {}x{} image", width, height),
+                                fmt::format("{}x{} would fit", std::max(1, int(width * scale)),
+                                            std::max(1, int(height * scale))));
     }
     output.color = t::geometry::Image(height, width, 4, core::Dtype::Float32);
     output.depth_expected = t::geometry::Image(height, width, 1, core::Dtype::Float32);

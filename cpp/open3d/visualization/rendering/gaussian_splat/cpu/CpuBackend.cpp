@@ -4,6 +4,7 @@
 #include <chrono>
 
 #include "open3d/core/Exception.h"
+#include "open3d/core/HostMemory.h"
 #include "open3d/visualization/rendering/gaussian_splat/cpu/Composite.h"
 
 namespace open3d {
@@ -31,6 +32,14 @@ void CpuBackend::RenderGeometryStage(const camera::PinholeCamera& camera,
     if (!cloud_) core::ThrowError("cpu backend: RenderGeometryStage called before SetScene");
     config.Validate();
     const auto start = std::chrono::steady_clock::now();
+    // The last view's results go first: they are replaced, and both would not fit twice.
+    projected_ = {};
+    tile_lists_ = TileLists{};
+    camera_.reset();
+    const uint64_t n = static_cast<uint64_t>(cloud_->NumPoints());
+    core::RequireHostMemory(n * (sizeof(ProjectedSplat) + 2 * sizeof(uint64_t)),
+                            fmt::format("cpu backend: projecting {} splats", n),
+                            "the vulkan backend keeps them in device memory");
     projected_ = ProjectSplats(*cloud_, camera, config);
     tile_lists_ =
         BuildTileLists(projected_, TileGrid::ForImage(camera.width, camera.height), config);

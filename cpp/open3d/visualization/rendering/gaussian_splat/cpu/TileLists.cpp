@@ -2,6 +2,10 @@
 
 #include <algorithm>
 
+#include <fmt/format.h>
+
+#include "open3d/core/HostMemory.h"
+
 namespace open3d {
 namespace visualization {
 namespace rendering {
@@ -70,6 +74,9 @@ TileLists BuildTileLists(const std::vector<ProjectedSplat>& splats, const TileGr
     }
     for (size_t t = 1; t < lists.offsets.size(); ++t) lists.offsets[t] += lists.offsets[t - 1];
     std::vector<uint64_t> cursor(lists.offsets.begin(), lists.offsets.end() - 1);
+    core::RequireHostMemory(total * sizeof(uint32_t),
+                            fmt::format("cpu backend: {} tile entries", total),
+                            "a lower resolution has fewer");
     lists.splat_indices.resize(total);
     for (uint32_t index : emitting) {
         for_each_tile(splats[index],

@@ -52,6 +52,9 @@ Buffer::Buffer(const VulkanContext& context, VkDeviceSize size, VkBufferUsageFla
     allocate_info.allocationSize = requirements.size;
     allocate_info.memoryTypeIndex =
         context.FindMemoryType(requirements.memoryTypeBits, required, preferred);
+    DeviceMemoryCharge charge = context.GetMemoryBudget().Charge(
+        allocate_info.memoryTypeIndex, requirements.size,
+        memory == MemoryUsage::kDevice ? "a device buffer" : "a host-visible buffer");
     VkDeviceMemory device_memory = VK_NULL_HANDLE;
     VkResult result = vkAllocateMemory(device, &allocate_info, nullptr, &device_memory);
     if (result != VK_SUCCESS) {
@@ -60,6 +63,7 @@ Buffer::Buffer(const VulkanContext& context, VkDeviceSize size, VkBufferUsageFla
             memory == MemoryUsage::kDevice ? "device" : "host-visible", VkResultName(result));
     }
     memory_ = UniqueDeviceMemory(device, device_memory);
+    charge_ = std::move(charge);
     CheckVk(vkBindBufferMemory(device, buffer, device_memory, 0), "vkBindBufferMemory");
     if (memory != MemoryUsage::kDevice) {
         CheckVk(vkMapMemory(device, device_memory, 0, VK_WHOLE_SIZE, 0, &mapped_), "vkMapMemory");

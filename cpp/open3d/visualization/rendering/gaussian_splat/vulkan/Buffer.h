@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <utility>
 
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/DeviceMemoryBudget.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/VulkanHandle.h"
 
 namespace open3d {
@@ -44,13 +45,15 @@ public:
            MemoryUsage memory, bool shared_with_transfer = false);
 
     Buffer(Buffer&& other) noexcept
-        : memory_(std::move(other.memory_)),
+        : charge_(std::move(other.charge_)),
+          memory_(std::move(other.memory_)),
           buffer_(std::move(other.buffer_)),
           size_(std::exchange(other.size_, 0)),
           mapped_(std::exchange(other.mapped_, nullptr)) {}
     Buffer& operator=(Buffer&& other) noexcept {
         buffer_ = std::move(other.buffer_);  // buffer before memory, as in the destructor
         memory_ = std::move(other.memory_);
+        charge_ = std::move(other.charge_);  // after the memory it accounts for is freed
         size_ = std::exchange(other.size_, 0);
         mapped_ = std::exchange(other.mapped_, nullptr);
         return *this;
@@ -66,6 +69,7 @@ public:
     explicit operator bool() const { return static_cast<bool>(buffer_); }
 
 private:
+    DeviceMemoryCharge charge_;  // given back after the memory is freed
     // Declared first so the buffer is destroyed before its memory is freed.
     UniqueDeviceMemory memory_;
     UniqueBuffer buffer_;

@@ -185,6 +185,9 @@ private:
 
     void UploadScene(SplatPrecision precision);
     void EnsureViewBuffers(uint32_t entry_capacity);
+    /// Refuses a view size whose images cannot fit in device memory, naming a size that
+    /// would (checked before the geometry stage, so nothing is half made).
+    void CheckViewFits(uint32_t width, uint32_t height) const;
     void EnsureTargets(uint32_t width, uint32_t height);
     void EnsureReadback(uint32_t width, uint32_t height);
     void WaitForGeometry();

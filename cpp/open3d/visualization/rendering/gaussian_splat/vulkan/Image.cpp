@@ -111,6 +111,9 @@ Image::Image(const VulkanContext& context, uint32_t width, uint32_t height, VkFo
     allocate_info.allocationSize = requirements.size;
     allocate_info.memoryTypeIndex =
         context.FindMemoryType(requirements.memoryTypeBits, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
+    DeviceMemoryCharge charge =
+        context.GetMemoryBudget().Charge(allocate_info.memoryTypeIndex, requirements.size,
+                                         fmt::format("a {}x{} image", width, height));
     VkDeviceMemory device_memory = VK_NULL_HANDLE;
     VkResult result = vkAllocateMemory(device, &allocate_info, nullptr, &device_memory);
     if (result != VK_SUCCESS) {
@@ -118,6 +121,7 @@ Image::Image(const VulkanContext& context, uint32_t width, uint32_t height, VkFo
                          requirements.size >> 10, width, height, VkResultName(result));
     }
     memory_ = UniqueDeviceMemory(device, device_memory);
+    charge_ = std::move(charge);
     allocation_size_ = requirements.size;
     CheckVk(vkBindImageMemory(device, image, device_memory, 0), "vkBindImageMemory");
 

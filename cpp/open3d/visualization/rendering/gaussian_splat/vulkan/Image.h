@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <utility>
 
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/DeviceMemoryBudget.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/VulkanHandle.h"
 
 namespace open3d {
@@ -55,6 +56,7 @@ public:
         view_ = std::move(other.view_);  // view, image, memory: the destructor's order
         image_ = std::move(other.image_);
         memory_ = std::move(other.memory_);
+        charge_ = std::move(other.charge_);
         width_ = other.width_;
         height_ = other.height_;
         format_ = other.format_;
@@ -78,6 +80,7 @@ public:
     ImageMemoryFd ExportFd(const VulkanContext& context) const;
 
 private:
+    DeviceMemoryCharge charge_;  // given back after the memory is freed
     // Destroyed in reverse order: view, image, then memory.
     UniqueDeviceMemory memory_;
     UniqueImage image_;

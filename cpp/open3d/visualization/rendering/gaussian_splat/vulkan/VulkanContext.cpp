@@ -387,6 +387,7 @@ void VulkanContext::InitDevice(VkPhysicalDevice physical_device, uint32_t queue_
         }
     }
     vkGetPhysicalDeviceMemoryProperties(physical_device, &memory_properties_);
+    memory_budget_.Init(memory_properties_);
 
     const VkPhysicalDeviceProperties& properties = query.properties.properties;
     info_.name = properties.deviceName;

@@ -12,6 +12,8 @@
 #include <optional>
 #include <string>
 
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/DeviceMemoryBudget.h"
+
 namespace open3d {
 namespace visualization {
 namespace rendering {
@@ -119,6 +121,9 @@ public:
     /// preferring one that also has `preferred`. Throws core::Open3DError when none fits.
     uint32_t FindMemoryType(uint32_t type_bits, VkMemoryPropertyFlags required,
                             VkMemoryPropertyFlags preferred = 0) const;
+    /// What Buffers and Images of this context hold per heap; they charge it before each
+    /// allocation (DeviceMemoryBudget.h).
+    const DeviceMemoryBudget& GetMemoryBudget() const { return memory_budget_; }
 
     /// vkCmdPushDescriptorSetKHR of this device (an extension entry point).
     PFN_vkCmdPushDescriptorSetKHR GetCmdPushDescriptorSet() const { return push_descriptor_set_; }
@@ -151,6 +156,7 @@ private:
     VkQueue transfer_queue_ = VK_NULL_HANDLE;
     uint32_t transfer_family_ = 0;
     VkPhysicalDeviceMemoryProperties memory_properties_{};
+    DeviceMemoryBudget memory_budget_;
     PFN_vkCmdPushDescriptorSetKHR push_descriptor_set_ = nullptr;
     PFN_vkGetMemoryFdKHR get_memory_fd_ = nullptr;
     VulkanDeviceInfo info_;

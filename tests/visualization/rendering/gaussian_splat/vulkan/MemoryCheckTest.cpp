@@ -1,0 +1,67 @@
+// Views and scenes that do not fit in device memory are refused before anything is
+// allocated, with the numbers and a size that fits; that size then renders
+// (OPEN3D_DEVICE_MEMORY_LIMIT stands in for a small device).
+#include <gtest/gtest.h>
+
+#include <regex>
+#include <string>
+
+#include "TestUtility.h"
+#include "open3d/core/Exception.h"
+#include "open3d/visualization/rendering/gaussian_splat/DefaultScene.h"
+#include "visualization/rendering/gaussian_splat/vulkan/VulkanTestFixture.h"
+
+namespace open3d {
+namespace tests {
+namespace {
+
+namespace rendering = visualization::rendering;
+using VulkanMemoryCheck = VulkanTest;
+
+TEST_F(VulkanMemoryCheck, ALargeViewIsRefusedWithASizeThatFits) {
+    auto backend = MakeBackend();
+    backend->SetScene(rendering::CreateDefaultGaussianSplatScene());
+    rendering::RenderConfig config;
+    camera::PinholeCamera camera =
+        camera::PinholeCamera::FromLookAt(rendering::GetDefaultSceneLookAt(), 4000, 4000);
+    // 4000 x 4000 x (52 bytes + the composite state) is more than 800 MB.
+    ScopedEnvironment limit("OPEN3D_DEVICE_MEMORY_LIMIT", "400000000");
+    std::string message;
+    try {
+        RenderStages(*backend, camera, config);
+    } catch (const core::Open3DError& e) {
+        message = e.what();
+    }
+    std::smatch m;
+    ASSERT_TRUE(std::regex_search(message, m,
+                                  std::regex("a 4000x4000 view needs ([0-9.]+) MB of device "
+                                             "memory for its images, ([0-9.]+) MB is free; "
+                                             "([0-9]+)x([0-9]+) would fit")))
+        << message;
+    EXPECT_GT(std::stod(m[1]), 800.0);
+    EXPECT_LT(std::stod(m[2]), 400.0);
+    const int w = std::stoi(m[3]), h = std::stoi(m[4]);
+    EXPECT_EQ(w, h);
+    EXPECT_GT(w, 1000);
+    camera = camera.Resized(w, h);
+    const rendering::RenderOutput out = RenderStages(*backend, camera, config);
+    EXPECT_EQ(out.color.GetCols(), w);
+    EXPECT_GT(out.stats.num_visible, 0);
+}
+
+TEST_F(VulkanMemoryCheck, ASceneThatDoesNotFitIsRefused) {
+    auto backend = MakeBackend();
+    ScopedEnvironment limit("OPEN3D_DEVICE_MEMORY_LIMIT", "1000");
+    try {
+        backend->SetScene(rendering::CreateDefaultGaussianSplatScene());
+        FAIL() << "a scene was uploaded into 1000 bytes";
+    } catch (const core::Open3DError& e) {
+        EXPECT_NE(std::string(e.what()).find("of device memory"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("OPEN3D_DEVICE_MEMORY_LIMIT"), std::string::npos)
+            << e.what();
+    }
+}
+
+}  // namespace
+}  // namespace tests
+}  // namespace open3d
