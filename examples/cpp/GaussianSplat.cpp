@@ -46,6 +46,7 @@ struct Options {
     bool screenshot_on_exit = false;
     double spin_degrees = 0.0;
     bool continuous = false;
+    double interactive_frame_ms = 100.0;
 };
 
 // Puts `cloud` into the viewer as the scene (replacing the one shown, if any) with the red
@@ -112,6 +113,7 @@ int Run(const Options& opt) {
     vo.home_pitch_deg = 20.0;  // look down on the scene a little: ground planes show
     vo.show_settings = !opt.hide_panel;
     vo.screenshot_dir = opt.screenshot_dir;
+    vo.interactive_frame_ms = opt.interactive_frame_ms;
     vis::Visualizer viewer(vo);
     ShowScene(viewer, cloud, name, default_scene, opt);
     viewer.GetSplatConfig().sh_degree = opt.sh_degree;
@@ -176,6 +178,7 @@ int Run(const Options& opt) {
     if (opt.spin_degrees != 0.0) {
         run.before_frame = [&viewer, &opt] {
             viewer.GetViewControl().Orbit(opt.spin_degrees, 0.0);
+            viewer.NoteCameraMotion();
         };
     }
     viewer.Run(run);
@@ -267,6 +270,12 @@ int main(int argc, char** argv) {
         ->capture_default_str();
     app.add_flag("--screenshot-on-exit", opt.screenshot_on_exit,
                  "Draw one more frame at exit and save it as a screenshot");
+    app.add_option("--interactive-frame-ms", opt.interactive_frame_ms,
+                   "While the camera moves (drag, keys, wheel, --spin), frames whose full-size "
+                   "time exceeded this are drawn at 1/2 or 1/4 of each side and scaled up; "
+                   "the full-size frame follows when the motion stops (0: always full size)")
+        ->check(CLI::NonNegativeNumber)
+        ->capture_default_str();
     app.add_option("--spin", opt.spin_degrees,
                    "Orbit the camera by this many degrees every frame, drawing continuously "
                    "(timing: the splat geometry stage then runs every frame)")

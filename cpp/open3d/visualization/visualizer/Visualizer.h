@@ -203,8 +203,12 @@ public:
     /// 1 when the last frame drawn to the window had the window's resolution, 2 or 4 when it
     /// was drawn at that fraction of each side (the camera was moving).
     int GetLastFrameDivisor() const { return last_divisor_; }
-    /// A drag is orbiting or panning, or the camera moved by key or wheel in the last 0.25 s.
+    /// A drag is orbiting or panning, or the camera moved by key or wheel (or
+    /// NoteCameraMotion) in the last 0.25 s.
     bool IsCameraMoving() const;
+    /// Counts as camera motion for 0.25 s: a scripted camera path (the example's --spin) gets
+    /// the reduced frames of a moving camera on a slow device.
+    void NoteCameraMotion();
     const FrameStatistics& GetFrameStatistics() const { return frame_stats_; }
     std::string GetBackendName() const;
     /// The scene behind the window (asks for a redraw).
@@ -256,7 +260,6 @@ private:
     rendering::FrameResult DrawToWindow(bool read_screen, int divisor);
     /// The resolution divisor of the next frame (VisualizerOptions::interactive_frame_ms).
     int InteractiveDivisor() const;
-    void NoteCameraMotion();
     /// While a frame is in flight its GPU waits poll window events (docs/viewer.md):
     /// handlers then keep the event for after the frame. True when `handler` was kept.
     bool DeferDuringFrame(std::function<void()> handler);
