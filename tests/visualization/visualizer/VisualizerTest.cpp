@@ -437,6 +437,39 @@ TEST_F(VisualizerTest, QDuringALongFrameStopsIt) {
     std::printf("Q after %.2f s stopped the frame after %.2f s\n", frame_s / 4, run_s);
 }
 
+// After a large scene arrives, a frame without splats that shows the notice in the panel is
+// presented first; the real frame follows in the same call, and later frames are plain.
+TEST_F(VisualizerTest, LargeSceneNoticeFrameComesFirst) {
+    visualization::VisualizerOptions options;
+    options.width = 240;
+    options.height = 160;
+    options.show_settings = true;
+    options.first_frame_notice_splats = 100;  // the wall has 144
+    Visualizer& vis = MakeVisualizer(options);
+    AddWallAndSphere(vis);
+    std::vector<rendering::FrameEvent> events;
+    renderer_->SetFrameEventListener(
+        [&](rendering::FrameEvent e, const rendering::FilamentView*) { events.push_back(e); });
+    ASSERT_TRUE(vis.RenderFrame());
+    using rendering::FrameEvent;
+    const std::vector<FrameEvent> notice = {FrameEvent::kBeginFrame, FrameEvent::kGeometryStage,
+                                            FrameEvent::kFilamentDraw, FrameEvent::kOverlay,
+                                            FrameEvent::kEndFrame};
+    const std::vector<FrameEvent> frame = {FrameEvent::kBeginFrame,   FrameEvent::kGeometryStage,
+                                           FrameEvent::kFilamentDraw, FrameEvent::kComposite,
+                                           FrameEvent::kOverlay,      FrameEvent::kEndFrame};
+    std::vector<FrameEvent> want = notice;
+    want.insert(want.end(), frame.begin(), frame.end());
+    EXPECT_EQ(events, want);
+    EXPECT_TRUE(vis.GetLastFrame().splats_drawn);
+    EXPECT_TRUE(vis.GetStatus().empty());
+    events.clear();
+    vis.GetViewControl().Orbit(5.0, 0.0);
+    ASSERT_TRUE(vis.RenderFrame());
+    renderer_->SetFrameEventListener({});
+    EXPECT_EQ(events, frame);
+}
+
 // A screenshot that cannot be written is a message; the viewer goes on and a later one into
 // a good folder works.
 TEST_F(VisualizerTest, ScreenshotIntoABadFolderIsAMessage) {

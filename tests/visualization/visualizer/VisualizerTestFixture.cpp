@@ -60,6 +60,12 @@ visualization::Visualizer& VisualizerTest::MakeVisualizer(int width, int height,
     options.height = height;
     options.show_settings = show_settings;
     options.interactive_frame_ms = interactive_frame_ms;
+    return MakeVisualizer(options);
+}
+
+visualization::Visualizer& VisualizerTest::MakeVisualizer(
+    visualization::VisualizerOptions options) {
+    options.title = ::testing::UnitTest::GetInstance()->current_test_info()->name();
     options.scene.backend = "vulkan";
     vis_ = std::make_unique<visualization::Visualizer>(*renderer_, options);
     return *vis_;

@@ -33,6 +33,8 @@ protected:
     visualization::Visualizer& MakeVisualizer(int width = 240, int height = 160,
                                               bool show_settings = false,
                                               double interactive_frame_ms = 0.0);
+    /// A visible window with these options (title and backend set here).
+    visualization::Visualizer& MakeVisualizer(visualization::VisualizerOptions options);
     /// Adds "wall" (splats) and "sphere" (mesh), in that order, and fits the camera.
     void AddWallAndSphere(visualization::Visualizer& vis);
     /// Polls events until the framebuffer is width x height (false after ~5 s).

@@ -58,6 +58,7 @@ void Visualizer::Init(const VisualizerOptions& options) {
     show_settings_ = options.show_settings;
     screenshot_dir_ = options.screenshot_dir.empty() ? "." : options.screenshot_dir;
     interactive_frame_ms_ = options.interactive_frame_ms;
+    first_frame_notice_splats_ = options.first_frame_notice_splats;
     rendering::FilamentEngine& engine = renderer_->GetEngine();
     window_ = std::make_unique<VisualizerWindow>(engine, options.title, options.width,
                                                  options.height, this);
@@ -78,8 +79,13 @@ Visualizer::~Visualizer() {
     owned_engine_.reset();
 }
 
+void Visualizer::NoteNewSplats(const t::geometry::PointCloud& cloud) {
+    if (cloud.IsGaussianSplat()) new_splats_ += cloud.NumPoints();
+}
+
 void Visualizer::AddGeometry(const std::string& name, const t::geometry::PointCloud& cloud) {
     scene_->AddGeometry(name, cloud);
+    NoteNewSplats(cloud);
     names_.push_back(name);
     PostRedraw();
 }
@@ -87,6 +93,7 @@ void Visualizer::AddGeometry(const std::string& name, const t::geometry::PointCl
 void Visualizer::AddGeometry(const std::string& name, const t::geometry::PointCloud& cloud,
                              const rendering::MaterialRecord& material) {
     scene_->AddGeometry(name, cloud, material);
+    NoteNewSplats(cloud);
     names_.push_back(name);
     PostRedraw();
 }
@@ -100,6 +107,7 @@ void Visualizer::AddGeometry(const std::string& name, const t::geometry::Triangl
 
 void Visualizer::UpdateGeometry(const std::string& name, const t::geometry::PointCloud& cloud) {
     scene_->UpdateGeometry(name, cloud);
+    NoteNewSplats(cloud);
     PostRedraw();
 }
 
@@ -210,7 +218,7 @@ int Visualizer::InteractiveDivisor() const {
     return over <= 1.0 ? 1 : over <= 4.0 ? 2 : 4;
 }
 
-rendering::FrameResult Visualizer::DrawToWindow(bool read_screen, int divisor) {
+rendering::FrameResult Visualizer::DrawToWindow(bool read_screen, int divisor, bool skip_splats) {
     const camera::PinholeCamera camera = view_control_.GetCamera();
     scene_->SetupCamera(divisor > 1 ? camera.Resized(std::max(1, camera.width / divisor),
                                                      std::max(1, camera.height / divisor))
@@ -218,6 +226,7 @@ rendering::FrameResult Visualizer::DrawToWindow(bool read_screen, int divisor) {
     scene_->GetView().SetPresentSize(fb_width_, fb_height_);
     rendering::FrameRequest request;
     request.read_screen = read_screen;
+    request.skip_splats = skip_splats;
     if (show_settings_) request.overlay_views.push_back(overlay_->GetView());
     // A close asked for during this frame (Q, Esc, the window's close button) skips its
     // composite and present; one asked for before it does not (a last screenshot at exit).
@@ -260,6 +269,19 @@ bool Visualizer::RenderFrame() {
         return false;
     }
     if (redraw_frames_ > 0) --redraw_frames_;
+    if (new_splats_ > 0 && first_frame_notice_splats_ > 0 &&
+        new_splats_ >= first_frame_notice_splats_ && show_settings_) {
+        // The notice frame: the panel with the line, no splats, presented at once; the
+        // geometry stage it submits runs on while it shows and serves the next frame.
+        const std::string status = status_;
+        const bool warning = status_warning_;
+        status_ = fmt::format("Drawing the first frame of {} splats...", new_splats_);
+        status_warning_ = false;
+        BuildOverlay();
+        DrawToWindow(false, 1, true);
+        status_ = status;
+        status_warning_ = warning;
+    }
     // A screenshot waits until ImGui has seen all input (a click takes two frames), so it
     // shows the state after everything that came before the request.
     const bool settled = BuildOverlay();
@@ -272,6 +294,7 @@ bool Visualizer::RenderFrame() {
     }
     last_divisor_ = divisor;
     if (divisor == 1) full_frame_ms_ = last_frame_.times.total_ms;
+    if (last_frame_.splats_drawn) new_splats_ = 0;
     const double now = NowSeconds();
     if (last_present_s_ >= 0.0)
         frame_stats_.Add(1000.0 * (now - last_present_s_), last_frame_.times);

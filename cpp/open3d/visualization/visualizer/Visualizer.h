@@ -60,6 +60,11 @@ struct VisualizerOptions {
     /// milliseconds is drawn at 1/2 (up to 4x over) or 1/4 of each side and scaled up; the
     /// full-resolution frame follows when the motion stops. 0: always full resolution.
     double interactive_frame_ms = 100.0;
+    /// After a splat cloud of at least this many splats is added or updated, the next frame
+    /// is preceded by one without splats showing "Drawing the first frame of N splats" in the
+    /// panel, presented while that frame's geometry stage runs (seconds on a software
+    /// device). 0: never.
+    int64_t first_frame_notice_splats = 1000000;
 };
 
 struct RunOptions {
@@ -257,7 +262,9 @@ private:
     void BuildPanel();
     /// Runs the panel's ImGui frame (when shown); false while input is still pending.
     bool BuildOverlay();
-    rendering::FrameResult DrawToWindow(bool read_screen, int divisor);
+    rendering::FrameResult DrawToWindow(bool read_screen, int divisor, bool skip_splats = false);
+    /// Notes a splat cloud that was added or updated (the first-frame notice).
+    void NoteNewSplats(const t::geometry::PointCloud& cloud);
     /// The resolution divisor of the next frame (VisualizerOptions::interactive_frame_ms).
     int InteractiveDivisor() const;
     /// While a frame is in flight its GPU waits poll window events (docs/viewer.md):
@@ -283,6 +290,8 @@ private:
     int redraw_frames_ = 2;               // frames Run still draws without new input
     float panel_rect_[4] = {0, 0, 0, 0};  // x, y, w, h of the panel in the last frame
     double interactive_frame_ms_ = 100.0;
+    int64_t first_frame_notice_splats_ = 1000000;
+    int64_t new_splats_ = 0;       // splats added since the last frame drawn with splats
     double full_frame_ms_ = 0.0;   // time of the last full-resolution frame
     double last_motion_s_ = -1e9;  // steady clock seconds of the last key/wheel motion
     int last_divisor_ = 1;

@@ -136,7 +136,7 @@ FrameResult FilamentRenderer::Draw(FilamentView& view, const FrameRequest& reque
 
     const camera::PinholeCamera& camera = view.GetCamera();
     const int64_t w = camera.width, h = camera.height;
-    result.splats_drawn = scene.HasVisibleGaussianSplats();
+    result.splats_drawn = !request.skip_splats && scene.HasVisibleGaussianSplats();
     result.scene_depth_used = result.splats_drawn && scene.HasNonGaussianVisibleGeometry();
 
     Clock::time_point t = Clock::now();

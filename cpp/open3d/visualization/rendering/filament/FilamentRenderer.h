@@ -55,6 +55,10 @@ struct FrameRequest {
     /// compose view) and sets FrameResult::cancelled. The viewer's Q during a frame of
     /// seconds on a software device.
     std::function<bool()> cancelled;
+    /// Draw the meshes and overlays only: no composite, the splats do not show. A geometry
+    /// stage BeginFrame submitted keeps running (the viewer presents such a frame with a
+    /// progress line while the first geometry stage of a large scene runs).
+    bool skip_splats = false;
 };
 
 /// The steps of a frame, in the order the seed's design fixes (reported to a listener).
