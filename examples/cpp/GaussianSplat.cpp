@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "open3d/camera/CamerasJson.h"
@@ -81,25 +82,18 @@ int Run(const Options& opt) {
     const std::string no_display = rendering::FilamentUnavailableReason();
     if (!no_display.empty()) core::ThrowError("cannot open a window: {}", no_display);
     const bool default_scene = opt.input.empty();
-    t::geometry::PointCloud cloud;
-    const auto start = std::chrono::steady_clock::now();
-    if (default_scene) {
-        cloud = rendering::CreateDefaultGaussianSplatScene();
-    } else {
-        t::io::ReadPointCloud(opt.input, cloud);
-        if (!cloud.IsGaussianSplat()) {
-            core::ThrowError(
-                "{} has points but no Gaussian splat attributes (f_dc, opacity, "
-                "scale, rot)",
-                opt.input);
+    // A bad --view fails before a long load.
+    std::optional<camera::PinholeCamera> start_camera;
+    if (!opt.cameras.empty()) {
+        const std::vector<camera::CameraView> views = camera::ReadCamerasJson(opt.cameras);
+        if (opt.view < 0 || opt.view >= static_cast<int>(views.size())) {
+            core::ThrowError("--view {}: {} has {} views (0..{})", opt.view, opt.cameras,
+                             views.size(), static_cast<int>(views.size()) - 1);
         }
+        start_camera = views[opt.view].camera;
     }
     const std::string name =
         default_scene ? "default_scene" : std::filesystem::path(opt.input).stem().string();
-    std::printf("GaussianSplat: scene %s, %lld splats, SH degree %d, loaded in %.1f ms\n",
-                default_scene ? "built-in default" : opt.input.c_str(),
-                static_cast<long long>(cloud.NumPoints()), cloud.GaussianSplatGetSHOrder(),
-                core::MillisecondsSince(start));
 
     vis::VisualizerOptions vo;
     vo.title = "GaussianSplat - " + name;
@@ -115,17 +109,43 @@ int Run(const Options& opt) {
     vo.screenshot_dir = opt.screenshot_dir;
     vo.interactive_frame_ms = opt.interactive_frame_ms;
     vis::Visualizer viewer(vo);
-    ShowScene(viewer, cloud, name, default_scene, opt);
     viewer.GetSplatConfig().sh_degree = opt.sh_degree;
     viewer.GetSplatConfig().antialias = opt.antialias;
     viewer.SetBackground(Eigen::Vector4f(0.1f, 0.1f, 0.12f, 1.0f));
-    if (!opt.cameras.empty()) {
-        const std::vector<camera::CameraView> views = camera::ReadCamerasJson(opt.cameras);
-        if (opt.view < 0 || opt.view >= static_cast<int>(views.size())) {
-            core::ThrowError("--view {}: {} has {} views (0..{})", opt.view, opt.cameras,
-                             views.size(), static_cast<int>(views.size()) - 1);
+
+    // The scene is read on a worker thread while the window shows the progress (file size,
+    // seconds so far) in the panel; closing the window meanwhile ends the program.
+    const auto start = std::chrono::steady_clock::now();
+    t::geometry::PointCloud cloud;
+    vis::BackgroundCloudReader reader;
+    if (default_scene) {
+        cloud = rendering::CreateDefaultGaussianSplatScene();
+    } else {
+        reader.Start(opt.input);
+        std::printf("GaussianSplat: loading %s\n", opt.input.c_str());
+        std::fflush(stdout);
+        std::optional<t::geometry::PointCloud> loaded;
+        double shown_s = -1.0;
+        while (!(loaded = reader.TakeResult())) {  // rethrows the reader's error
+            if (!viewer.PollEvents()) return 0;
+            const double now = core::MillisecondsSince(start) / 1000.0;
+            if (now - shown_s >= 0.5) {  // twice a second
+                viewer.SetStatus(reader.Describe());
+                viewer.RenderFrame();
+                shown_s = now;
+            }
+            std::this_thread::sleep_for(std::chrono::milliseconds(20));
         }
-        viewer.SetCamera(views[opt.view].camera);
+        cloud = std::move(*loaded);
+        viewer.SetStatus("");
+    }
+    std::printf("GaussianSplat: scene %s, %lld splats, SH degree %d, loaded in %.1f ms\n",
+                default_scene ? "built-in default" : opt.input.c_str(),
+                static_cast<long long>(cloud.NumPoints()), cloud.GaussianSplatGetSHOrder(),
+                core::MillisecondsSince(start));
+    ShowScene(viewer, cloud, name, default_scene, opt);
+    if (start_camera) {
+        viewer.SetCamera(*start_camera);
     } else if (default_scene) {
         viewer.SetCamera(rendering::GetDefaultSceneLookAt());
     } else {
@@ -139,7 +159,6 @@ int Run(const Options& opt) {
 
     // Another file (dropped on the window or typed into the panel) is read on a worker
     // thread: the viewer keeps drawing the current scene and shows the read's progress.
-    vis::BackgroundCloudReader reader;
     viewer.SetOpenCallback([&](const std::vector<std::string>& paths) {
         reader.Start(paths.front());
         viewer.SetStatus(reader.Describe());
@@ -208,7 +227,9 @@ int main(int argc, char** argv) {
         "Vulkan compute (splats) and Filament (meshes, the panel). Opens SCENE (.ply,\n"
         ".compressed.ply, .splat, .spz, .sog or a SOG folder, .gltf, .glb, .ksplat) or,\n"
         "without one, the built-in default scene, and adds a red sphere mesh to\n"
-        "show depth compositing. Needs an X server (run under `xvfb-run -a` without a display).\n"
+        "show depth compositing. The file is read while the window shows the progress; drop\n"
+        "another file on the window (or type its path into the panel) to open it instead.\n"
+        "Needs an X server (run under `xvfb-run -a` without a display).\n"
         "\n"
         "Mouse: left drag orbits, right/middle/shift+left drag pans, wheel zooms.\n"
         "Keys: arrows orbit (shift: pan), +/- zoom, R resets the camera (fits the visible\n"
