@@ -13,6 +13,7 @@ packages=(
   libfilament-dev libfilament-tools libglfw3-dev libimgui-dev
   libxrandr-dev  # glfw3native.h (the GLX context handed to Filament) includes Xrandr.h
   xvfb xauth libgl1-mesa-dri libgl-dev xdotool
+  python3-dev pybind11-dev python3-numpy python3-pytest  # the Python package (docs/python.md)
 )
 
 missing=()

@@ -1,0 +1,18 @@
+// The Python extension module `open3d_gs._core` (docs/python.md): one function per part of
+// the library, each adding its classes and functions to a submodule that mirrors the C++
+// namespace (t.geometry, t.io, camera, visualization.rendering, visualization).
+#pragma once
+
+#include <pybind11/pybind11.h>
+
+namespace open3d {
+namespace pybind {
+
+void BindGeometry(pybind11::module_& t_geometry);
+void BindIo(pybind11::module_& t_io);
+void BindCamera(pybind11::module_& camera);
+void BindRendering(pybind11::module_& rendering);
+void BindVisualization(pybind11::module_& visualization);
+
+}  // namespace pybind
+}  // namespace open3d

@@ -1,0 +1,57 @@
+// t.io: read_point_cloud / write_point_cloud in every format the library knows.
+#include <pybind11/stl.h>
+
+#include <memory>
+#include <string>
+
+#include "Bindings.h"
+#include "PyPointCloud.h"
+#include "open3d/core/Exception.h"
+#include "open3d/t/io/PointCloudIO.h"
+
+namespace py = pybind11;
+
+namespace open3d {
+namespace pybind {
+
+void BindIo(py::module_& m) {
+    m.def(
+        "read_point_cloud",
+        [](const std::string& filename, bool drop_non_finite) {
+            auto cloud = std::make_shared<PyPointCloud>();
+            t::io::ReadPointCloudOptions options;
+            options.drop_non_finite = drop_non_finite;
+            py::gil_scoped_release release;
+            t::io::ReadPointCloud(filename, cloud->cloud, options);
+            return cloud;
+        },
+        py::arg("filename"), py::arg("drop_non_finite") = false,
+        "Reads a splat file of any supported format (detected by content: .ply, "
+        ".compressed.ply, .splat, .spz, .sog or a SOG folder, .gltf, .glb, .ksplat). Raises "
+        "Open3DError naming the file and the problem.");
+    m.def(
+        "write_point_cloud",
+        [](const std::string& filename, const PyPointCloud& cloud, const std::string& ply_format) {
+            t::io::WritePointCloudOptions options;
+            if (ply_format == "binary_little_endian") {
+                options.ply_format = t::io::PlyFormat::BinaryLittleEndian;
+            } else if (ply_format == "binary_big_endian") {
+                options.ply_format = t::io::PlyFormat::BinaryBigEndian;
+            } else if (ply_format == "ascii") {
+                options.ply_format = t::io::PlyFormat::Ascii;
+            } else {
+                core::ThrowError(
+                    "write_point_cloud: ply_format '{}' (binary_little_endian, "
+                    "binary_big_endian or ascii)",
+                    ply_format);
+            }
+            py::gil_scoped_release release;
+            t::io::WritePointCloud(filename, cloud.cloud, options);
+        },
+        py::arg("filename"), py::arg("pointcloud"), py::arg("ply_format") = "binary_little_endian",
+        "Writes the format the extension names (.ply, .compressed.ply, .splat, .spz, .sog, .glb, "
+        ".gltf); the file appears complete or not at all.");
+}
+
+}  // namespace pybind
+}  // namespace open3d

@@ -1,0 +1,283 @@
+// visualization.rendering: OffscreenRenderer for splat scenes without a display (the splat
+// backends alone, no Filament), RenderConfig knobs as properties, batches of cameras.
+#include <pybind11/eigen.h>
+#include <pybind11/numpy.h>
+#include <pybind11/stl.h>
+
+#include <cstring>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "Bindings.h"
+#include "NumpyTensor.h"
+#include "PyPointCloud.h"
+#include "open3d/core/Exception.h"
+#include "open3d/visualization/rendering/gaussian_splat/GaussianSplatRenderer.h"
+
+namespace py = pybind11;
+
+namespace open3d {
+namespace pybind {
+
+namespace {
+
+using visualization::rendering::GaussianSplatRenderer;
+using visualization::rendering::RenderConfig;
+using visualization::rendering::RenderOutput;
+
+constexpr uint64_t kView = 0;  // the renderer's one view
+
+// The splat scene and its camera, rendered with one backend. Python's OffscreenRenderer and
+// its `scene` share one of these.
+class SplatOffscreen {
+public:
+    SplatOffscreen(int width, int height, const std::string& backend)
+        : width_(width), height_(height) {
+        if (width <= 0 || height <= 0) {
+            core::ThrowError("OffscreenRenderer: size must be positive, got {}x{}", width, height);
+        }
+        if (backend != "vulkan" && backend != "cpu") {
+            core::ThrowError("OffscreenRenderer: backend '{}' (vulkan or cpu)", backend);
+        }
+        renderer_ = std::make_unique<GaussianSplatRenderer>(backend);
+    }
+
+    GaussianSplatRenderer& Splats() { return *renderer_; }
+    RenderConfig& Config() { return config_; }
+    int Width() const { return width_; }
+    int Height() const { return height_; }
+
+    /// The camera at the renderer's size (intrinsics scaled when the camera's differs).
+    void SetCamera(const camera::PinholeCamera& camera) {
+        camera.Validate();
+        camera_ = (camera.width == width_ && camera.height == height_)
+                      ? camera
+                      : camera.Resized(width_, height_);
+        has_camera_ = true;
+    }
+    const camera::PinholeCamera& Camera() const {
+        if (!has_camera_) core::ThrowError("OffscreenRenderer: call setup_camera first");
+        return camera_;
+    }
+
+    RenderOutput Render(bool expected_depth, bool median_depth) {
+        const camera::PinholeCamera camera = Camera();
+        if (!renderer_->HasVisibleSplats()) {
+            core::ThrowError("OffscreenRenderer: the scene has no visible splat cloud");
+        }
+        RenderOutput out;
+        visualization::rendering::CompositeInputs inputs;
+        inputs.expected_depth = expected_depth;
+        inputs.median_depth = median_depth;
+        py::gil_scoped_release release;
+        renderer_->Prepare();
+        renderer_->RenderGeometryStage(kView, camera, config_);
+        renderer_->RenderCompositeStage(kView, out, inputs);
+        return out;
+    }
+
+    std::vector<RenderOutput> RenderBatch(const std::vector<camera::PinholeCamera>& cameras,
+                                          bool uint8) {
+        std::vector<camera::PinholeCamera> sized;
+        for (const camera::PinholeCamera& c : cameras) {
+            c.Validate();
+            sized.push_back(c.width == width_ && c.height == height_ ? c
+                                                                     : c.Resized(width_, height_));
+        }
+        if (!renderer_->HasVisibleSplats()) {
+            core::ThrowError("OffscreenRenderer: the scene has no visible splat cloud");
+        }
+        visualization::rendering::BatchOptions options;
+        options.color_uint8 = uint8;
+        py::gil_scoped_release release;
+        renderer_->Prepare();
+        // The batch replaces the view's sorted entries in the backend.
+        renderer_->ReleaseView(kView);
+        return renderer_->GetBackend().RenderBatch(sized, config_, options);
+    }
+
+private:
+    int width_, height_;
+    std::unique_ptr<GaussianSplatRenderer> renderer_;
+    RenderConfig config_;
+    camera::PinholeCamera camera_;
+    bool has_camera_ = false;
+};
+
+using Offscreen = std::shared_ptr<SplatOffscreen>;
+
+struct SplatScene {
+    Offscreen renderer;
+};
+
+py::array ColorArray(RenderOutput& out, const std::string& dtype) {
+    if (dtype == "float32") return ArrayFromImage(std::move(out.color));
+    return ArrayFromImage(out.color.SelectChannels(0, 3).ToUInt8());
+}
+
+void CheckDtype(const std::string& dtype) {
+    if (dtype != "float32" && dtype != "uint8") {
+        core::ThrowError("dtype '{}': float32 (premultiplied RGBA) or uint8 (RGB)", dtype);
+    }
+}
+
+}  // namespace
+
+void BindRendering(py::module_& m) {
+    py::class_<SplatScene>(m, "SplatScene",
+                           "The geometry of an OffscreenRenderer: Gaussian splat clouds by name")
+        .def(
+            "add_geometry",
+            [](SplatScene& s, const std::string& name, const PyPointCloud& cloud) {
+                s.renderer->Splats().AddCloud(name, cloud.cloud);
+            },
+            py::arg("name"), py::arg("geometry"),
+            "Adds a copy of a splat cloud; raises for a taken name or a cloud without the "
+            "Gaussian attributes")
+        .def(
+            "update_geometry",
+            [](SplatScene& s, const std::string& name, const PyPointCloud& cloud) {
+                s.renderer->Splats().UpdateCloud(name, cloud.cloud);
+            },
+            py::arg("name"), py::arg("geometry"))
+        .def(
+            "remove_geometry",
+            [](SplatScene& s, const std::string& name) {
+                return s.renderer->Splats().RemoveCloud(name);
+            },
+            py::arg("name"))
+        .def(
+            "show_geometry",
+            [](SplatScene& s, const std::string& name, bool show) {
+                s.renderer->Splats().ShowCloud(name, show);
+            },
+            py::arg("name"), py::arg("show"))
+        .def(
+            "has_geometry",
+            [](const SplatScene& s, const std::string& name) {
+                return s.renderer->Splats().HasCloud(name);
+            },
+            py::arg("name"))
+        .def("clear_geometry", [](SplatScene& s) { s.renderer->Splats().Clear(); })
+        .def_property_readonly(
+            "geometry_names",
+            [](const SplatScene& s) { return s.renderer->Splats().GetCloudNames(); })
+        .def(
+            "set_background",
+            [](SplatScene& s, const Eigen::Vector3d& rgb) {
+                s.renderer->Config().background = rgb;
+            },
+            py::arg("rgb"),
+            "Linear RGB where no splat covers the pixel (default black: the colour is then "
+            "premultiplied)");
+
+    py::class_<SplatOffscreen, Offscreen>(
+        m, "OffscreenRenderer",
+        "Renders splat scenes without a display: the Vulkan backend (any Vulkan 1.3 device, "
+        "lavapipe on machines without a GPU) or the double-precision CPU reference. Meshes need "
+        "Filament and an X server; they are not available from Python yet.")
+        .def(py::init<int, int, const std::string&>(), py::arg("width"), py::arg("height"),
+             py::arg("backend") = "vulkan")
+        .def_property_readonly("scene", [](const Offscreen& r) { return SplatScene{r}; })
+        .def_property_readonly("backend",
+                               [](SplatOffscreen& r) { return r.Splats().GetBackendName(); })
+        .def_property_readonly("width", &SplatOffscreen::Width)
+        .def_property_readonly("height", &SplatOffscreen::Height)
+        .def("setup_camera", &SplatOffscreen::SetCamera, py::arg("camera"),
+             "Uses the camera; its intrinsics are scaled to the renderer's size when they differ")
+        .def(
+            "setup_camera",
+            [](SplatOffscreen& r, const Eigen::Matrix3d& K, const Eigen::Matrix4d& extrinsic) {
+                camera::PinholeCamera c;
+                c.width = r.Width();
+                c.height = r.Height();
+                c.fx = K(0, 0);
+                c.fy = K(1, 1);
+                c.cx = K(0, 2);
+                c.cy = K(1, 2);
+                c.world_to_camera = extrinsic;
+                r.SetCamera(c);
+            },
+            py::arg("intrinsic"), py::arg("extrinsic"),
+            "OpenCV intrinsics (for this renderer's size) and a world-to-camera extrinsic")
+        .def(
+            "setup_camera",
+            [](SplatOffscreen& r, double vertical_fov_deg, const Eigen::Vector3d& center,
+               const Eigen::Vector3d& eye, const Eigen::Vector3d& up) {
+                camera::LookAtCamera look;
+                look.eye = eye;
+                look.center = center;
+                look.up = up;
+                look.vertical_fov_deg = vertical_fov_deg;
+                r.SetCamera(camera::PinholeCamera::FromLookAt(look, r.Width(), r.Height()));
+            },
+            py::arg("vertical_field_of_view"), py::arg("center"), py::arg("eye"), py::arg("up"))
+        .def_property_readonly("camera", &SplatOffscreen::Camera)
+        .def_property(
+            "sh_degree", [](SplatOffscreen& r) { return r.Config().sh_degree; },
+            [](SplatOffscreen& r, int v) { r.Config().sh_degree = v; }, "SH degree cap, 0..3")
+        .def_property(
+            "antialias", [](SplatOffscreen& r) { return r.Config().antialias; },
+            [](SplatOffscreen& r, bool v) { r.Config().antialias = v; })
+        .def_property(
+            "near_plane", [](SplatOffscreen& r) { return r.Config().near_plane; },
+            [](SplatOffscreen& r, double v) { r.Config().near_plane = v; })
+        .def_property(
+            "compact_storage", [](SplatOffscreen& r) { return r.Config().compact_storage; },
+            [](SplatOffscreen& r, bool v) { r.Config().compact_storage = v; },
+            "Vulkan: half-precision splat storage (about half the memory, not exact)")
+        .def(
+            "render_to_image",
+            [](SplatOffscreen& r, const std::string& dtype) {
+                CheckDtype(dtype);
+                RenderOutput out = r.Render(false, false);
+                return ColorArray(out, dtype);
+            },
+            py::arg("dtype") = "float32",
+            "float32: (H, W, 4) RGBA, premultiplied over a black background; uint8: (H, W, 3) "
+            "RGB rounded to nearest")
+        .def(
+            "render_to_depth_image",
+            [](SplatOffscreen& r, const std::string& kind) {
+                if (kind != "expected" && kind != "median") {
+                    core::ThrowError("render_to_depth_image: kind '{}' (expected or median)", kind);
+                }
+                RenderOutput out = r.Render(kind == "expected", kind == "median");
+                return ArrayFromImage(
+                    std::move(kind == "expected" ? out.depth_expected : out.depth_median), true);
+            },
+            py::arg("kind") = "expected",
+            "(H, W) float32 view-space z: the alpha-weighted mean (expected) or where the "
+            "accumulated alpha reaches one half (median); 0 where no splat is")
+        .def(
+            "render_batch",
+            [](SplatOffscreen& r, const std::vector<camera::PinholeCamera>& cameras,
+               const std::string& dtype) {
+                CheckDtype(dtype);
+                if (cameras.empty()) core::ThrowError("render_batch: no cameras");
+                std::vector<RenderOutput> outs = r.RenderBatch(cameras, dtype == "uint8");
+                const py::ssize_t n = static_cast<py::ssize_t>(outs.size());
+                const py::ssize_t h = r.Height(), w = r.Width();
+                if (dtype == "uint8") {
+                    py::array_t<uint8_t> images({n, h, w, py::ssize_t(4)});
+                    for (py::ssize_t i = 0; i < n; ++i) {
+                        std::memcpy(images.mutable_data(i), outs[i].color.Data<uint8_t>(),
+                                    size_t(h * w * 4));
+                    }
+                    return py::array(images);
+                }
+                py::array_t<float> images({n, h, w, py::ssize_t(4)});
+                for (py::ssize_t i = 0; i < n; ++i) {
+                    std::memcpy(images.mutable_data(i), outs[i].color.Data<float>(),
+                                size_t(h * w * 4) * sizeof(float));
+                }
+                return py::array(images);
+            },
+            py::arg("cameras"), py::arg("dtype") = "float32",
+            "(N, H, W, 4) for N cameras in one call: float32 premultiplied RGBA, or uint8 RGBA "
+            "(the device's rounding); each equals render_to_image of that camera");
+}
+
+}  // namespace pybind
+}  // namespace open3d

@@ -1,0 +1,60 @@
+// visualization.draw: the interactive viewer of the C++ library (needs an X server).
+#include <pybind11/stl.h>
+
+#include <fmt/format.h>
+
+#include <string>
+#include <vector>
+
+#include "Bindings.h"
+#include "PyPointCloud.h"
+#include "open3d/core/Exception.h"
+#include "open3d/visualization/visualizer/Visualizer.h"
+
+namespace py = pybind11;
+
+namespace open3d {
+namespace pybind {
+
+void BindVisualization(py::module_& m) {
+    m.def(
+        "draw",
+        [](const py::list& geometries, const std::string& title, int width, int height,
+           double max_seconds) {
+            std::vector<visualization::DrawObject> objects;
+            int index = 0;
+            for (const py::handle& item : geometries) {
+                visualization::DrawObject object;
+                if (py::isinstance<PyPointCloud>(item)) {
+                    object.name = fmt::format("cloud_{}", index);
+                    object.geometry = item.cast<const PyPointCloud&>().cloud;
+                } else if (py::isinstance<py::tuple>(item) && py::len(item) == 2) {
+                    const py::tuple pair = item.cast<py::tuple>();
+                    object.name = pair[0].cast<std::string>();
+                    object.geometry = pair[1].cast<const PyPointCloud&>().cloud;
+                } else {
+                    core::ThrowError(
+                        "draw: item {} is neither a PointCloud nor a (name, PointCloud) pair",
+                        index);
+                }
+                objects.push_back(std::move(object));
+                ++index;
+            }
+            visualization::VisualizerOptions options;
+            options.title = title;
+            options.width = width;
+            options.height = height;
+            visualization::RunOptions run;
+            run.max_seconds = max_seconds;
+            py::gil_scoped_release release;
+            visualization::Draw(objects, options, run);
+        },
+        py::arg("geometries"), py::arg("title") = "Open3D", py::arg("width") = 1280,
+        py::arg("height") = 720, py::arg("max_seconds") = 0.0,
+        "Opens the viewer with the clouds (PointCloud or (name, PointCloud) items) and runs "
+        "until the window closes (or max_seconds pass). Needs an X server: without one the "
+        "error says to run under xvfb-run.");
+}
+
+}  // namespace pybind
+}  // namespace open3d
