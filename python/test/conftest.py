@@ -1,0 +1,47 @@
+"""Shared fixtures of the open3d_gs tests: where the shared scenes and gs-render are, and the
+project's rule for tests that cannot run here (skip locally, fail in CI: CI=true)."""
+import os
+import pathlib
+
+import pytest
+
+import open3d_gs as o3d
+
+DATA = pathlib.Path(os.environ.get("OPEN3D_DATA_DIR", pathlib.Path(__file__).parents[3] / "shared" / "data"))
+
+
+def unavailable(reason):
+    """Skips the test, or fails it in CI, where a skip would hide a failure."""
+    if os.environ.get("CI") == "true":
+        pytest.fail("CI=true, so this test may not skip: " + reason)
+    pytest.skip(reason)
+
+
+@pytest.fixture
+def data():
+    def path(relative):
+        p = DATA / relative
+        if not p.exists():
+            unavailable(f"shared scene {p} is absent")
+        return p
+
+    return path
+
+
+@pytest.fixture
+def gs_render():
+    exe = os.environ.get("GS_RENDER", "")
+    if not exe or not os.path.exists(exe):
+        unavailable("GS_RENDER does not name the gs-render binary (ctest sets it)")
+    return exe
+
+
+@pytest.fixture(params=["vulkan", "cpu"])
+def backend(request):
+    """Both backends; the Vulkan one needs a device (lavapipe without a GPU)."""
+    if request.param == "vulkan":
+        try:
+            o3d.visualization.rendering.OffscreenRenderer(1, 1, "vulkan")
+        except o3d.Open3DError as e:
+            unavailable(f"no Vulkan device: {e}")
+    return request.param
