@@ -1,0 +1,64 @@
+#!/usr/bin/env python3
+"""Renders every view of a 3DGS cameras.json to PNGs without a display, in batches.
+
+    PYTHONPATH=build/python python3 examples/python/render_views.py \
+        ../shared/data/playbot/playbot_125k.ply ../shared/data/playbot/cameras.json out/
+"""
+import argparse
+import pathlib
+import sys
+import time
+import zlib
+import struct
+
+import numpy as np
+
+import open3d_gs as o3d
+
+
+def write_png(path, rgb):
+    """An 8-bit RGB PNG with the standard library alone (no imaging package needed)."""
+    h, w, _ = rgb.shape
+    raw = b"".join(b"\x00" + rgb[y].tobytes() for y in range(h))
+
+    def chunk(kind, body):
+        return struct.pack(">I", len(body)) + kind + body + struct.pack(">I", zlib.crc32(kind + body))
+
+    path.write_bytes(b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", w, h, 8, 2, 0, 0, 0))
+                     + chunk(b"IDAT", zlib.compress(raw, 6)) + chunk(b"IEND", b""))
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("scene", help="splat file in any format the library reads")
+    parser.add_argument("cameras", help="3DGS cameras.json")
+    parser.add_argument("output", help="folder for view_NNN.png (made when missing)")
+    parser.add_argument("--backend", default="vulkan", choices=["vulkan", "cpu"])
+    parser.add_argument("--width", type=int, help="image width (default: the first view's)")
+    parser.add_argument("--height", type=int, help="image height (default: the first view's)")
+    parser.add_argument("--batch", type=int, default=16, help="views per render_batch call")
+    args = parser.parse_args()
+
+    views = o3d.camera.read_cameras_json(args.cameras)
+    width = args.width or views[0].camera.width
+    height = args.height or views[0].camera.height
+    out = pathlib.Path(args.output)
+    out.mkdir(parents=True, exist_ok=True)
+    renderer = o3d.visualization.rendering.OffscreenRenderer(width, height, args.backend)
+    renderer.scene.add_geometry("scene", o3d.t.io.read_point_cloud(args.scene))
+    start = time.monotonic()
+    for first in range(0, len(views), args.batch):
+        chunk = views[first:first + args.batch]
+        images = renderer.render_batch([v.camera for v in chunk], "uint8")
+        for i, image in enumerate(images):
+            write_png(out / f"view_{first + i:03d}.png", np.ascontiguousarray(image[..., :3]))
+        done = first + len(chunk)
+        bar = "#" * (30 * done // len(views))
+        print(f"\r[{bar:<30}] {done}/{len(views)} views", end="", file=sys.stderr, flush=True)
+    seconds = time.monotonic() - start
+    print(f"\n{len(views)} views of {width}x{height} in {seconds:.2f} s ({len(views) / seconds:.1f} views/s, "
+          f"{renderer.backend} backend) into {out}", file=sys.stderr)
+
+
+if __name__ == "__main__":
+    main()
