@@ -4,8 +4,10 @@
 #include <pybind11/numpy.h>
 #include <pybind11/stl.h>
 
+#include <algorithm>
 #include <cstring>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -77,8 +79,9 @@ public:
         return out;
     }
 
-    std::vector<RenderOutput> RenderBatch(const std::vector<camera::PinholeCamera>& cameras,
-                                          bool uint8) {
+    /// Renders into `destination` (N x H x W x 4 elements of float32, or uint8 with `uint8`).
+    void RenderBatch(const std::vector<camera::PinholeCamera>& cameras, bool uint8,
+                     uint8_t* destination) {
         std::vector<camera::PinholeCamera> sized;
         for (const camera::PinholeCamera& c : cameras) {
             c.Validate();
@@ -90,11 +93,12 @@ public:
         }
         visualization::rendering::BatchOptions options;
         options.color_uint8 = uint8;
+        options.color_destination = destination;
         py::gil_scoped_release release;
         renderer_->Prepare();
         // The batch replaces the view's sorted entries in the backend.
         renderer_->ReleaseView(kView);
-        return renderer_->GetBackend().RenderBatch(sized, config_, options);
+        renderer_->GetBackend().RenderBatch(sized, config_, options);
     }
 
 private:
@@ -253,30 +257,42 @@ void BindRendering(py::module_& m) {
         .def(
             "render_batch",
             [](SplatOffscreen& r, const std::vector<camera::PinholeCamera>& cameras,
-               const std::string& dtype) {
+               const std::string& dtype, std::optional<py::array> out) {
                 CheckDtype(dtype);
                 if (cameras.empty()) core::ThrowError("render_batch: no cameras");
-                std::vector<RenderOutput> outs = r.RenderBatch(cameras, dtype == "uint8");
-                const py::ssize_t n = static_cast<py::ssize_t>(outs.size());
-                const py::ssize_t h = r.Height(), w = r.Width();
-                if (dtype == "uint8") {
-                    py::array_t<uint8_t> images({n, h, w, py::ssize_t(4)});
-                    for (py::ssize_t i = 0; i < n; ++i) {
-                        std::memcpy(images.mutable_data(i), outs[i].color.Data<uint8_t>(),
-                                    size_t(h * w * 4));
+                const bool uint8 = dtype == "uint8";
+                const std::vector<py::ssize_t> shape = {py::ssize_t(cameras.size()), r.Height(),
+                                                        r.Width(), 4};
+                py::array images;
+                if (out) {
+                    // The caller's array, reused across calls: no fresh pages to fault in
+                    // (a new 64-view float32 array at 800x800 is 655 MB).
+                    const bool dtype_ok = uint8 ? py::isinstance<py::array_t<uint8_t>>(*out)
+                                                : py::isinstance<py::array_t<float>>(*out);
+                    const bool shape_ok =
+                        out->ndim() == 4 && std::equal(shape.begin(), shape.end(), out->shape());
+                    if (!dtype_ok || !shape_ok || !(out->flags() & py::array::c_style) ||
+                        !out->writeable()) {
+                        core::ThrowError(
+                            "render_batch: out must be a writeable C-contiguous {} array of "
+                            "shape ({}, {}, {}, 4)",
+                            dtype, shape[0], shape[1], shape[2]);
                     }
-                    return py::array(images);
+                    images = *out;
+                } else if (uint8) {
+                    images = py::array_t<uint8_t>(shape);
+                } else {
+                    images = py::array_t<float>(shape);
                 }
-                py::array_t<float> images({n, h, w, py::ssize_t(4)});
-                for (py::ssize_t i = 0; i < n; ++i) {
-                    std::memcpy(images.mutable_data(i), outs[i].color.Data<float>(),
-                                size_t(h * w * 4) * sizeof(float));
-                }
-                return py::array(images);
+                // Rendered straight into the array: one copy from the device's readback buffer.
+                r.RenderBatch(cameras, uint8, static_cast<uint8_t*>(images.mutable_data()));
+                return images;
             },
-            py::arg("cameras"), py::arg("dtype") = "float32",
+            py::arg("cameras"), py::arg("dtype") = "float32", py::arg("out") = py::none(),
             "(N, H, W, 4) for N cameras in one call: float32 premultiplied RGBA, or uint8 RGBA "
-            "(the device's rounding); each equals render_to_image of that camera");
+            "(the device's rounding); each equals render_to_image of that camera. `out`: an "
+            "array of that shape and dtype to render into (reused across calls, it saves "
+            "allocating and faulting in fresh memory each time)");
 }
 
 }  // namespace pybind

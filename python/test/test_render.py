@@ -57,6 +57,14 @@ def test_batch_equals_single_renders(data, backend):
     for i, v in enumerate(views):
         r.setup_camera(v.camera)
         np.testing.assert_array_equal(batch[i], r.render_to_image(), err_msg=f"view {i}")
+    # Into an array of the caller's, reused: the same images, the same object back.
+    out = np.full_like(batch, -1.0)
+    assert r.render_batch([v.camera for v in views], out=out) is out
+    np.testing.assert_array_equal(out, batch)
+    with pytest.raises(o3d.Open3DError, match=r"out must be a writeable C-contiguous float32 array of shape \(3, 96, 96, 4\)"):
+        r.render_batch([v.camera for v in views], out=np.zeros((3, 96, 96, 3), np.float32))
+    with pytest.raises(o3d.Open3DError, match="out must be"):
+        r.render_batch([v.camera for v in views], "uint8", out=out)
     # 8-bit batches: the device's (or the CPU's) rounding of the same floats.
     batch8 = r.render_batch([v.camera for v in views], "uint8")
     assert batch8.dtype == np.uint8

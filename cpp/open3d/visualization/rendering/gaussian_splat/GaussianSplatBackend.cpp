@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <map>
 #include <mutex>
 
@@ -74,6 +75,16 @@ std::vector<RenderOutput> GaussianSplatBackend::RenderBatch(
     outputs.reserve(cameras.size());
     for (const camera::PinholeCamera& camera : cameras) {
         outputs.push_back(Render(camera, config, inputs));
+        if (options.color_destination != nullptr && options.read_back) {
+            RenderOutput& out = outputs.back();
+            const t::geometry::Image color =
+                options.color_uint8 ? ColorToUInt8(out.color) : std::move(out.color);
+            const size_t bytes = static_cast<size_t>(color.AsTensor().NumBytes());
+            std::memcpy(options.color_destination + (outputs.size() - 1) * bytes,
+                        color.AsTensor().RawData(), bytes);
+            out.color = t::geometry::Image();
+            continue;
+        }
         if (options.read_back && options.color_uint8) {
             outputs.back().color = ColorToUInt8(outputs.back().color);
         }

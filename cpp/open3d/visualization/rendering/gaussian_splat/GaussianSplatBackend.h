@@ -60,6 +60,11 @@ struct BatchOptions {
     bool color_uint8 = false;
     bool expected_depth = false;
     bool median_depth = false;
+    /// With read_back: the colours go here instead of RenderOutput::color (left empty), view
+    /// i at color_destination + i * H * W * 4 * (4 bytes, or 1 with color_uint8), in the
+    /// caller's memory (a numpy array from Python): no image per view is allocated and the
+    /// colour is copied once, straight from the readback buffer.
+    uint8_t* color_destination = nullptr;
 };
 
 class GaussianSplatBackend {

@@ -9,9 +9,11 @@
 
 #include <algorithm>
 #include <cstdlib>
+#include <cstring>
 
 #include "open3d/core/Exception.h"
 #include "open3d/visualization/rendering/gaussian_splat/DefaultScene.h"
+#include "open3d/visualization/rendering/gaussian_splat/cpu/CpuBackend.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/GaussianSplatVulkanBackend.h"
 #include "visualization/rendering/gaussian_splat/vulkan/VulkanTestFixture.h"
 
@@ -164,6 +166,40 @@ TEST_F(SubmissionPath, EightBitColourIsTheFloatResultRounded) {
         EXPECT_GT(nonzero, 1000);  // not a blank image
         const std::vector<RenderOutput> one = backend->RenderBatch({views[i]}, {}, eight_bit);
         EXPECT_TRUE(one[0].color.AsTensor() == batch[i].color.AsTensor());
+    }
+}
+
+// Colours rendered into the caller's memory (BatchOptions::color_destination, Python's
+// render_batch) equal the images of an ordinary batch, across submissions (3 + 3 + 1 views)
+// and for both colour formats; on the CPU backend too. Outputs then carry no colour image.
+TEST_F(SubmissionPath, ColoursIntoTheCallersMemoryEqualTheImages) {
+    auto vulkan = MakeBackend();
+    cpu::CpuBackend reference;
+    const t::geometry::PointCloud scene = CreateDefaultGaussianSplatScene();
+    vulkan->SetScene(scene);
+    reference.SetScene(scene);
+    const auto views = SlidingViews(7, 48, 32);
+    vulkan->SetBatchBudget(3 * 48 * 32 * 16);
+    for (GaussianSplatBackend* backend : {static_cast<GaussianSplatBackend*>(vulkan.get()),
+                                          static_cast<GaussianSplatBackend*>(&reference)}) {
+        for (const bool uint8 : {false, true}) {
+            SCOPED_TRACE(backend->GetName() + (uint8 ? " uint8" : " float32"));
+            BatchOptions options;
+            options.color_uint8 = uint8;
+            const std::vector<RenderOutput> images = backend->RenderBatch(views, {}, options);
+            const size_t view_bytes = 48 * 32 * 4 * (uint8 ? 1 : 4);
+            std::vector<uint8_t> memory(views.size() * view_bytes, 0xAB);
+            options.color_destination = memory.data();
+            const std::vector<RenderOutput> into = backend->RenderBatch(views, {}, options);
+            for (size_t i = 0; i < views.size(); ++i) {
+                SCOPED_TRACE("view " + std::to_string(i));
+                EXPECT_TRUE(into[i].color.IsEmpty());
+                EXPECT_EQ(std::memcmp(memory.data() + i * view_bytes,
+                                      images[i].color.AsTensor().RawData(), view_bytes),
+                          0);
+                EXPECT_EQ(into[i].stats.num_tile_entries, images[i].stats.num_tile_entries);
+            }
+        }
     }
 }
 

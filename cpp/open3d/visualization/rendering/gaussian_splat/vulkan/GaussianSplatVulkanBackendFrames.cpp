@@ -518,9 +518,17 @@ std::vector<RenderOutput> GaussianSplatVulkanBackend::WaitBatch(uint64_t ticket)
         std::vector<CopyJob> jobs;
         for (size_t i = 0; i < views; ++i) {
             RenderOutput& out = outputs[i];
-            out.color = ImageFrom(
-                slot.host_color, i * color_bytes, h, w, 4,
-                slot.options.color_uint8 ? core::Dtype::UInt8 : core::Dtype::Float32, jobs);
+            if (slot.options.color_destination != nullptr) {
+                // The caller's memory; this submission's first view is already there.
+                jobs.push_back(
+                    {slot.options.color_destination + i * color_bytes,
+                     static_cast<const uint8_t*>(slot.host_color.GetMapped()) + i * color_bytes,
+                     static_cast<int64_t>(color_bytes)});
+            } else {
+                out.color = ImageFrom(
+                    slot.host_color, i * color_bytes, h, w, 4,
+                    slot.options.color_uint8 ? core::Dtype::UInt8 : core::Dtype::Float32, jobs);
+            }
             if (slot.host_depth) {
                 out.depth_expected =
                     ImageFrom(slot.host_depth, i * pixels * 4, h, w, 1, core::Dtype::Float32, jobs);
@@ -601,9 +609,14 @@ std::vector<RenderOutput> GaussianSplatVulkanBackend::RenderBatch(
     while (collected < cameras.size()) {
         while (next < cameras.size() && tickets.size() < slots_.size()) {
             const size_t end = std::min(cameras.size(), next + chunk);
+            BatchOptions part = options;  // the destination of this submission's first view
+            if (part.color_destination != nullptr) {
+                part.color_destination += next * uint64_t(cameras[0].width) * cameras[0].height *
+                                          ColorBytesPerPixel(options);
+            }
             tickets.push_back(SubmitBatch(
                 std::vector<camera::PinholeCamera>(cameras.begin() + next, cameras.begin() + end),
-                config, options));
+                config, part));
             next = end;
         }
         std::vector<RenderOutput> part = WaitBatch(tickets.front());
