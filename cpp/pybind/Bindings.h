@@ -9,6 +9,8 @@ namespace open3d {
 namespace pybind {
 
 void BindGeometry(pybind11::module_& t_geometry);
+void BindMesh(pybind11::module_& t_geometry);
+void BindMaterial(pybind11::module_& rendering);
 void BindIo(pybind11::module_& t_io);
 void BindCamera(pybind11::module_& camera);
 void BindRendering(pybind11::module_& rendering);

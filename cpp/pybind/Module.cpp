@@ -22,6 +22,8 @@ PYBIND11_MODULE(_core, m) {
     py::module_ rendering =
         visualization.def_submodule("rendering", "OffscreenRenderer without a display");
     open3d::pybind::BindGeometry(t_geometry);
+    open3d::pybind::BindMesh(t_geometry);
+    open3d::pybind::BindMaterial(rendering);
     open3d::pybind::BindIo(t_io);
     open3d::pybind::BindCamera(camera);
     open3d::pybind::BindRendering(rendering);

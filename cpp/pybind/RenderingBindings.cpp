@@ -15,6 +15,9 @@
 #include "NumpyTensor.h"
 #include "PyPointCloud.h"
 #include "open3d/core/Exception.h"
+#include "open3d/t/geometry/TriangleMesh.h"
+#include "open3d/visualization/rendering/filament/MaterialRecord.h"
+#include "open3d/visualization/rendering/filament/OffscreenRenderer.h"
 #include "open3d/visualization/rendering/gaussian_splat/GaussianSplatRenderer.h"
 
 namespace py = pybind11;
@@ -25,16 +28,19 @@ namespace pybind {
 namespace {
 
 using visualization::rendering::GaussianSplatRenderer;
+using visualization::rendering::MaterialRecord;
 using visualization::rendering::RenderConfig;
 using visualization::rendering::RenderOutput;
 
 constexpr uint64_t kView = 0;  // the renderer's one view
 
-// The splat scene and its camera, rendered with one backend. Python's OffscreenRenderer and
+// The scene, its camera and its settings. Without meshes: the splat backend alone
+// (GaussianSplatRenderer, no display needed). With `meshes`: the Filament OffscreenRenderer
+// (meshes and splats composited by depth; needs an X server). Python's OffscreenRenderer and
 // its `scene` share one of these.
 class SplatOffscreen {
 public:
-    SplatOffscreen(int width, int height, const std::string& backend)
+    SplatOffscreen(int width, int height, const std::string& backend, bool meshes)
         : width_(width), height_(height) {
         if (width <= 0 || height <= 0) {
             core::ThrowError("OffscreenRenderer: size must be positive, got {}x{}", width, height);
@@ -42,13 +48,100 @@ public:
         if (backend != "vulkan" && backend != "cpu") {
             core::ThrowError("OffscreenRenderer: backend '{}' (vulkan or cpu)", backend);
         }
-        renderer_ = std::make_unique<GaussianSplatRenderer>(backend);
+        if (!meshes) {
+            renderer_ = std::make_unique<GaussianSplatRenderer>(backend);
+            return;
+        }
+        visualization::rendering::Open3DSceneOptions options;
+        options.backend = backend;
+        try {
+            filament_ = std::make_unique<visualization::rendering::OffscreenRenderer>(width, height,
+                                                                                      options);
+        } catch (const core::Open3DError& e) {
+            core::ThrowError(
+                "OffscreenRenderer(meshes=True) draws with Filament, which needs an X server "
+                "(splats alone need none: leave meshes off): {}",
+                e.what());
+        }
     }
 
-    GaussianSplatRenderer& Splats() { return *renderer_; }
+    bool HasMeshes() const { return filament_ != nullptr; }
     RenderConfig& Config() { return config_; }
     int Width() const { return width_; }
     int Height() const { return height_; }
+    std::string BackendName() const {
+        return filament_ ? filament_->GetScene()->GetScene().GetBackend().GetName()
+                         : renderer_->GetBackendName();
+    }
+    const std::vector<std::string>& Names() const { return names_; }
+
+    void AddCloud(const std::string& name, const t::geometry::PointCloud& cloud,
+                  const std::optional<MaterialRecord>& material) {
+        if (filament_) {
+            if (material) {
+                filament_->GetScene()->AddGeometry(name, cloud, *material);
+            } else {
+                filament_->GetScene()->AddGeometry(name, cloud);
+            }
+        } else {
+            if (material && material->shader != visualization::rendering::kShaderGaussianSplat) {
+                core::ThrowError(
+                    "OffscreenRenderer: '{}' with shader '{}': without meshes=True only Gaussian "
+                    "splat clouds are drawn",
+                    name, material->shader);
+            }
+            renderer_->AddCloud(name, cloud);
+        }
+        names_.push_back(name);
+    }
+    void AddMesh(const std::string& name, const t::geometry::TriangleMesh& mesh,
+                 const MaterialRecord& material) {
+        if (!filament_) {
+            core::ThrowError(
+                "OffscreenRenderer: mesh '{}': meshes are drawn by Filament; create the renderer "
+                "with meshes=True (needs an X server)",
+                name);
+        }
+        filament_->GetScene()->AddGeometry(name, mesh, material);
+        names_.push_back(name);
+    }
+    void UpdateCloud(const std::string& name, const t::geometry::PointCloud& cloud) {
+        if (filament_) {
+            filament_->GetScene()->UpdateGeometry(name, cloud);
+        } else {
+            renderer_->UpdateCloud(name, cloud);
+        }
+    }
+    bool Remove(const std::string& name) {
+        const bool removed =
+            filament_ ? filament_->GetScene()->RemoveGeometry(name) : renderer_->RemoveCloud(name);
+        std::erase(names_, name);
+        return removed;
+    }
+    void Show(const std::string& name, bool show) {
+        if (filament_) {
+            filament_->GetScene()->ShowGeometry(name, show);
+        } else {
+            renderer_->ShowCloud(name, show);
+        }
+    }
+    bool Has(const std::string& name) const {
+        return filament_ ? filament_->GetScene()->HasGeometry(name) : renderer_->HasCloud(name);
+    }
+    void Clear() {
+        if (filament_) {
+            filament_->GetScene()->ClearGeometry();
+        } else {
+            renderer_->Clear();
+        }
+        names_.clear();
+    }
+    void SetBackground(const Eigen::Vector3d& rgb) {
+        config_.background = rgb;
+        if (filament_) {
+            filament_->GetScene()->SetBackground(rgb.cast<float>().homogeneous());
+        }
+    }
 
     /// The camera at the renderer's size (intrinsics scaled when the camera's differs).
     void SetCamera(const camera::PinholeCamera& camera) {
@@ -79,9 +172,26 @@ public:
         return out;
     }
 
+    /// Filament's frame: UInt8 [H, W, 3], or the view z Float32 [H, W, 1] with `depth`.
+    t::geometry::Image RenderWithMeshes(bool depth) {
+        const camera::PinholeCamera camera = Camera();
+        // The knobs go to the scene's splat settings (background stays the view's).
+        RenderConfig& splat = filament_->GetScene()->GetSplatConfig();
+        splat.sh_degree = config_.sh_degree;
+        splat.antialias = config_.antialias;
+        splat.near_plane = config_.near_plane;
+        splat.compact_storage = config_.compact_storage;
+        filament_->SetupCamera(camera);
+        py::gil_scoped_release release;
+        return depth ? filament_->RenderToDepthImage(true) : filament_->RenderToImage();
+    }
+
     /// Renders into `destination` (N x H x W x 4 elements of float32, or uint8 with `uint8`).
     void RenderBatch(const std::vector<camera::PinholeCamera>& cameras, bool uint8,
                      uint8_t* destination) {
+        if (filament_) {
+            core::ThrowError("render_batch: batches are for splat-only renderers (meshes=False)");
+        }
         std::vector<camera::PinholeCamera> sized;
         for (const camera::PinholeCamera& c : cameras) {
             c.Validate();
@@ -104,6 +214,8 @@ public:
 private:
     int width_, height_;
     std::unique_ptr<GaussianSplatRenderer> renderer_;
+    std::unique_ptr<visualization::rendering::OffscreenRenderer> filament_;
+    std::vector<std::string> names_;
     RenderConfig config_;
     camera::PinholeCamera camera_;
     bool has_camera_ = false;
@@ -129,63 +241,65 @@ void CheckDtype(const std::string& dtype) {
 }  // namespace
 
 void BindRendering(py::module_& m) {
-    py::class_<SplatScene>(m, "SplatScene",
-                           "The geometry of an OffscreenRenderer: Gaussian splat clouds by name")
+    py::class_<SplatScene>(m, "Scene",
+                           "The geometry of an OffscreenRenderer, by name: Gaussian splat "
+                           "clouds, and with meshes=True meshes and point clouds too")
         .def(
             "add_geometry",
-            [](SplatScene& s, const std::string& name, const PyPointCloud& cloud) {
-                s.renderer->Splats().AddCloud(name, cloud.cloud);
+            [](SplatScene& s, const std::string& name, const PyPointCloud& cloud,
+               const std::optional<MaterialRecord>& material) {
+                s.renderer->AddCloud(name, cloud.cloud, material);
             },
-            py::arg("name"), py::arg("geometry"),
-            "Adds a copy of a splat cloud; raises for a taken name or a cloud without the "
-            "Gaussian attributes")
+            py::arg("name"), py::arg("geometry"), py::arg("material") = py::none(),
+            "Adds a copy of a cloud (a Gaussian splat cloud unless the material says otherwise); "
+            "raises for a taken name or a cloud without the Gaussian attributes")
+        .def(
+            "add_geometry",
+            [](SplatScene& s, const std::string& name, const t::geometry::TriangleMesh& mesh,
+               const std::optional<MaterialRecord>& material) {
+                s.renderer->AddMesh(name, mesh, material.value_or(MaterialRecord{}));
+            },
+            py::arg("name"), py::arg("geometry"), py::arg("material") = py::none(),
+            "Adds a copy of a mesh (renderers made with meshes=True)")
         .def(
             "update_geometry",
             [](SplatScene& s, const std::string& name, const PyPointCloud& cloud) {
-                s.renderer->Splats().UpdateCloud(name, cloud.cloud);
+                s.renderer->UpdateCloud(name, cloud.cloud);
             },
             py::arg("name"), py::arg("geometry"))
         .def(
             "remove_geometry",
-            [](SplatScene& s, const std::string& name) {
-                return s.renderer->Splats().RemoveCloud(name);
-            },
+            [](SplatScene& s, const std::string& name) { return s.renderer->Remove(name); },
             py::arg("name"))
         .def(
             "show_geometry",
-            [](SplatScene& s, const std::string& name, bool show) {
-                s.renderer->Splats().ShowCloud(name, show);
-            },
+            [](SplatScene& s, const std::string& name, bool show) { s.renderer->Show(name, show); },
             py::arg("name"), py::arg("show"))
         .def(
             "has_geometry",
-            [](const SplatScene& s, const std::string& name) {
-                return s.renderer->Splats().HasCloud(name);
-            },
+            [](const SplatScene& s, const std::string& name) { return s.renderer->Has(name); },
             py::arg("name"))
-        .def("clear_geometry", [](SplatScene& s) { s.renderer->Splats().Clear(); })
-        .def_property_readonly(
-            "geometry_names",
-            [](const SplatScene& s) { return s.renderer->Splats().GetCloudNames(); })
+        .def("clear_geometry", [](SplatScene& s) { s.renderer->Clear(); })
+        .def_property_readonly("geometry_names",
+                               [](const SplatScene& s) { return s.renderer->Names(); })
         .def(
             "set_background",
-            [](SplatScene& s, const Eigen::Vector3d& rgb) {
-                s.renderer->Config().background = rgb;
-            },
+            [](SplatScene& s, const Eigen::Vector3d& rgb) { s.renderer->SetBackground(rgb); },
             py::arg("rgb"),
-            "Linear RGB where no splat covers the pixel (default black: the colour is then "
+            "Linear RGB where nothing is drawn (default black: splat colours are then "
             "premultiplied)");
 
     py::class_<SplatOffscreen, Offscreen>(
         m, "OffscreenRenderer",
-        "Renders splat scenes without a display: the Vulkan backend (any Vulkan 1.3 device, "
-        "lavapipe on machines without a GPU) or the double-precision CPU reference. Meshes need "
-        "Filament and an X server; they are not available from Python yet.")
-        .def(py::init<int, int, const std::string&>(), py::arg("width"), py::arg("height"),
-             py::arg("backend") = "vulkan")
+        "Renders scenes to numpy arrays. Default: splat clouds only, drawn by the splat backend "
+        "alone without a display: 'vulkan' (any Vulkan 1.3 device, lavapipe without a GPU) or "
+        "'cpu' (the double-precision reference). meshes=True: Filament draws meshes and points "
+        "and composites the splats by depth (needs an X server; 8-bit colour).")
+        .def(py::init<int, int, const std::string&, bool>(), py::arg("width"), py::arg("height"),
+             py::arg("backend") = "vulkan", py::arg("meshes") = false)
         .def_property_readonly("scene", [](const Offscreen& r) { return SplatScene{r}; })
-        .def_property_readonly("backend",
-                               [](SplatOffscreen& r) { return r.Splats().GetBackendName(); })
+        .def_property_readonly("backend", &SplatOffscreen::BackendName)
+        .def_property_readonly("meshes", &SplatOffscreen::HasMeshes)
         .def_property_readonly("width", &SplatOffscreen::Width)
         .def_property_readonly("height", &SplatOffscreen::Height)
         .def("setup_camera", &SplatOffscreen::SetCamera, py::arg("camera"),
@@ -233,19 +347,33 @@ void BindRendering(py::module_& m) {
             "Vulkan: half-precision splat storage (about half the memory, not exact)")
         .def(
             "render_to_image",
-            [](SplatOffscreen& r, const std::string& dtype) {
+            [](SplatOffscreen& r, const std::optional<std::string>& requested) {
+                const std::string dtype = requested.value_or(r.HasMeshes() ? "uint8" : "float32");
                 CheckDtype(dtype);
+                if (r.HasMeshes()) {
+                    if (dtype != "uint8") {
+                        core::ThrowError(
+                            "render_to_image: with meshes=True the picture is 8-bit (Filament's "
+                            "colour target): dtype 'uint8'");
+                    }
+                    return ArrayFromImage(r.RenderWithMeshes(false));
+                }
                 RenderOutput out = r.Render(false, false);
                 return ColorArray(out, dtype);
             },
-            py::arg("dtype") = "float32",
-            "float32: (H, W, 4) RGBA, premultiplied over a black background; uint8: (H, W, 3) "
-            "RGB rounded to nearest")
+            py::arg("dtype") = py::none(),
+            "float32 (the default without meshes): (H, W, 4) RGBA, premultiplied over a black "
+            "background; uint8 (the default and only choice with meshes): (H, W, 3) RGB rounded "
+            "to nearest")
         .def(
             "render_to_depth_image",
             [](SplatOffscreen& r, const std::string& kind) {
                 if (kind != "expected" && kind != "median") {
                     core::ThrowError("render_to_depth_image: kind '{}' (expected or median)", kind);
+                }
+                if (r.HasMeshes()) {
+                    // The nearer of the meshes' z and the splats' expected z (Filament's merge).
+                    return ArrayFromImage(r.RenderWithMeshes(true), true);
                 }
                 RenderOutput out = r.Render(kind == "expected", kind == "median");
                 return ArrayFromImage(
@@ -253,7 +381,8 @@ void BindRendering(py::module_& m) {
             },
             py::arg("kind") = "expected",
             "(H, W) float32 view-space z: the alpha-weighted mean (expected) or where the "
-            "accumulated alpha reaches one half (median); 0 where no splat is")
+            "accumulated alpha reaches one half (median); 0 where no splat is. With meshes: the "
+            "nearer of the mesh's z and the splats' (kind is not used)")
         .def(
             "render_batch",
             [](SplatOffscreen& r, const std::vector<camera::PinholeCamera>& cameras,

@@ -1,0 +1,94 @@
+// t.geometry.TriangleMesh (copied in and out: meshes are small next to splat scenes) and
+// visualization.rendering.MaterialRecord.
+#include <pybind11/eigen.h>
+#include <pybind11/numpy.h>
+#include <pybind11/stl.h>
+
+#include <fmt/format.h>
+
+#include <cstring>
+
+#include "Bindings.h"
+#include "NumpyTensor.h"
+#include "open3d/core/Exception.h"
+#include "open3d/t/geometry/TriangleMesh.h"
+#include "open3d/visualization/rendering/filament/MaterialRecord.h"
+
+namespace py = pybind11;
+
+namespace open3d {
+namespace pybind {
+
+namespace {
+
+py::array CopyOfTensor(const core::Tensor& tensor) {
+    py::array_t<float> out({py::ssize_t(tensor.GetShape(0)), py::ssize_t(tensor.GetShape(1))});
+    std::memcpy(out.mutable_data(), tensor.Data<float>(), size_t(tensor.NumBytes()));
+    return out;
+}
+
+}  // namespace
+
+void BindMesh(py::module_& m) {
+    using t::geometry::TriangleMesh;
+    py::class_<TriangleMesh>(m, "TriangleMesh",
+                             "Vertices [N, 3] float32 and triangles [M, 3] (counter-clockwise "
+                             "seen from the front); drawn by Filament (needs an X server)")
+        .def(py::init([](const py::array& vertices, const py::array_t<int64_t>& triangles) {
+                 if (triangles.ndim() != 2 || triangles.shape(1) != 3) {
+                     core::ThrowError("TriangleMesh: triangles must have shape (M, 3)");
+                 }
+                 TriangleMesh::TriangleIndices indices(triangles.shape(0));
+                 const auto t = triangles.unchecked<2>();
+                 for (py::ssize_t i = 0; i < triangles.shape(0); ++i) {
+                     indices[i] = Eigen::Vector3i(int(t(i, 0)), int(t(i, 1)), int(t(i, 2)));
+                 }
+                 TriangleMesh mesh(TensorFromArray(vertices, "vertices"), std::move(indices));
+                 mesh.Validate();
+                 return mesh;
+             }),
+             py::arg("vertices"), py::arg("triangles"))
+        .def_static("create_sphere", &TriangleMesh::CreateSphere, py::arg("radius") = 1.0,
+                    py::arg("resolution") = 20)
+        .def_static("create_box", &TriangleMesh::CreateBox, py::arg("width") = 1.0,
+                    py::arg("height") = 1.0, py::arg("depth") = 1.0)
+        .def("num_vertices", &TriangleMesh::NumVertices)
+        .def("num_triangles", &TriangleMesh::NumTriangles)
+        .def_property_readonly(
+            "vertices",
+            [](const TriangleMesh& mesh) { return CopyOfTensor(mesh.GetVertexPositions()); },
+            "A copy of the vertex positions")
+        .def(
+            "set_vertex_colors",
+            [](TriangleMesh& mesh, const py::array& colors) {
+                mesh.SetVertexColors(TensorFromArray(colors, "vertex colors"));
+                mesh.Validate();
+            },
+            py::arg("colors"), "Linear RGB [N, 3] float32 in 0..1")
+        .def(
+            "translate",
+            [](TriangleMesh& mesh, const Eigen::Vector3d& t) -> TriangleMesh& {
+                return mesh.Translate(t);
+            },
+            py::arg("translation"), py::return_value_policy::reference_internal)
+        .def("__repr__", [](const TriangleMesh& mesh) {
+            return fmt::format("TriangleMesh with {} vertices and {} triangles", mesh.NumVertices(),
+                               mesh.NumTriangles());
+        });
+}
+
+void BindMaterial(py::module_& m) {
+    using visualization::rendering::MaterialRecord;
+    py::class_<MaterialRecord>(m, "MaterialRecord",
+                               "How a geometry is drawn: shader 'defaultUnlit', 'defaultLit' "
+                               "(meshes, points) or 'gaussianSplat'")
+        .def(py::init<>())
+        .def_readwrite("shader", &MaterialRecord::shader)
+        .def_readwrite("base_color", &MaterialRecord::base_color)
+        .def_readwrite("point_size", &MaterialRecord::point_size)
+        .def_readwrite("gaussian_splat_sh_degree", &MaterialRecord::gaussian_splat_sh_degree)
+        .def_readwrite("gaussian_splat_antialias", &MaterialRecord::gaussian_splat_antialias);
+}
+
+}  // namespace pybind
+}  // namespace open3d

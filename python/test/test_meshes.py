@@ -1,0 +1,92 @@
+"""Meshes from Python: the Filament path of OffscreenRenderer (needs an X server: Xvfb under
+ctest), its depth against analytic values, and the errors that say where meshes can go."""
+import os
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+import open3d_gs as o3d
+from conftest import unavailable
+
+Renderer = o3d.visualization.rendering.OffscreenRenderer
+
+
+@pytest.fixture
+def display():
+    if not os.environ.get("DISPLAY"):
+        unavailable("DISPLAY is not set: meshes need an X server (run under xvfb-run; ctest does)")
+
+
+def wall(n=20):
+    """A wall of blue splats at z = 4, across x, y in [-2, 2]."""
+    g = np.linspace(-2, 2, n, dtype=np.float32)
+    xy = np.stack(np.meshgrid(g, g), -1).reshape(-1, 2)
+    pcd = o3d.t.geometry.PointCloud(np.concatenate([xy, np.full((len(xy), 1), 4, np.float32)], 1))
+    pcd.point["scale"] = np.tile(np.float32([0.15, 0.15, 0.01]), (len(xy), 1))
+    pcd.point["rot"] = np.tile(np.float32([1, 0, 0, 0]), (len(xy), 1))
+    pcd.point["opacity"] = np.full((len(xy), 1), 3.0, np.float32)
+    blue = (np.float32([0.1, 0.2, 0.9]) - 0.5) / 0.28209479  # f_dc of that colour
+    pcd.point["f_dc"] = np.tile(blue, (len(xy), 1))
+    return pcd
+
+
+def test_a_mesh_in_front_of_splats(display, backend):
+    r = Renderer(160, 120, backend, meshes=True)
+    assert r.meshes
+    r.scene.add_geometry("wall", wall())
+    sphere = o3d.t.geometry.TriangleMesh.create_sphere(0.5, 40)
+    sphere.translate([0, 0, 2])
+    red = o3d.visualization.rendering.MaterialRecord()
+    red.base_color = [1, 0, 0, 1]  # defaultUnlit: exactly this colour
+    r.scene.add_geometry("sphere", sphere, red)
+    # The camera at the origin looking along +z (y down), 60 degrees tall.
+    fy = 60 / np.tan(np.radians(30))
+    r.setup_camera(o3d.camera.PinholeCamera(160, 120, fy, fy, 79.5, 59.5))
+    image = r.render_to_image()
+    assert image.shape == (120, 160, 3) and image.dtype == np.uint8
+    centre = image[60, 80]
+    assert centre[0] > 200 and centre[1] < 10 and centre[2] < 10, centre  # the sphere hides the wall
+    beside = image[60, 40].astype(int)  # world x = (40 - 79.5) / fy * 4 = -1.5: on the wall
+    assert beside[2] > beside[0] + 50, beside  # the blue wall around the sphere
+    depth = r.render_to_depth_image()
+    assert depth.shape == (120, 160)
+    # The sphere's front at the centre pixel is 2 - 0.5 = 1.5 away; the 40-step tessellation
+    # puts it within 0.01 (chord sagitta 0.5 (1 - cos(pi / 40)) = 0.0015). The wall: z = 4
+    # in the splats' expected depth.
+    assert abs(depth[60, 80] - 1.5) < 0.01, depth[60, 80]
+    assert abs(depth[60, 40] - 4.0) < 0.05, depth[60, 40]
+    with pytest.raises(o3d.Open3DError, match="8-bit"):
+        r.render_to_image("float32")
+    with pytest.raises(o3d.Open3DError, match="splat-only"):
+        r.render_batch([r.camera])
+
+
+def test_meshes_need_meshes_true():
+    r = Renderer(16, 16, "cpu")
+    with pytest.raises(o3d.Open3DError, match="meshes=True"):
+        r.scene.add_geometry("box", o3d.t.geometry.TriangleMesh.create_box())
+    points = o3d.visualization.rendering.MaterialRecord()
+    points.shader = "defaultUnlit"
+    with pytest.raises(o3d.Open3DError, match="only Gaussian splat clouds"):
+        r.scene.add_geometry("points", wall(), points)
+
+
+def test_without_a_display_the_error_says_so():
+    env = {k: v for k, v in os.environ.items() if k != "DISPLAY"}
+    code = ("import open3d_gs as o3d\n"
+            "try:\n    o3d.visualization.rendering.OffscreenRenderer(8, 8, 'cpu', meshes=True)\n"
+            "except o3d.Open3DError as e:\n    print(e)\n")
+    out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, timeout=120)
+    assert "needs an X server" in out.stdout and "xvfb-run" in out.stdout, out.stdout + out.stderr
+
+
+def test_mesh_arrays():
+    mesh = o3d.t.geometry.TriangleMesh(np.float32([[0, 0, 0], [1, 0, 0], [0, 1, 0]]), np.array([[0, 1, 2]]))
+    assert mesh.num_vertices() == 3 and mesh.num_triangles() == 1
+    np.testing.assert_array_equal(mesh.vertices[1], [1, 0, 0])
+    with pytest.raises(o3d.Open3DError):
+        o3d.t.geometry.TriangleMesh(np.float32([[0, 0, 0]]), np.array([[0, 1, 2]]))  # index 2 of 1 vertex
+    with pytest.raises(o3d.Open3DError, match=r"\(M, 3\)"):
+        o3d.t.geometry.TriangleMesh(np.float32([[0, 0, 0]]), np.array([0, 0, 0]))
