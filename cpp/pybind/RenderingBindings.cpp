@@ -232,6 +232,11 @@ py::array ColorArray(RenderOutput& out, const std::string& dtype) {
     return ArrayFromImage(out.color.SelectChannels(0, 3).ToUInt8());
 }
 
+int CheckShDegree(int degree) {
+    if (degree < 0 || degree > 3) core::ThrowError("sh_degree {}: the cap is 0..3", degree);
+    return degree;
+}
+
 void CheckDtype(const std::string& dtype) {
     if (dtype != "float32" && dtype != "uint8") {
         core::ThrowError("dtype '{}': float32 (premultiplied RGBA) or uint8 (RGB)", dtype);
@@ -295,8 +300,23 @@ void BindRendering(py::module_& m) {
         "alone without a display: 'vulkan' (any Vulkan 1.3 device, lavapipe without a GPU) or "
         "'cpu' (the double-precision reference). meshes=True: Filament draws meshes and points "
         "and composites the splats by depth (needs an X server; 8-bit colour).")
-        .def(py::init<int, int, const std::string&, bool>(), py::arg("width"), py::arg("height"),
-             py::arg("backend") = "vulkan", py::arg("meshes") = false)
+        .def(py::init([](int width, int height, const std::string& backend, bool meshes,
+                         int sh_degree, bool antialias, bool compact_storage, double near_plane) {
+                 auto r = std::make_shared<SplatOffscreen>(width, height, backend, meshes);
+                 r->Config().sh_degree = CheckShDegree(sh_degree);
+                 r->Config().antialias = antialias;
+                 r->Config().compact_storage = compact_storage;
+                 r->Config().near_plane = near_plane;
+                 r->Config().Validate();
+                 return r;
+             }),
+             py::arg("width"), py::arg("height"), py::arg("backend") = "vulkan",
+             py::arg("meshes") = false, py::kw_only(), py::arg("sh_degree") = 3,
+             py::arg("antialias") = false, py::arg("compact_storage") = false,
+             py::arg("near_plane") = RenderConfig{}.near_plane,
+             "The knobs are keyword arguments and properties: sh_degree (cap, 0..3), "
+             "antialias (Mip-Splatting's), compact_storage (Vulkan, half precision), "
+             "near_plane")
         .def_property_readonly("scene", [](const Offscreen& r) { return SplatScene{r}; })
         .def_property_readonly("backend", &SplatOffscreen::BackendName)
         .def_property_readonly("meshes", &SplatOffscreen::HasMeshes)
@@ -334,7 +354,8 @@ void BindRendering(py::module_& m) {
         .def_property_readonly("camera", &SplatOffscreen::Camera)
         .def_property(
             "sh_degree", [](SplatOffscreen& r) { return r.Config().sh_degree; },
-            [](SplatOffscreen& r, int v) { r.Config().sh_degree = v; }, "SH degree cap, 0..3")
+            [](SplatOffscreen& r, int v) { r.Config().sh_degree = CheckShDegree(v); },
+            "SH degree cap, 0..3")
         .def_property(
             "antialias", [](SplatOffscreen& r) { return r.Config().antialias; },
             [](SplatOffscreen& r, bool v) { r.Config().antialias = v; })

@@ -115,6 +115,25 @@ def test_rendering_releases_the_gil(data):
     assert ticks > 10 * seconds, (ticks, seconds)
 
 
+def test_knobs_as_keyword_arguments(data, backend):
+    pcd = o3d.t.io.read_point_cloud(str(data("playbot/playbot_31k.ply")))
+    camera = o3d.camera.read_cameras_json(str(data("playbot/cameras.json")))[0].camera
+    images = {}
+    for degree in (0, 2):
+        r = Renderer(64, 64, backend, sh_degree=degree)
+        assert r.sh_degree == degree
+        r.scene.add_geometry("playbot", pcd)
+        r.setup_camera(camera)
+        images[degree] = r.render_to_image()
+    assert np.abs(images[0] - images[2]).max() > 1e-3  # the SH bands above 0 change colours
+    r.sh_degree = 0
+    np.testing.assert_array_equal(r.render_to_image(), images[0])
+    with pytest.raises(o3d.Open3DError, match="sh_degree 7: the cap is 0..3"):
+        Renderer(8, 8, "cpu", sh_degree=7)
+    with pytest.raises(o3d.Open3DError, match="near_plane must be a positive"):
+        Renderer(8, 8, "cpu", near_plane=-1.0)
+
+
 def test_errors():
     with pytest.raises(o3d.Open3DError, match="backend 'metal'"):
         Renderer(8, 8, "metal")
