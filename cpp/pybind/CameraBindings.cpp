@@ -49,16 +49,7 @@ void BindCamera(py::module_& m) {
                         "from_intrinsics_extrinsics: K must be [[fx, 0, cx], [0, fy, cy], [0, 0, "
                         "1]] (no skew)");
                 }
-                PinholeCamera c;
-                c.width = width;
-                c.height = height;
-                c.fx = K(0, 0);
-                c.fy = K(1, 1);
-                c.cx = K(0, 2);
-                c.cy = K(1, 2);
-                c.world_to_camera = extrinsic;
-                c.Validate();
-                return c;
+                return PinholeCamera::FromIntrinsic(K, extrinsic, width, height);
             },
             py::arg("intrinsic"), py::arg("extrinsic"), py::arg("width"), py::arg("height"),
             "OpenCV: K = [[fx, 0, cx], [0, fy, cy], [0, 0, 1]], extrinsic = world-to-camera "

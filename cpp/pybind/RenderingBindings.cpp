@@ -327,15 +327,8 @@ void BindRendering(py::module_& m) {
         .def(
             "setup_camera",
             [](SplatOffscreen& r, const Eigen::Matrix3d& K, const Eigen::Matrix4d& extrinsic) {
-                camera::PinholeCamera c;
-                c.width = r.Width();
-                c.height = r.Height();
-                c.fx = K(0, 0);
-                c.fy = K(1, 1);
-                c.cx = K(0, 2);
-                c.cy = K(1, 2);
-                c.world_to_camera = extrinsic;
-                r.SetCamera(c);
+                r.SetCamera(
+                    camera::PinholeCamera::FromIntrinsic(K, extrinsic, r.Width(), r.Height()));
             },
             py::arg("intrinsic"), py::arg("extrinsic"),
             "OpenCV intrinsics (for this renderer's size) and a world-to-camera extrinsic")

@@ -171,5 +171,22 @@ TEST(CamerasJson, ReadsSharedPlaybotCameras) {
     EXPECT_LT(std::abs(cam.fx * v.x() / v.z()), 400.0);
 }
 
+TEST(PinholeCamera, FromIntrinsicReadsFocalLengthsAndPrincipalPoint) {
+    Eigen::Matrix3d K;
+    K << 500, 0, 319.5, 0, 480, 239.5, 0, 0, 1;
+    Eigen::Matrix4d extrinsic = Eigen::Matrix4d::Identity();
+    extrinsic(2, 3) = 2.0;
+    const camera::PinholeCamera cam = camera::PinholeCamera::FromIntrinsic(K, extrinsic, 640, 480);
+    EXPECT_EQ(cam.width, 640);
+    EXPECT_EQ(cam.height, 480);
+    EXPECT_EQ(cam.fx, 500.0);
+    EXPECT_EQ(cam.fy, 480.0);
+    EXPECT_EQ(cam.cx, 319.5);
+    EXPECT_EQ(cam.cy, 239.5);
+    EXPECT_EQ(cam.world_to_camera, extrinsic);
+    K(0, 0) = 0.0;  // validated: a focal length must be positive
+    EXPECT_THROW(camera::PinholeCamera::FromIntrinsic(K, extrinsic, 640, 480), core::Open3DError);
+}
+
 }  // namespace tests
 }  // namespace open3d

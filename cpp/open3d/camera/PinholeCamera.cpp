@@ -30,6 +30,21 @@ void PinholeCamera::Validate() const {
     }
 }
 
+PinholeCamera PinholeCamera::FromIntrinsic(const Eigen::Matrix3d& intrinsic,
+                                           const Eigen::Matrix4d& extrinsic, int width,
+                                           int height) {
+    PinholeCamera camera;
+    camera.width = width;
+    camera.height = height;
+    camera.fx = intrinsic(0, 0);
+    camera.fy = intrinsic(1, 1);
+    camera.cx = intrinsic(0, 2);
+    camera.cy = intrinsic(1, 2);
+    camera.world_to_camera = extrinsic;
+    camera.Validate();
+    return camera;
+}
+
 PinholeCamera PinholeCamera::Resized(int new_width, int new_height) const {
     if (new_width <= 0 || new_height <= 0) {
         core::ThrowError("PinholeCamera::Resized: size must be positive, got {}x{}", new_width,

@@ -49,6 +49,11 @@ struct PinholeCamera {
     /// cx' = (cx + 0.5) * W' / W - 0.5), so a centred principal point stays centred.
     PinholeCamera Resized(int new_width, int new_height) const;
 
+    /// From a pinhole intrinsic matrix [[fx, 0, cx], [0, fy, cy], [0, 0, 1]] (only those four
+    /// entries are read) and a 4x4 world-to-camera extrinsic, OpenCV axes; validated.
+    static PinholeCamera FromIntrinsic(const Eigen::Matrix3d& intrinsic,
+                                       const Eigen::Matrix4d& extrinsic, int width, int height);
+
     /// A camera looking from eye to center, with `up` projected to the camera's -y axis.
     /// Square pixels, fy = H / (2 tan(fov / 2)), principal point at the image centre.
     /// Throws when eye == center, up is parallel to the view direction or fov is not in (0, 180).

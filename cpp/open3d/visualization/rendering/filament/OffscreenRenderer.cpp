@@ -55,16 +55,8 @@ void OffscreenRenderer::SetupCamera(float vertical_fov_deg, const Eigen::Vector3
 
 void OffscreenRenderer::SetupCamera(const Eigen::Matrix3d& intrinsic,
                                     const Eigen::Matrix4d& extrinsic) {
-    camera::PinholeCamera camera;
-    camera.width = width_;
-    camera.height = height_;
-    camera.fx = intrinsic(0, 0);
-    camera.fy = intrinsic(1, 1);
-    camera.cx = intrinsic(0, 2);
-    camera.cy = intrinsic(1, 2);
-    camera.world_to_camera = extrinsic;
-    camera.Validate();
-    scene_->SetupCamera(camera);
+    scene_->SetupCamera(
+        camera::PinholeCamera::FromIntrinsic(intrinsic, extrinsic, width_, height_));
 }
 
 void OffscreenRenderer::SetupCamera(const camera::PinholeCamera& camera) {
