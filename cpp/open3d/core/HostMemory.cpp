@@ -6,7 +6,6 @@
 #include <cstdlib>
 #include <fstream>
 #include <limits>
-#include <sstream>
 #include <string>
 
 #include "open3d/core/Exception.h"
@@ -60,17 +59,21 @@ uint64_t ReadCgroupRoom() {
 }
 
 uint64_t ReadLimitVariable() {
-    const char* text = std::getenv("OPEN3D_HOST_MEMORY_LIMIT");
-    if (text == nullptr || text[0] == '\0') return kUnknown;
-    char* end = nullptr;
-    const unsigned long long value = std::strtoull(text, &end, 10);
-    if (end == text || *end != '\0') {
-        ThrowError("OPEN3D_HOST_MEMORY_LIMIT={}: expected a number of bytes", text);
-    }
-    return value;
+    return ReadByteCountVariable("OPEN3D_HOST_MEMORY_LIMIT").value_or(kUnknown);
 }
 
 }  // namespace
+
+std::optional<uint64_t> ReadByteCountVariable(const char* name) {
+    const char* text = std::getenv(name);
+    if (text == nullptr || text[0] == '\0') return std::nullopt;
+    char* end = nullptr;
+    const unsigned long long value = std::strtoull(text, &end, 10);
+    if (end == text || *end != '\0') {
+        ThrowError("{}={}: expected a number of bytes", name, text);
+    }
+    return value;
+}
 
 uint64_t AvailableHostMemory() {
     return std::min({ReadMemAvailable(), ReadCgroupRoom(), ReadLimitVariable()});
@@ -86,8 +89,7 @@ std::string FormatBytes(uint64_t bytes) {
 void RequireHostMemory(uint64_t bytes, const std::string& what, const std::string& hint) {
     const uint64_t available = AvailableHostMemory();
     if (bytes <= available) return;
-    const bool capped =
-        std::getenv("OPEN3D_HOST_MEMORY_LIMIT") != nullptr && available == ReadLimitVariable();
+    const bool capped = ReadByteCountVariable("OPEN3D_HOST_MEMORY_LIMIT") == available;
     ThrowError("{} needs {} of memory, {} is available ({}){}{}", what, FormatBytes(bytes),
                FormatBytes(available),
                capped ? "OPEN3D_HOST_MEMORY_LIMIT" : "MemAvailable and the cgroup limit",

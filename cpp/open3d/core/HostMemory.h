@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 
 namespace open3d {
@@ -15,6 +16,11 @@ namespace core {
 /// tests and for leaving room to other programs) when that is set. UINT64_MAX when
 /// nothing is known (no /proc).
 uint64_t AvailableHostMemory();
+
+/// The number of bytes an environment variable holds (OPEN3D_HOST_MEMORY_LIMIT,
+/// OPEN3D_DEVICE_MEMORY_LIMIT), nothing when it is unset or empty; throws core::Open3DError
+/// naming the variable when it is not a plain number.
+std::optional<uint64_t> ReadByteCountVariable(const char* name);
 
 /// "1.23 GB" (powers of 1000, as free(1) -h and file managers show sizes).
 std::string FormatBytes(uint64_t bytes);
