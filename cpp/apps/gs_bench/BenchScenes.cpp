@@ -30,11 +30,7 @@ t::geometry::PointCloud MakeGridScene(const t::geometry::PointCloud& tile, int k
     const int64_t n = tile.NumPoints();
     {
         // Checked before the copies are made (--grid 64 once grew past 12 GB and on).
-        uint64_t tile_bytes = 0;
-        for (const std::string& name : tile.GetPointAttrNames()) {
-            tile_bytes += tile.GetPointAttr(name).NumBytes();
-        }
-        const uint64_t per_copy = std::max<uint64_t>(tile_bytes, 1);
+        const uint64_t per_copy = std::max<uint64_t>(tile.NumBytes(), 1);
         const uint64_t available = core::AvailableHostMemory();
         const int fits = int(std::sqrt(double(available / per_copy)));
         core::RequireHostMemory(

@@ -23,6 +23,15 @@ PointCloud SplatCloud(int64_t n, int degree) {
     return cloud;
 }
 
+TEST(PointCloud, NumBytesCountsEveryAttribute) {
+    // 5 splats of degree 2: 4 bytes x (3 + 3 + 4 + 1 + 3 + 8 x 3) = 152 bytes each.
+    EXPECT_EQ(SplatCloud(5, 2).NumBytes(), 5 * 152);
+    PointCloud cloud = SplatCloud(5, 0);
+    cloud.SetPointAttr("label", Tensor({5, 1}, Dtype::UInt8));
+    EXPECT_EQ(cloud.NumBytes(), 5 * 56 + 5);
+    EXPECT_EQ(PointCloud().NumBytes(), 0);
+}
+
 TEST(PointCloud, GaussianSplatArraysPointAtTheAttributes) {
     const PointCloud d2 = SplatCloud(5, 2);
     const GaussianSplatArrays a = d2.GetGaussianSplatArrays();

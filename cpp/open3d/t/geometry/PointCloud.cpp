@@ -55,6 +55,12 @@ std::vector<std::string> PointCloud::GetPointAttrNames() const {
     return names;
 }
 
+int64_t PointCloud::NumBytes() const {
+    int64_t bytes = 0;
+    for (const auto& kv : attrs_) bytes += kv.second.NumBytes();
+    return bytes;
+}
+
 void PointCloud::ValidateGaussianSplat() const {
     const int64_t n = NumPoints();
     auto check = [&](const char* name, const core::SizeVector& expected) {

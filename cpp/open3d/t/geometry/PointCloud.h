@@ -66,6 +66,8 @@ public:
     void SetPointAttr(const std::string& name, core::Tensor value);
     void RemovePointAttr(const std::string& name) { attrs_.erase(name); }
     std::vector<std::string> GetPointAttrNames() const;
+    /// Bytes held by all attributes (what a copy of the cloud takes).
+    int64_t NumBytes() const;
 
     /// True when scale, rot, opacity and f_dc exist (f_rest optional) with valid shapes.
     bool IsGaussianSplat() const;

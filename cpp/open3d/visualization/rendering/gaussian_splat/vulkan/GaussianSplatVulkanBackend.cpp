@@ -98,10 +98,7 @@ void GaussianSplatVulkanBackend::UploadScene(SplatPrecision precision) {
     ++scene_serial_;
     {
         // The packed copy is about as large as the cloud's attributes (compact: about half).
-        uint64_t cloud_bytes = 0;
-        for (const std::string& name : cloud_->GetPointAttrNames()) {
-            cloud_bytes += cloud_->GetPointAttr(name).NumBytes();
-        }
+        const uint64_t cloud_bytes = cloud_->NumBytes();
         core::RequireHostMemory(
             precision == SplatPrecision::kCompact ? cloud_bytes / 2 : cloud_bytes,
             fmt::format("vulkan backend: packing {} splats for upload", cloud_->NumPoints()),
