@@ -257,6 +257,11 @@ rendering::FrameResult Visualizer::DrawToWindow(bool read_screen, int divisor, b
         result.times.compose_ms = core::MillisecondsSince(compose_start);
         result.times.total_ms += result.times.compose_ms;
     }
+    if (!result.cancelled && !skip_splats) {
+        // What the next frame's resolution is chosen from (InteractiveDivisor).
+        last_divisor_ = divisor;
+        if (divisor == 1) full_frame_ms_ = result.times.total_ms;
+    }
     std::vector<std::function<void()>> events;
     events.swap(deferred_);
     for (const std::function<void()>& event : events) event();
@@ -292,8 +297,6 @@ bool Visualizer::RenderFrame() {
         last_present_s_ = -1.0;  // nothing was presented
         return true;
     }
-    last_divisor_ = divisor;
-    if (divisor == 1) full_frame_ms_ = last_frame_.times.total_ms;
     if (last_frame_.splats_drawn) new_splats_ = 0;
     const double now = NowSeconds();
     if (last_present_s_ >= 0.0)
@@ -352,10 +355,7 @@ t::geometry::Image Visualizer::CaptureScreenImage() {
         core::ThrowError("CaptureScreenImage: the window is minimised (nothing is drawn)");
     }
     BuildOverlay();
-    const int divisor = InteractiveDivisor();
-    last_frame_ = DrawToWindow(true, divisor);
-    last_divisor_ = divisor;
-    if (divisor == 1) full_frame_ms_ = last_frame_.times.total_ms;
+    last_frame_ = DrawToWindow(true, InteractiveDivisor());
     return DropAlpha(last_frame_.screen);
 }
 
