@@ -143,12 +143,9 @@ public:
         }
     }
 
-    /// The camera at the renderer's size (intrinsics scaled when the camera's differs).
+    /// Uses the camera at the renderer's size.
     void SetCamera(const camera::PinholeCamera& camera) {
-        camera.Validate();
-        camera_ = (camera.width == width_ && camera.height == height_)
-                      ? camera
-                      : camera.Resized(width_, height_);
+        camera_ = Sized(camera);
         has_camera_ = true;
     }
     const camera::PinholeCamera& Camera() const {
@@ -158,9 +155,7 @@ public:
 
     RenderOutput Render(bool expected_depth, bool median_depth) {
         const camera::PinholeCamera camera = Camera();
-        if (!renderer_->HasVisibleSplats()) {
-            core::ThrowError("OffscreenRenderer: the scene has no visible splat cloud");
-        }
+        RequireVisibleSplats();
         RenderOutput out;
         visualization::rendering::CompositeInputs inputs;
         inputs.expected_depth = expected_depth;
@@ -193,14 +188,8 @@ public:
             core::ThrowError("render_batch: batches are for splat-only renderers (meshes=False)");
         }
         std::vector<camera::PinholeCamera> sized;
-        for (const camera::PinholeCamera& c : cameras) {
-            c.Validate();
-            sized.push_back(c.width == width_ && c.height == height_ ? c
-                                                                     : c.Resized(width_, height_));
-        }
-        if (!renderer_->HasVisibleSplats()) {
-            core::ThrowError("OffscreenRenderer: the scene has no visible splat cloud");
-        }
+        for (const camera::PinholeCamera& c : cameras) sized.push_back(Sized(c));
+        RequireVisibleSplats();
         visualization::rendering::BatchOptions options;
         options.color_uint8 = uint8;
         options.color_destination = destination;
@@ -212,6 +201,18 @@ public:
     }
 
 private:
+    /// Validated, with its intrinsics scaled to the renderer's size when its size differs.
+    camera::PinholeCamera Sized(const camera::PinholeCamera& camera) const {
+        camera.Validate();
+        return camera.width == width_ && camera.height == height_ ? camera
+                                                                  : camera.Resized(width_, height_);
+    }
+    void RequireVisibleSplats() const {
+        if (!renderer_->HasVisibleSplats()) {
+            core::ThrowError("OffscreenRenderer: the scene has no visible splat cloud");
+        }
+    }
+
     int width_, height_;
     std::unique_ptr<GaussianSplatRenderer> renderer_;
     std::unique_ptr<visualization::rendering::OffscreenRenderer> filament_;
