@@ -118,6 +118,15 @@ int Run(const Options& opt) {
     const auto start = std::chrono::steady_clock::now();
     t::geometry::PointCloud cloud;
     vis::BackgroundCloudReader reader;
+    double shown_s = -1.0;
+    // The panel's progress line, twice a second; true when it changed.
+    const auto show_progress = [&] {
+        const double now = core::MillisecondsSince(start) / 1000.0;
+        if (now - shown_s < 0.5) return false;
+        viewer.SetStatus(reader.Describe());
+        shown_s = now;
+        return true;
+    };
     if (default_scene) {
         cloud = rendering::CreateDefaultGaussianSplatScene();
     } else {
@@ -125,15 +134,9 @@ int Run(const Options& opt) {
         std::printf("GaussianSplat: loading %s\n", opt.input.c_str());
         std::fflush(stdout);
         std::optional<t::geometry::PointCloud> loaded;
-        double shown_s = -1.0;
         while (!(loaded = reader.TakeResult())) {  // rethrows the reader's error
             if (!viewer.PollEvents()) return 0;
-            const double now = core::MillisecondsSince(start) / 1000.0;
-            if (now - shown_s >= 0.5) {  // twice a second
-                viewer.SetStatus(reader.Describe());
-                viewer.RenderFrame();
-                shown_s = now;
-            }
+            if (show_progress()) viewer.RenderFrame();
             std::this_thread::sleep_for(std::chrono::milliseconds(20));
         }
         cloud = std::move(*loaded);
@@ -163,7 +166,6 @@ int Run(const Options& opt) {
         reader.Start(paths.front());
         viewer.SetStatus(reader.Describe());
     });
-    double last_status_s = 0.0;
     vis::RunOptions run;
     run.poll = [&] {
         if (!reader.IsBusy()) return;
@@ -183,13 +185,7 @@ int Run(const Options& opt) {
             std::fprintf(stderr, "GaussianSplat: %s\n", e.what());
             return;
         }
-        const double now =
-            std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch())
-                .count();
-        if (now - last_status_s >= 0.5) {  // the panel's progress, twice a second
-            viewer.SetStatus(reader.Describe());
-            last_status_s = now;
-        }
+        show_progress();  // SetStatus asks for the frame that shows it
     };
     run.continuous = opt.continuous || opt.frames > 0 || opt.spin_degrees != 0.0;
     run.max_frames = opt.frames;
