@@ -50,6 +50,11 @@ OPEN3D_SHADER_CONST uint kSpecSceneDepth = 0u;
 OPEN3D_SHADER_CONST uint kSpecCompositeDepth = 1u;
 OPEN3D_SHADER_CONST uint kCompositeExpectedDepthBit = 1u;  // expected depth and alpha images
 OPEN3D_SHADER_CONST uint kCompositeMedianDepthBit = 2u;    // median depth image
+// Specialisation constant of gaussian_composite.comp (RGBA32F): 1 = the colour goes to the
+// storage buffer at kCompositeColorBufferBinding (vec4 per pixel, row-major) instead of the
+// image, so a batch's views need no image-to-buffer copy (0.18 ms per 800x800 view on an
+// H200, docs/perf/h200.md); 0 = the image.
+OPEN3D_SHADER_CONST uint kSpecColorBuffer = 2u;
 
 // Which pixel blocks of a tile a splat can change: bit k is set unless no pixel of block k
 // lies in the splat's culling ellipse q <= t (TileCullThreshold, stored as cull_threshold), found
@@ -87,17 +92,18 @@ OPEN3D_SHADER_FUNC uint CompositeBlockMask(float cx, float cy, float a, float b,
 }
 
 // Descriptor set 0 of the composite (push descriptors).
-OPEN3D_SHADER_CONST uint kCompositeProjectedBinding = 0u;    // GaussianProjectedSplat[N]
-OPEN3D_SHADER_CONST uint kCompositeEntryKeysBinding = 1u;    // uint[capacity]: tile, ascending
-OPEN3D_SHADER_CONST uint kCompositeEntryValuesBinding = 2u;  // uint[capacity]: splat index
-OPEN3D_SHADER_CONST uint kCompositeCountBinding = 3u;        // uint[]: entry count at count_index
-OPEN3D_SHADER_CONST uint kCompositeStateBinding = 4u;        // GaussianCompositeState
-OPEN3D_SHADER_CONST uint kCompositeColorBinding = 5u;        // image2D rgba32f / rgba16f
-OPEN3D_SHADER_CONST uint kCompositeDepthBinding = 6u;        // image2D r32f: expected view z
-OPEN3D_SHADER_CONST uint kCompositeAlphaBinding = 7u;        // image2D r32f: 1 - T
-OPEN3D_SHADER_CONST uint kCompositeMedianDepthBinding = 8u;  // image2D r32f: median view z
-OPEN3D_SHADER_CONST uint kCompositeSceneDepthBinding = 9u;   // texture2D, reversed-Z
-OPEN3D_SHADER_CONST uint kCompositeNumBindings = 10u;
+OPEN3D_SHADER_CONST uint kCompositeProjectedBinding = 0u;     // GaussianProjectedSplat[N]
+OPEN3D_SHADER_CONST uint kCompositeEntryKeysBinding = 1u;     // uint[capacity]: tile, ascending
+OPEN3D_SHADER_CONST uint kCompositeEntryValuesBinding = 2u;   // uint[capacity]: splat index
+OPEN3D_SHADER_CONST uint kCompositeCountBinding = 3u;         // uint[]: entry count at count_index
+OPEN3D_SHADER_CONST uint kCompositeStateBinding = 4u;         // GaussianCompositeState
+OPEN3D_SHADER_CONST uint kCompositeColorBinding = 5u;         // image2D rgba32f / rgba16f
+OPEN3D_SHADER_CONST uint kCompositeDepthBinding = 6u;         // image2D r32f: expected view z
+OPEN3D_SHADER_CONST uint kCompositeAlphaBinding = 7u;         // image2D r32f: 1 - T
+OPEN3D_SHADER_CONST uint kCompositeMedianDepthBinding = 8u;   // image2D r32f: median view z
+OPEN3D_SHADER_CONST uint kCompositeSceneDepthBinding = 9u;    // texture2D, reversed-Z
+OPEN3D_SHADER_CONST uint kCompositeColorBufferBinding = 10u;  // vec4[W * H] (kSpecColorBuffer)
+OPEN3D_SHADER_CONST uint kCompositeNumBindings = 11u;
 
 // Descriptor set 0 of the depth merge (push descriptors).
 OPEN3D_SHADER_CONST uint kDepthMergeSplatDepthBinding = 0u;  // image2D r32f: splat view z

@@ -34,6 +34,8 @@ layout(constant_id = kSpecCompositeDepth) const uint kDepthOutputs =
         kCompositeExpectedDepthBit | kCompositeMedianDepthBit;
 const bool kExpectedDepth = (kDepthOutputs & kCompositeExpectedDepthBit) != 0u;
 const bool kMedianDepth = (kDepthOutputs & kCompositeMedianDepthBit) != 0u;
+// 1: the colour goes to color_buffer instead of out_color (RGBA32F batches, no image copy).
+layout(constant_id = kSpecColorBuffer) const uint kColorToBuffer = 0u;
 
 layout(push_constant, std430) uniform PushConstantsBlock {
     GaussianCompositePushConstants pc;
@@ -56,6 +58,9 @@ layout(set = 0, binding = kCompositeAlphaBinding, r32f) writeonly uniform image2
 layout(set = 0, binding = kCompositeMedianDepthBinding, r32f) writeonly
 uniform image2D out_median_depth;
 layout(set = 0, binding = kCompositeSceneDepthBinding) uniform texture2D scene_depth;
+layout(std430, set = 0, binding = kCompositeColorBufferBinding) writeonly buffer ColorBufferBlock {
+    vec4 color_buffer[];  // row-major W x H, the same floats the image would hold
+};
 
 // The batch in shared memory: 48 B per splat, 12 KiB (lavapipe allows 32 KiB).
 shared vec4 s_center_depth_opacity[kCompositeBatchSize];
@@ -287,8 +292,12 @@ uint CompositeTile(uint tile, uvec2 range, uint next_index, uvec2 upcoming, uint
 
     if (inside) {
         float accumulated = 1.0 - p.transmittance;
-        imageStore(out_color, pixel,
-                   vec4(p.color + p.transmittance * pc.background, accumulated));
+        const vec4 color = vec4(p.color + p.transmittance * pc.background, accumulated);
+        if (kColorToBuffer != 0u) {
+            color_buffer[uint(pixel.y) * pc.width + uint(pixel.x)] = color;
+        } else {
+            imageStore(out_color, pixel, color);
+        }
         if (kExpectedDepth) {
             imageStore(out_depth, pixel,
                        vec4(p.weight > 0.0 ? p.weighted_depth / p.weight : 0.0));

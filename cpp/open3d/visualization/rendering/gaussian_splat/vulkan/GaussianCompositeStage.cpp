@@ -72,15 +72,18 @@ VkDescriptorImageInfo StorageImage(VkImageView view) {
     return {VK_NULL_HANDLE, view, VK_IMAGE_LAYOUT_GENERAL};
 }
 
-// Specialised on kSpecSceneDepth and kSpecCompositeDepth. The depth merge declares no
-// kSpecCompositeDepth: Vulkan ignores a map entry whose ID the shader does not use.
+// Specialised on kSpecSceneDepth, kSpecCompositeDepth and kSpecColorBuffer. The depth merge
+// declares only the first: Vulkan ignores a map entry whose ID the shader does not use.
 UniquePipeline CreateSpecialised(const VulkanContext& context, VkPipelineLayout layout,
                                  std::span<const uint32_t> spirv, const char* name,
-                                 bool scene_depth, uint32_t depth_outputs = 0u) {
-    const std::array<uint32_t, 2> values{scene_depth ? 1u : 0u, depth_outputs};
-    const std::array<VkSpecializationMapEntry, 2> entries{
+                                 bool scene_depth, uint32_t depth_outputs = 0u,
+                                 bool color_buffer = false) {
+    const std::array<uint32_t, 3> values{scene_depth ? 1u : 0u, depth_outputs,
+                                         color_buffer ? 1u : 0u};
+    const std::array<VkSpecializationMapEntry, 3> entries{
         {{kSpecSceneDepth, 0, sizeof(uint32_t)},
-         {kSpecCompositeDepth, sizeof(uint32_t), sizeof(uint32_t)}}};
+         {kSpecCompositeDepth, sizeof(uint32_t), sizeof(uint32_t)},
+         {kSpecColorBuffer, 2 * sizeof(uint32_t), sizeof(uint32_t)}}};
     const VkSpecializationInfo specialization{static_cast<uint32_t>(entries.size()), entries.data(),
                                               sizeof(values), values.data()};
     return CreateComputePipeline(context, layout, spirv, name, &specialization);
@@ -115,6 +118,7 @@ GaussianCompositeStage::GaussianCompositeStage(const VulkanContext& context) : c
     composite[kCompositeCountBinding] = kBuffer;
     composite[kCompositeStateBinding] = kBuffer;
     composite[kCompositeSceneDepthBinding] = kSampled;
+    composite[kCompositeColorBufferBinding] = kBuffer;
     composite_set_layout_ = CreatePushLayout(context, composite);
     composite_layout_ = CreatePipelineLayout(context, composite_set_layout_.Get(),
                                              sizeof(GaussianCompositePushConstants));
@@ -138,15 +142,24 @@ VkDeviceSize GaussianCompositeStage::StateBytes(uint32_t width, uint32_t height)
     return sizeof(GaussianCompositeState) + sizeof(uint32_t) * 2 * tiles_x * tiles_y;
 }
 
+bool GaussianCompositeStage::ColorBufferFits(uint32_t width, uint32_t height,
+                                             VkDeviceSize offset) const {
+    const VulkanDeviceInfo& info = context_.GetDeviceInfo();
+    const uint64_t bytes = uint64_t(width) * height * 16;
+    return bytes <= info.max_storage_buffer_range &&
+           offset % info.min_storage_buffer_offset_alignment == 0;
+}
+
 VkPipeline GaussianCompositeStage::GetCompositePipeline(CompositeColorFormat format,
-                                                        const CompositeParams& params) {
+                                                        const CompositeParams& params,
+                                                        bool color_buffer) {
     const bool scene_depth = params.scene_depth != nullptr;
     const uint32_t depth_outputs = (params.expected_depth ? kCompositeExpectedDepthBit : 0u) |
                                    (params.median_depth ? kCompositeMedianDepthBit : 0u);
     static_assert(kCompositeExpectedDepthBit == 1u && kCompositeMedianDepthBit == 2u);
     const uint32_t format_index = static_cast<uint32_t>(format);
-    UniquePipeline& pipeline =
-        composite_[format_index * 8u + (scene_depth ? 4u : 0u) + depth_outputs];
+    UniquePipeline& pipeline = composite_[(color_buffer ? 24u : 0u) + format_index * 8u +
+                                          (scene_depth ? 4u : 0u) + depth_outputs];
     if (!pipeline) {
         std::span<const uint32_t> code = spirv::kGaussianComposite;
         const char* name = "gaussian_composite";
@@ -158,7 +171,7 @@ VkPipeline GaussianCompositeStage::GetCompositePipeline(CompositeColorFormat for
             name = "gaussian_composite_rgba8";
         }
         pipeline = CreateSpecialised(context_, composite_layout_.Get(), code, name, scene_depth,
-                                     depth_outputs);
+                                     depth_outputs, color_buffer);
     }
     return pipeline.Get();
 }
@@ -215,6 +228,22 @@ void GaussianCompositeStage::RecordComposite(VkCommandBuffer cmd,
         core::ThrowError(
             "GaussianCompositeStage: entry_count needs a buffer and a 4-byte aligned offset");
     }
+    const bool color_buffer = targets.color_buffer.buffer != VK_NULL_HANDLE;
+    const VkDeviceSize color_buffer_bytes = VkDeviceSize(targets.width) * targets.height * 16;
+    if (color_buffer) {
+        if (targets.color_format != CompositeColorFormat::kRgba32f) {
+            core::ThrowError("GaussianCompositeStage: a colour buffer takes RGBA32F only");
+        }
+        if (!ColorBufferFits(targets.width, targets.height, targets.color_buffer.offset) ||
+            (targets.color_buffer.size != VK_WHOLE_SIZE &&
+             targets.color_buffer.size < color_buffer_bytes)) {
+            core::ThrowError(
+                "GaussianCompositeStage: the colour buffer range (offset {}, {} bytes) cannot "
+                "hold a {}x{} RGBA32F image on this device",
+                targets.color_buffer.offset, targets.color_buffer.size, targets.width,
+                targets.height);
+        }
+    }
     const VkDeviceSize state_bytes = StateBytes(targets.width, targets.height);
     if (state.size != VK_WHOLE_SIZE && state.size < state_bytes) {
         core::ThrowError("GaussianCompositeStage: state holds {} bytes, a {}x{} image needs {}",
@@ -255,12 +284,19 @@ void GaussianCompositeStage::RecordComposite(VkCommandBuffer cmd,
     push.scene_near = params.scene_depth ? params.scene_depth->near_plane : 0.f;
 
     const VkDeviceSize entry_bytes = VkDeviceSize(std::max(inputs.entry_capacity, 1u)) * 4;
-    const std::array<VkDescriptorBufferInfo, 5> buffers{{
+    // Without a colour buffer the binding is never written (kSpecColorBuffer 0) but must hold
+    // a valid descriptor: the state buffer stands in.
+    const VkDescriptorBufferInfo color_buffer_info =
+        color_buffer ? VkDescriptorBufferInfo{targets.color_buffer.buffer,
+                                              targets.color_buffer.offset, color_buffer_bytes}
+                     : VkDescriptorBufferInfo{state.buffer, state.offset, state_bytes};
+    const std::array<VkDescriptorBufferInfo, 6> buffers{{
         {inputs.projected.buffer, inputs.projected.offset, inputs.projected.size},
         {inputs.entry_keys.buffer, inputs.entry_keys.offset, entry_bytes},
         {inputs.entry_values.buffer, inputs.entry_values.offset, entry_bytes},
         {inputs.entry_count.buffer, count_offset, VK_WHOLE_SIZE},
         {state.buffer, state.offset, state_bytes},
+        color_buffer_info,
     }};
     const std::array<VkDescriptorImageInfo, 5> images{{
         StorageImage(targets.color),
@@ -280,6 +316,7 @@ void GaussianCompositeStage::RecordComposite(VkCommandBuffer cmd,
         ImageWrite(kCompositeAlphaBinding, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, &images[2]),
         ImageWrite(kCompositeMedianDepthBinding, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, &images[3]),
         ImageWrite(kCompositeSceneDepthBinding, VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE, &images[4]),
+        BufferWrite(kCompositeColorBufferBinding, &buffers[5]),
     }};
     // Both pipelines share the layout: descriptors and push constants are set once.
     context_.GetCmdPushDescriptorSet()(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, composite_layout_.Get(),
@@ -299,7 +336,7 @@ void GaussianCompositeStage::RecordComposite(VkCommandBuffer cmd,
                         VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
                         VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
     vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE,
-                      GetCompositePipeline(targets.color_format, params));
+                      GetCompositePipeline(targets.color_format, params, color_buffer));
     vkCmdDispatch(cmd, workgroups, 1, 1);
 }
 

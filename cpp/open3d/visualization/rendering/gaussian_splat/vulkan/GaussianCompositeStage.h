@@ -76,6 +76,12 @@ struct CompositeStageTargets {
     /// R32F view z of the splat that brings 1 - T to >= 0.5; 0 where it never gets there.
     /// Written only with CompositeParams::median_depth.
     VkImageView median_depth = VK_NULL_HANDLE;
+    /// Optional, RGBA32F only: the colour goes here instead of `color` (which must still be
+    /// a valid view; it is left as it was): width x height vec4 row-major, the floats the
+    /// image would hold. A storage buffer range at a minStorageBufferOffsetAlignment offset,
+    /// at most maxStorageBufferRange bytes (ColorBufferFits). Batches use it to skip the
+    /// image-to-buffer copy. Synchronisation as for the images (COMPUTE_SHADER storage writes).
+    BufferRange color_buffer;
 };
 
 /// A sampled depth texture in Filament's convention: reversed-Z with an infinite far plane,
@@ -139,6 +145,9 @@ public:
     /// Bytes of the composite's state for a width x height image: shader::GaussianCompositeState
     /// (the work-stealing tile counter) and each tile's entry range, both rewritten per frame.
     static VkDeviceSize StateBytes(uint32_t width, uint32_t height);
+    /// Whether CompositeStageTargets::color_buffer can take a width x height RGBA32F image at
+    /// `offset` on this device (the binding's range limit and offset alignment).
+    bool ColorBufferFits(uint32_t width, uint32_t height, VkDeviceSize offset) const;
 
     /// Records the composite: zero `state` (vkCmdFillBuffer, StateBytes(width, height)), find
     /// each tile's range of the sorted entries (gaussian_tile_ranges.comp), then one dispatch
@@ -157,7 +166,8 @@ public:
                           const DepthMergeParams& params);
 
 private:
-    VkPipeline GetCompositePipeline(CompositeColorFormat format, const CompositeParams& params);
+    VkPipeline GetCompositePipeline(CompositeColorFormat format, const CompositeParams& params,
+                                    bool color_buffer);
     VkPipeline GetDepthMergePipeline(bool scene_depth);
     // The view and layout to bind for `scene_depth`; records the placeholder's transition
     // when it stands in.
@@ -170,8 +180,8 @@ private:
     UniqueDescriptorSetLayout merge_set_layout_;
     UniquePipelineLayout merge_layout_;
     UniquePipeline tile_ranges_;
-    // [format][scene depth][expected depth][median depth]
-    std::array<UniquePipeline, 24> composite_;  // format * 8 + scene depth * 4 + outputs
+    // [colour buffer][format][scene depth][expected depth][median depth]
+    std::array<UniquePipeline, 48> composite_;  // buffer * 24 + format * 8 + depth * 4 + outputs
     std::array<UniquePipeline, 2> merge_;       // [scene depth]
     Image placeholder_depth_;
 };
