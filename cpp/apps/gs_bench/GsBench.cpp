@@ -78,6 +78,8 @@ struct Row {
     // --batch: views per second (colour read back as float32 / uint8, or left on the GPU).
     double batch_float_vps = 0, batch_uint8_vps = 0, batch_gpu_only_vps = 0;
     double batch_float_into_buffer_vps = 0;  // float32 into one reused buffer
+    // Into rendering::BatchHostMemory (the device copies into it, no host copy).
+    double batch_float_host_memory_vps = 0, batch_uint8_host_memory_vps = 0;
     double batch_gpu_ms_per_view = 0;
     int batch_submissions = 0;
     bool has_error = false;
@@ -278,11 +280,12 @@ void PrintTable(const std::vector<Row>& rows) {
         }
         if (r.batch_float_vps > 0) {
             std::printf(
-                "%-11s batch: %.0f views/s float32 readback (%.0f into one reused buffer), %.0f "
-                "uint8 readback, %.0f on the GPU only; GPU %.3f ms/view, %d submission(s) per "
-                "batch\n",
-                "", r.batch_float_vps, r.batch_float_into_buffer_vps, r.batch_uint8_vps,
-                r.batch_gpu_only_vps, r.batch_gpu_ms_per_view, r.batch_submissions);
+                "%-11s batch: %.0f views/s float32 readback (%.0f into one reused buffer, %.0f "
+                "into BatchHostMemory), %.0f uint8 readback (%.0f into BatchHostMemory), %.0f on "
+                "the GPU only; GPU %.3f ms/view, %d submission(s) per batch\n",
+                "", r.batch_float_vps, r.batch_float_into_buffer_vps, r.batch_float_host_memory_vps,
+                r.batch_uint8_vps, r.batch_uint8_host_memory_vps, r.batch_gpu_only_vps,
+                r.batch_gpu_ms_per_view, r.batch_submissions);
         }
     }
 }
@@ -447,7 +450,17 @@ int Run(const Options& opt) {
                             bench::MeasureBatch(*vulkan, cams, config, o, opt.batch, repeats);
                         o.color_destination = nullptr;
                         row.batch_float_into_buffer_vps = b.views_per_second;
+                        // Into memory the device copies into directly (imported where the
+                        // device can: no host copy at all).
+                        o.color_memory = rendering::BatchHostMemory(buffer.size());
+                        row.batch_float_host_memory_vps =
+                            bench::MeasureBatch(*vulkan, cams, config, o, opt.batch, repeats)
+                                .views_per_second;
                         o.color_uint8 = true;
+                        row.batch_uint8_host_memory_vps =
+                            bench::MeasureBatch(*vulkan, cams, config, o, opt.batch, repeats)
+                                .views_per_second;
+                        o.color_memory = rendering::BatchHostMemory();
                         const bench::BatchThroughput u =
                             bench::MeasureBatch(*vulkan, cams, config, o, opt.batch, repeats);
                         o.read_back = false;
@@ -542,6 +555,8 @@ int Run(const Options& opt) {
                     {"views", opt.batch},
                     {"views_per_second_float32", r.batch_float_vps},
                     {"views_per_second_float32_into_buffer", r.batch_float_into_buffer_vps},
+                    {"views_per_second_float32_into_host_memory", r.batch_float_host_memory_vps},
+                    {"views_per_second_uint8_into_host_memory", r.batch_uint8_host_memory_vps},
                     {"views_per_second_uint8", r.batch_uint8_vps},
                     {"views_per_second_no_readback", r.batch_gpu_only_vps},
                     {"gpu_ms_per_view", r.batch_gpu_ms_per_view},

@@ -63,6 +63,22 @@ t::geometry::Image ColorToUInt8(const t::geometry::Image& color) {
     return out;
 }
 
+uint8_t* BatchColorDestination(const BatchOptions& options, size_t views, size_t view_bytes) {
+    if (!options.color_memory) return options.color_destination;
+    const BatchHostMemory& memory = options.color_memory;
+    uint8_t* destination =
+        options.color_destination != nullptr ? options.color_destination : memory.Data();
+    const size_t need = views * view_bytes;
+    if (destination < memory.Data() || destination > memory.Data() + memory.Size() ||
+        need > size_t(memory.Data() + memory.Size() - destination)) {
+        core::ThrowError(
+            "RenderBatch: {} views of {} bytes do not fit in the batch memory of {} bytes "
+            "from offset {}",
+            views, view_bytes, memory.Size(), static_cast<long long>(destination - memory.Data()));
+    }
+    return destination;
+}
+
 std::vector<RenderOutput> GaussianSplatBackend::RenderBatch(
     const std::vector<camera::PinholeCamera>& cameras, const RenderConfig& config,
     const BatchOptions& options) {
@@ -72,16 +88,22 @@ std::vector<RenderOutput> GaussianSplatBackend::RenderBatch(
     inputs.expected_depth = options.expected_depth;
     inputs.median_depth = options.median_depth;
     std::vector<RenderOutput> outputs;
+    if (cameras.empty()) return outputs;
     outputs.reserve(cameras.size());
+    uint8_t* const destination =
+        options.read_back ? BatchColorDestination(options, cameras.size(),
+                                                  size_t(cameras[0].width) * cameras[0].height * 4 *
+                                                      (options.color_uint8 ? 1 : 4))
+                          : nullptr;
     for (const camera::PinholeCamera& camera : cameras) {
         outputs.push_back(Render(camera, config, inputs));
-        if (options.color_destination != nullptr && options.read_back) {
+        if (destination != nullptr) {
             RenderOutput& out = outputs.back();
             const t::geometry::Image color =
                 options.color_uint8 ? ColorToUInt8(out.color) : std::move(out.color);
             const size_t bytes = static_cast<size_t>(color.AsTensor().NumBytes());
-            std::memcpy(options.color_destination + (outputs.size() - 1) * bytes,
-                        color.AsTensor().RawData(), bytes);
+            std::memcpy(destination + (outputs.size() - 1) * bytes, color.AsTensor().RawData(),
+                        bytes);
             out.color = t::geometry::Image();
             continue;
         }

@@ -12,6 +12,7 @@
 #include "open3d/camera/PinholeCamera.h"
 #include "open3d/t/geometry/Image.h"
 #include "open3d/t/geometry/PointCloud.h"
+#include "open3d/visualization/rendering/gaussian_splat/BatchHostMemory.h"
 #include "open3d/visualization/rendering/gaussian_splat/RenderConfig.h"
 
 namespace open3d {
@@ -65,7 +66,18 @@ struct BatchOptions {
     /// caller's memory (a numpy array from Python): no image per view is allocated and the
     /// colour is copied once, straight from the readback buffer.
     uint8_t* color_destination = nullptr;
+    /// With read_back, optional: memory the colours go into, view i at
+    /// color_destination + i * (view bytes) when color_destination points inside it, at
+    /// Data() + i * (view bytes) when color_destination is null. The Vulkan backend lets the
+    /// device copy straight into it (no copy on the host); other backends copy into it as
+    /// into any memory. The views must fit in it.
+    BatchHostMemory color_memory;
 };
+
+/// Where BatchOptions puts the colours of a batch of `views` views of `view_bytes` each:
+/// color_destination, else color_memory's start, else nullptr (into RenderOutput::color).
+/// Throws core::Open3DError when they would not fit in color_memory.
+uint8_t* BatchColorDestination(const BatchOptions& options, size_t views, size_t view_bytes);
 
 class GaussianSplatBackend {
 public:

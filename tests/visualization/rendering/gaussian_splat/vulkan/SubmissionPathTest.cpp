@@ -203,6 +203,79 @@ TEST_F(SubmissionPath, ColoursIntoTheCallersMemoryEqualTheImages) {
     }
 }
 
+// BatchHostMemory: the Vulkan backend imports it and the device copies the colours straight
+// into it (no host copy); each submission of a split batch lands at its own offset while the
+// slots' recordings are reused. The bytes equal an ordinary batch's images; memory outside
+// the views is left alone; too little memory is refused; the import is dropped once the
+// caller lets the memory go. The CPU backend copies into it as into any memory.
+TEST_F(SubmissionPath, ColoursIntoBatchHostMemoryEqualTheImages) {
+    auto vulkan = MakeBackend();
+    vulkan->SetFramesInFlight(2);  // two submissions at different offsets in flight at once
+    cpu::CpuBackend reference;
+    const t::geometry::PointCloud scene = CreateDefaultGaussianSplatScene();
+    vulkan->SetScene(scene);
+    reference.SetScene(scene);
+    const auto views = SlidingViews(6, 48, 32);
+    // 2 + 2 + 2 views: the first slot takes the first and the last submission, at two offsets.
+    vulkan->SetBatchBudget(2 * 48 * 32 * 16);
+    const bool imports = vulkan->GetContext().CanImportHostMemory();
+    if (std::getenv("CI") != nullptr) {
+        EXPECT_TRUE(imports) << "lavapipe has VK_EXT_external_memory_host: it must be used";
+    }
+    for (GaussianSplatBackend* backend : {static_cast<GaussianSplatBackend*>(vulkan.get()),
+                                          static_cast<GaussianSplatBackend*>(&reference)}) {
+        for (const bool uint8 : {false, true}) {
+            SCOPED_TRACE(backend->GetName() + (uint8 ? " uint8" : " float32"));
+            BatchOptions options;
+            options.color_uint8 = uint8;
+            const std::vector<RenderOutput> images = backend->RenderBatch(views, {}, options);
+            const size_t view_bytes = 48 * 32 * 4 * (uint8 ? 1 : 4);
+            BatchHostMemory memory((views.size() + 1) * view_bytes);
+            std::memset(memory.Data(), 0xAB, memory.Size());
+            options.color_memory = memory;
+            options.color_destination = memory.Data() + view_bytes;  // one view in
+            // By the third round both slots have recorded for this memory and reuse that.
+            for (int round = 0; round < 3; ++round) {
+                const int64_t recordings = vulkan->GetCounters().recordings;
+                const std::vector<RenderOutput> into = backend->RenderBatch(views, {}, options);
+                if (round == 2 && backend == vulkan.get()) {
+                    EXPECT_EQ(vulkan->GetCounters().recordings, recordings);
+                }
+                for (size_t i = 0; i < views.size(); ++i) {
+                    SCOPED_TRACE("view " + std::to_string(i));
+                    EXPECT_TRUE(into[i].color.IsEmpty());
+                    EXPECT_EQ(std::memcmp(memory.Data() + (i + 1) * view_bytes,
+                                          images[i].color.AsTensor().RawData(), view_bytes),
+                              0);
+                }
+                EXPECT_TRUE(std::all_of(memory.Data(), memory.Data() + view_bytes,
+                                        [](uint8_t b) { return b == 0xAB; }));
+                EXPECT_TRUE(std::all_of(memory.Data() + (views.size() + 1) * view_bytes,
+                                        memory.Data() + memory.Size(),
+                                        [](uint8_t b) { return b == 0xAB; }));
+            }
+            // As many views as the (rounded-up) memory holds fit from its start, not from
+            // the second view's place.
+            options.color_destination = nullptr;
+            const auto most = SlidingViews(static_cast<int>(memory.Size() / view_bytes), 48, 32);
+            EXPECT_NO_THROW(backend->RenderBatch(most, {}, options));
+            options.color_destination = memory.Data() + view_bytes;
+            try {
+                backend->RenderBatch(most, {}, options);
+                ADD_FAILURE() << most.size() << " views at one view's offset were accepted";
+            } catch (const core::Open3DError& e) {
+                EXPECT_NE(std::string(e.what()).find("do not fit in the batch memory"),
+                          std::string::npos)
+                    << e.what();
+            }
+        }
+    }
+    // One import per block (two blocks: float32 and uint8); the first was dropped once its
+    // memory went out of scope, when the second was imported.
+    EXPECT_EQ(vulkan->GetCounters().host_imports, imports ? 2 : 0);
+    EXPECT_EQ(vulkan->GetCounters().host_import_releases, imports ? 1 : 0);
+}
+
 TEST_F(SubmissionPath, FramesInFlightSurviveAResizeAndASceneChange) {
     // Two frames on the GPU at once: the first of the old scene at one size, the second of a
     // moved scene at another. The old scene's buffers must outlive the first frame (deferred

@@ -53,6 +53,7 @@ protected:
         // Readback copies then take the copy engines where the device has them (NVIDIA).
         handles.transfer_queue = Context().GetTransferQueue();
         handles.transfer_queue_family_index = Context().GetTransferQueueFamilyIndex();
+        handles.host_memory_import_enabled = Context().CanImportHostMemory();
         return handles;
     }
     static visualization::rendering::vulkan::CommandPool& Pool() { return *pool_; }

@@ -60,6 +60,14 @@ public:
     }
     ~Buffer() = default;
 
+    /// A buffer over `size` bytes of host memory at `data` that the caller allocated and
+    /// keeps allocated while the buffer exists (VK_EXT_external_memory_host): device copies
+    /// into the buffer land in that memory directly. `data` and `size` must be multiples of
+    /// VulkanContext::GetHostImportAlignment(). Not charged to the device budget (the memory
+    /// is the caller's). Throws core::Open3DError when the context cannot import it.
+    static Buffer ImportHost(const VulkanContext& context, void* data, VkDeviceSize size,
+                             VkBufferUsageFlags usage, bool shared_with_transfer = false);
+
     VkBuffer Get() const { return buffer_.Get(); }
     VkDeviceSize GetSize() const { return size_; }
     /// The whole buffer, or [offset, offset + size).

@@ -32,7 +32,9 @@ struct FrameRecordingKey {
     uint64_t scene_serial = 0;  ///< bumped by every scene, mask or precision upload
     GeometryStageChoices choices;
     RenderConfig config;
-    BatchOptions options;
+    BatchOptions options;  ///< without its destination (which the readback copy names)
+    /// The colours go to imported host memory: the slot keeps no host colour buffer.
+    bool color_imported = false;
     bool operator==(const FrameRecordingKey& other) const;
 };
 
@@ -55,11 +57,20 @@ struct FrameSlot {
     uint32_t view_capacity = 0;  ///< views the per-view buffers hold
 
     CommandBuffer cmd;
-    // With a transfer queue and readback: the copies to host memory run on the copy engines
-    // (transfer_cmd, after `rendered`), overlapping the next submission's compute work.
-    CommandBuffer transfer_cmd;
+    // With readback: the copies to host memory, in their own command buffer, re-recorded
+    // alone when only their destination changes (a batch split over imported memory puts
+    // each submission at another offset). With a transfer queue they run on the copy engines
+    // (after `rendered`), overlapping the next submission's compute work; without one they
+    // follow `cmd` on the same queue.
+    CommandBuffer copy_cmd;
     UniqueSemaphore rendered;
-    bool uses_transfer = false;     ///< of the recording
+    bool uses_transfer = false;  ///< of the recording
+    bool copy_recorded = false;  ///< copy_cmd matches the recording and the target below
+    /// Where the colours are copied: host_color at 0, or an imported buffer at an offset.
+    VkBuffer color_target = VK_NULL_HANDLE;
+    VkDeviceSize color_target_offset = 0;
+    VkBuffer copied_color_target = VK_NULL_HANDLE;  ///< what copy_cmd holds
+    VkDeviceSize copied_color_target_offset = 0;
     UniqueFence fence;              ///< the last submission of the job
     uint64_t serial = 0;            ///< of the last submission
     bool in_flight = false;         ///< submitted, fence not waited for yet
@@ -75,6 +86,7 @@ struct FrameSlot {
     std::vector<camera::PinholeCamera> cameras;
     RenderConfig config;
     BatchOptions options;
+    uint8_t* color_destination = nullptr;  ///< the caller's memory for the colours, if any
     double record_ms = 0.0, submit_ms = 0.0;
 };
 

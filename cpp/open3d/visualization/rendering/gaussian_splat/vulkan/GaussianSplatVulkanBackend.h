@@ -146,15 +146,17 @@ public:
 
     /// Counters that make the skips visible to tests and benchmarks.
     struct Counters {
-        int64_t scene_uploads = 0;       ///< packs + uploads of the scene
-        int64_t geometry_runs = 0;       ///< geometry stage recorded
-        int64_t geometry_reuses = 0;     ///< geometry stage skipped (nothing changed)
-        int64_t composites = 0;          ///< composite stage recorded
-        int64_t capacity_growths = 0;    ///< frames re-rendered with larger entry buffers
-        int64_t skipped_composites = 0;  ///< frames with no tile entry: images cleared instead
-        int64_t submissions = 0;         ///< submission path: command buffers submitted
-        int64_t recordings = 0;          ///< submission path: command buffers recorded
-        int64_t deferred_releases = 0;   ///< resources retired while frames were in flight
+        int64_t scene_uploads = 0;         ///< packs + uploads of the scene
+        int64_t geometry_runs = 0;         ///< geometry stage recorded
+        int64_t geometry_reuses = 0;       ///< geometry stage skipped (nothing changed)
+        int64_t composites = 0;            ///< composite stage recorded
+        int64_t capacity_growths = 0;      ///< frames re-rendered with larger entry buffers
+        int64_t skipped_composites = 0;    ///< frames with no tile entry: images cleared instead
+        int64_t submissions = 0;           ///< submission path: command buffers submitted
+        int64_t recordings = 0;            ///< submission path: command buffers recorded
+        int64_t deferred_releases = 0;     ///< resources retired while frames were in flight
+        int64_t host_imports = 0;          ///< BatchHostMemory blocks imported
+        int64_t host_import_releases = 0;  ///< imports dropped after their memory's last user
     };
     const Counters& GetCounters() const { return counters_; }
     const VulkanContext& GetContext() const { return *context_; }
@@ -171,6 +173,7 @@ private:
     FrameSlot& AcquireSlot();
     void PrepareSlot(FrameSlot& slot, const FrameRecordingKey& key);
     void RecordSlot(FrameSlot& slot, const FrameRecordingKey& key);
+    void RecordReadback(FrameSlot& slot);
     void SubmitSlot(FrameSlot& slot);
     void WaitSlot(FrameSlot& slot);
     void WaitAllSlots();
@@ -178,6 +181,17 @@ private:
                               const RenderConfig& config, const BatchOptions& options,
                               uint32_t entry_capacity) const;
     void EnsureScenePrecision(const RenderConfig& config);
+    // BatchHostMemory the device copies colours into (VK_EXT_external_memory_host), kept
+    // imported while the caller holds the memory and frames in flight still write it.
+    struct HostImport {
+        BatchHostMemory memory;
+        Buffer buffer;
+        uint64_t last_serial = 0;  ///< the last submission that writes it
+    };
+    /// The import of `memory`, made on first use; nullptr when the context cannot import
+    /// it (then the colours are copied on the host as into any memory). Drops imports whose
+    /// memory nobody else holds and no frame in flight writes.
+    HostImport* ImportHostMemory(const BatchHostMemory& memory);
     void RetireSceneBuffers(bool visibility_only);
     bool AnySlotBusy() const;
     /// Logs each error flag the first time a frame reports it.
@@ -238,6 +252,8 @@ private:
     bool growing_ = false;
 
     std::vector<std::unique_ptr<FrameSlot>> slots_;
+    std::vector<std::unique_ptr<HostImport>> host_imports_;
+    bool host_import_failed_ = false;  ///< warned once; later blocks are copied on the host
     DeferredReleaseQueue deferred_;
     uint64_t next_serial_ = 1;       ///< serial of the next submission of the submission path
     uint64_t completed_serial_ = 0;  ///< every submission up to it has completed

@@ -7,6 +7,7 @@
 #include <cstring>
 
 #include "open3d/core/Exception.h"
+#include "open3d/core/Logging.h"
 #include "open3d/core/ParallelFor.h"
 #include "open3d/core/Timer.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/GaussianSplatVulkanBackend.h"
@@ -97,7 +98,8 @@ bool FrameRecordingKey::operator==(const FrameRecordingKey& other) const {
     return views == other.views && width == other.width && height == other.height &&
            entry_capacity == other.entry_capacity && scene_serial == other.scene_serial &&
            SameChoices(choices, other.choices) && SameGeometryConfig(config, other.config) &&
-           config.background == other.config.background && SameOptions(options, other.options);
+           config.background == other.config.background && SameOptions(options, other.options) &&
+           color_imported == other.color_imported;
 }
 
 void GaussianSplatVulkanBackend::SetFramesInFlight(int count) {
@@ -164,6 +166,41 @@ void GaussianSplatVulkanBackend::EnsureScenePrecision(const RenderConfig& config
     geometry_.valid = false;
 }
 
+GaussianSplatVulkanBackend::HostImport* GaussianSplatVulkanBackend::ImportHostMemory(
+    const BatchHostMemory& memory) {
+    // Ours is the only reference left and nothing in flight writes it: let it go.
+    std::erase_if(host_imports_, [&](const std::unique_ptr<HostImport>& import) {
+        const bool unused =
+            import->memory.UseCount() == 1 && import->last_serial <= completed_serial_;
+        if (unused) ++counters_.host_import_releases;
+        return unused;
+    });
+    for (auto& import : host_imports_) {
+        if (import->memory.SameMemory(memory)) return import.get();
+    }
+    const uint64_t alignment = context_->GetHostImportAlignment();
+    if (!context_->CanImportHostMemory() || host_import_failed_ || alignment == 0 ||
+        reinterpret_cast<uintptr_t>(memory.Data()) % alignment != 0 ||
+        memory.Size() % alignment != 0) {
+        return nullptr;
+    }
+    auto import = std::make_unique<HostImport>();
+    try {
+        import->buffer = Buffer::ImportHost(*context_, memory.Data(), memory.Size(),
+                                            VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                                            /*shared_with_transfer=*/true);
+    } catch (const core::Open3DError& error) {
+        core::LogWarning("Vulkan backend: {}; batch colours are copied on the host instead",
+                         error.what());
+        host_import_failed_ = true;
+        return nullptr;
+    }
+    import->memory = memory;
+    ++counters_.host_imports;
+    host_imports_.push_back(std::move(import));
+    return host_imports_.back().get();
+}
+
 FrameSlot& GaussianSplatVulkanBackend::AcquireSlot() {
     // The slot whose last submission is oldest: with frames in flight it is usually done.
     FrameSlot* best = nullptr;
@@ -193,6 +230,10 @@ FrameRecordingKey GaussianSplatVulkanBackend::MakeKey(
     key.choices = geometry_stage_resources_.ViewParams(cameras[0], config, entry_capacity).choices;
     key.config = config;
     key.options = options;
+    // The destination is the readback copy's business (re-recorded alone when it changes),
+    // and a key must not keep the caller's memory alive.
+    key.options.color_destination = nullptr;
+    key.options.color_memory = BatchHostMemory();
     return key;
 }
 
@@ -226,7 +267,8 @@ void GaussianSplatVulkanBackend::PrepareSlot(FrameSlot& slot, const FrameRecordi
     const bool same_outputs = slot.params_upload && slot.view_capacity == key.views &&
                               slot.has_recording && slot.recorded.width == key.width &&
                               slot.recorded.height == key.height &&
-                              SameOptions(slot.recorded.options, key.options);
+                              SameOptions(slot.recorded.options, key.options) &&
+                              slot.recorded.color_imported == key.color_imported;
     if (!same_outputs) {
         const VkDeviceSize pixels = VkDeviceSize(key.width) * key.height;
         const auto per_view = [&](bool wanted, VkDeviceSize bytes, MemoryUsage memory,
@@ -249,7 +291,8 @@ void GaussianSplatVulkanBackend::PrepareSlot(FrameSlot& slot, const FrameRecordi
             per_view(on_device && o.expected_depth, pixels * 4, MemoryUsage::kDevice);
         slot.device_median =
             per_view(on_device && o.median_depth, pixels * 4, MemoryUsage::kDevice);
-        slot.host_color = per_view(o.read_back, color_bytes, MemoryUsage::kHostReadback);
+        slot.host_color =
+            per_view(o.read_back && !key.color_imported, color_bytes, MemoryUsage::kHostReadback);
         slot.host_depth =
             per_view(o.read_back && o.expected_depth, pixels * 4, MemoryUsage::kHostReadback);
         slot.host_median =
@@ -349,47 +392,49 @@ void GaussianSplatVulkanBackend::RecordSlot(FrameSlot& slot, const FrameRecordin
                                i * bytes);
         }
     }
-    // The host reads the counters (and, without a transfer queue, the images) after the fence.
-    slot.uses_transfer = key.options.read_back && context_->HasTransferQueue();
-    VkCommandBuffer copy_cmd = cmd;
-    if (slot.uses_transfer) {
-        if (slot.transfer_cmd.Get() == VK_NULL_HANDLE)
-            slot.transfer_cmd = transfer_pool_->Allocate();
-        if (!slot.rendered) slot.rendered = CreateBinarySemaphore(*context_);
-        slot.transfer_cmd.Begin(/*one_time_submit=*/false);
-        copy_cmd = slot.transfer_cmd.Get();
-    } else if (key.options.read_back) {
-        // The per-view copies and the composite's buffer writes to the readback copies.
-        RecordMemoryBarrier(cmd,
-                            VK_PIPELINE_STAGE_2_COPY_BIT | VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
-                            VK_ACCESS_2_TRANSFER_WRITE_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
-                            VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_READ_BIT);
-    }
-    if (key.options.read_back) {
-        // The whole batch to host memory: one linear copy per kind, on the copy engines when
-        // the context has a transfer queue (the semaphore orders it after the rendering).
-        const std::pair<const Buffer*, const Buffer*> readbacks[] = {
-            {&slot.device_color, &slot.host_color},
-            {&slot.device_depth, &slot.host_depth},
-            {&slot.device_median, &slot.host_median}};
-        for (const auto& [device, host] : readbacks) {
-            if (!*host) continue;
-            const VkBufferCopy region{0, 0, device->GetSize()};
-            vkCmdCopyBuffer(copy_cmd, device->Get(), host->Get(), 1, &region);
-        }
-    }
+    // The host reads the counters after the fence; the images reach it through copy_cmd.
     RecordMemoryBarrier(cmd, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
                         VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT);
-    if (slot.uses_transfer) {
-        RecordMemoryBarrier(copy_cmd, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
-                            VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT);
-        slot.transfer_cmd.End();
-    }
+    slot.uses_transfer = key.options.read_back && context_->HasTransferQueue();
+    slot.copy_recorded = false;
     slot.job_timestamps.RecordEnd(cmd, 0u);
     slot.cmd.End();
     slot.recorded = key;
     slot.has_recording = true;
     ++counters_.recordings;
+}
+
+void GaussianSplatVulkanBackend::RecordReadback(FrameSlot& slot) {
+    if (slot.copy_cmd.Get() == VK_NULL_HANDLE) {
+        slot.copy_cmd = slot.uses_transfer ? transfer_pool_->Allocate() : pool_.Allocate();
+    }
+    const VkCommandBuffer copy_cmd = slot.copy_cmd.Get();
+    slot.copy_cmd.Begin(/*one_time_submit=*/false);
+    if (!slot.uses_transfer) {
+        // Same queue, after cmd: its per-view copies and the composite's buffer writes first.
+        // (On the transfer queue the semaphore orders the copies after the rendering.)
+        RecordMemoryBarrier(copy_cmd,
+                            VK_PIPELINE_STAGE_2_COPY_BIT | VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                            VK_ACCESS_2_TRANSFER_WRITE_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
+                            VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_READ_BIT);
+    }
+    // The whole submission to host memory: one linear copy per kind.
+    const VkBufferCopy color{0, slot.color_target_offset, slot.device_color.GetSize()};
+    vkCmdCopyBuffer(copy_cmd, slot.device_color.Get(), slot.color_target, 1, &color);
+    for (const auto& [device, host] :
+         {std::pair<const Buffer*, const Buffer*>{&slot.device_depth, &slot.host_depth},
+          {&slot.device_median, &slot.host_median}}) {
+        if (!*host) continue;
+        const VkBufferCopy region{0, 0, device->GetSize()};
+        vkCmdCopyBuffer(copy_cmd, device->Get(), host->Get(), 1, &region);
+    }
+    RecordMemoryBarrier(copy_cmd, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                        VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT);
+    slot.copy_cmd.End();
+    if (slot.uses_transfer && !slot.rendered) slot.rendered = CreateBinarySemaphore(*context_);
+    slot.copied_color_target = slot.color_target;
+    slot.copied_color_target_offset = slot.color_target_offset;
+    slot.copy_recorded = true;
 }
 
 void GaussianSplatVulkanBackend::SubmitSlot(FrameSlot& slot) {
@@ -398,11 +443,22 @@ void GaussianSplatVulkanBackend::SubmitSlot(FrameSlot& slot) {
     } else {
         ResetFence(*context_, slot.fence.Get());
     }
+    const bool read_back = slot.recorded.options.read_back;
+    if (read_back && (!slot.copy_recorded || slot.copied_color_target != slot.color_target ||
+                      slot.copied_color_target_offset != slot.color_target_offset)) {
+        RecordReadback(slot);
+    }
     if (slot.uses_transfer) {
         SubmitToQueue(context_->GetQueue(), slot.cmd.Get(), VK_NULL_HANDLE, VK_NULL_HANDLE,
                       VK_PIPELINE_STAGE_2_NONE, slot.rendered.Get());
-        SubmitToQueue(context_->GetTransferQueue(), slot.transfer_cmd.Get(), slot.fence.Get(),
+        SubmitToQueue(context_->GetTransferQueue(), slot.copy_cmd.Get(), slot.fence.Get(),
                       slot.rendered.Get(), VK_PIPELINE_STAGE_2_COPY_BIT, VK_NULL_HANDLE);
+    } else if (read_back) {
+        // Two submissions to one queue: the fence of the second covers both.
+        SubmitToQueue(context_->GetQueue(), slot.cmd.Get(), VK_NULL_HANDLE, VK_NULL_HANDLE,
+                      VK_PIPELINE_STAGE_2_NONE, VK_NULL_HANDLE);
+        SubmitToQueue(context_->GetQueue(), slot.copy_cmd.Get(), slot.fence.Get(), VK_NULL_HANDLE,
+                      VK_PIPELINE_STAGE_2_NONE, VK_NULL_HANDLE);
     } else {
         Submit(*context_, slot.cmd.Get(), slot.fence.Get());
     }
@@ -437,8 +493,24 @@ uint64_t GaussianSplatVulkanBackend::SubmitBatch(const std::vector<camera::Pinho
                                   ? slot.view.EntryCapacity()
                                   : static_cast<uint32_t>(std::min<uint64_t>(
                                         MaxEntryCapacity(config), initial_entry_capacity_));
-    const FrameRecordingKey key = MakeKey(cameras, config, options, capacity);
+    FrameRecordingKey key = MakeKey(cameras, config, options, capacity);
+    const VkDeviceSize color_bytes = VkDeviceSize(w) * h * ColorBytesPerPixel(options);
+    uint8_t* const destination =
+        options.read_back ? BatchColorDestination(options, cameras.size(), color_bytes) : nullptr;
+    HostImport* import = destination != nullptr && options.color_memory
+                             ? ImportHostMemory(options.color_memory)
+                             : nullptr;
+    key.color_imported = import != nullptr;
     PrepareSlot(slot, key);
+    if (import != nullptr) {
+        slot.color_target = import->buffer.Get();
+        slot.color_target_offset = VkDeviceSize(destination - options.color_memory.Data());
+        import->last_serial = next_serial_;  // the serial SubmitSlot gives this submission
+    } else {
+        slot.color_target = slot.host_color ? slot.host_color.Get() : VK_NULL_HANDLE;
+        slot.color_target_offset = 0;
+    }
+    slot.color_destination = destination;
     auto* params = static_cast<GaussianViewParams*>(slot.params_upload.GetMapped());
     for (size_t i = 0; i < cameras.size(); ++i) {
         params[i] = geometry_stage_resources_.ViewParams(cameras[i], config, capacity).params;
@@ -449,7 +521,7 @@ uint64_t GaussianSplatVulkanBackend::SubmitBatch(const std::vector<camera::Pinho
     slot.recording_reused = reuse;
     slot.cameras = cameras;
     slot.config = config;
-    slot.options = options;
+    slot.options = key.options;
     const auto submit_start = std::chrono::steady_clock::now();
     SubmitSlot(slot);
     slot.submit_ms = core::MillisecondsSince(submit_start);
@@ -496,7 +568,8 @@ std::vector<RenderOutput> GaussianSplatVulkanBackend::WaitBatch(uint64_t ticket)
             static_cast<uint32_t>(std::min<uint64_t>(limit, asked + asked / 4));
         slot.view.Allocate(*context_, slot.view.NumSplats(), capacity);
         slot.has_recording = false;
-        const FrameRecordingKey key = MakeKey(slot.cameras, slot.config, slot.options, capacity);
+        FrameRecordingKey key = MakeKey(slot.cameras, slot.config, slot.options, capacity);
+        key.color_imported = slot.recorded.color_imported;
         PrepareSlot(slot, key);
         auto* params = static_cast<GaussianViewParams*>(slot.params_upload.GetMapped());
         for (size_t i = 0; i < views; ++i) {
@@ -533,10 +606,12 @@ std::vector<RenderOutput> GaussianSplatVulkanBackend::WaitBatch(uint64_t ticket)
         std::vector<CopyJob> jobs;
         for (size_t i = 0; i < views; ++i) {
             RenderOutput& out = outputs[i];
-            if (slot.options.color_destination != nullptr) {
+            if (slot.recorded.color_imported) {
+                // The device copied the colours into the caller's memory: nothing to do.
+            } else if (slot.color_destination != nullptr) {
                 // The caller's memory; this submission's first view is already there.
                 jobs.push_back(
-                    {slot.options.color_destination + i * color_bytes,
+                    {slot.color_destination + i * color_bytes,
                      static_cast<const uint8_t*>(slot.host_color.GetMapped()) + i * color_bytes,
                      static_cast<int64_t>(color_bytes)});
             } else {
@@ -583,6 +658,7 @@ std::vector<RenderOutput> GaussianSplatVulkanBackend::WaitBatch(uint64_t ticket)
     }
     slot.pending = false;
     slot.cameras.clear();
+    slot.color_destination = nullptr;
     last_batch_ = stats;
     return outputs;
 }
@@ -616,6 +692,10 @@ std::vector<RenderOutput> GaussianSplatVulkanBackend::RenderBatch(
     const uint32_t chunk = std::min<uint32_t>(
         fit, cameras.size() >= 8 ? static_cast<uint32_t>((cameras.size() + 3) / 4)
                                  : static_cast<uint32_t>(cameras.size()));
+    const uint64_t view_bytes =
+        uint64_t(cameras[0].width) * cameras[0].height * ColorBytesPerPixel(options);
+    uint8_t* const destination =
+        options.read_back ? BatchColorDestination(options, cameras.size(), view_bytes) : nullptr;
     // Submit up to one chunk per free slot ahead, collect in order.
     std::vector<uint64_t> tickets;
     size_t next = 0, collected = 0;
@@ -625,10 +705,7 @@ std::vector<RenderOutput> GaussianSplatVulkanBackend::RenderBatch(
         while (next < cameras.size() && tickets.size() < slots_.size()) {
             const size_t end = std::min(cameras.size(), next + chunk);
             BatchOptions part = options;  // the destination of this submission's first view
-            if (part.color_destination != nullptr) {
-                part.color_destination += next * uint64_t(cameras[0].width) * cameras[0].height *
-                                          ColorBytesPerPixel(options);
-            }
+            if (destination != nullptr) part.color_destination = destination + next * view_bytes;
             tickets.push_back(SubmitBatch(
                 std::vector<camera::PinholeCamera>(cameras.begin() + next, cameras.begin() + end),
                 config, part));

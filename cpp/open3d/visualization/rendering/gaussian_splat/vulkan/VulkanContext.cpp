@@ -299,9 +299,13 @@ std::unique_ptr<VulkanContext> VulkanContext::CreateHeadless(const VulkanContext
     const DeviceQuery chosen(best);
     const char* transfer_env = std::getenv("OPEN3D_VULKAN_TRANSFER_QUEUE");
     const bool transfer_wanted = transfer_env == nullptr || std::string(transfer_env) != "0";
-    context->InitDevice(best, *chosen.FindQueueFamily(),
-                        chosen.HasExtension(VK_KHR_EXTERNAL_MEMORY_FD_EXTENSION_NAME),
-                        transfer_wanted ? chosen.FindTransferFamily() : std::nullopt);
+    const char* import_env = std::getenv("OPEN3D_VULKAN_HOST_IMPORT");
+    const bool import_wanted = import_env == nullptr || std::string(import_env) != "0";
+    context->InitDevice(
+        best, *chosen.FindQueueFamily(),
+        chosen.HasExtension(VK_KHR_EXTERNAL_MEMORY_FD_EXTENSION_NAME),
+        transfer_wanted ? chosen.FindTransferFamily() : std::nullopt,
+        import_wanted && chosen.HasExtension(VK_EXT_EXTERNAL_MEMORY_HOST_EXTENSION_NAME));
     return context;
 }
 
@@ -339,12 +343,14 @@ std::unique_ptr<VulkanContext> VulkanContext::CreateFromBorrowed(
         context->transfer_family_ = handles.transfer_queue_family_index;
     }
     context->InitDevice(handles.physical_device, handles.queue_family_index,
-                        handles.external_memory_fd_enabled);
+                        handles.external_memory_fd_enabled, std::nullopt,
+                        handles.host_memory_import_enabled);
     return context;
 }
 
 void VulkanContext::InitDevice(VkPhysicalDevice physical_device, uint32_t queue_family_index,
-                               bool external_memory_fd, std::optional<uint32_t> transfer_family) {
+                               bool external_memory_fd, std::optional<uint32_t> transfer_family,
+                               bool host_memory_import) {
     physical_device_ = physical_device;
     DeviceQuery query(physical_device);
     if (owns_handles_) {
@@ -352,6 +358,9 @@ void VulkanContext::InitDevice(VkPhysicalDevice physical_device, uint32_t queue_
         std::vector<const char*> extensions(std::begin(kRequiredDeviceExtensions),
                                             std::end(kRequiredDeviceExtensions));
         if (external_memory_fd) extensions.push_back(VK_KHR_EXTERNAL_MEMORY_FD_EXTENSION_NAME);
+        if (host_memory_import) {
+            extensions.push_back(VK_EXT_EXTERNAL_MEMORY_HOST_EXTENSION_NAME);
+        }
         const float priority = 1.0f;
         std::vector<VkDeviceQueueCreateInfo> queue_infos(1);
         queue_infos[0] =
@@ -411,11 +420,25 @@ void VulkanContext::InitDevice(VkPhysicalDevice physical_device, uint32_t queue_
     std::copy(std::begin(query.ids.driverUUID), std::end(query.ids.driverUUID),
               info_.driver_uuid.begin());
 
-    LoadDeviceFunctions(external_memory_fd);
+    if (host_memory_import) {
+        VkPhysicalDeviceExternalMemoryHostPropertiesEXT host_import =
+            MakeInfo<VkPhysicalDeviceExternalMemoryHostPropertiesEXT>(
+                VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_EXTERNAL_MEMORY_HOST_PROPERTIES_EXT);
+        VkPhysicalDeviceProperties2 host_properties =
+            MakeInfo<VkPhysicalDeviceProperties2>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2);
+        host_properties.pNext = &host_import;
+        vkGetPhysicalDeviceProperties2(physical_device, &host_properties);
+        host_import_alignment_ = host_import.minImportedHostPointerAlignment;
+    }
+    LoadDeviceFunctions(external_memory_fd, host_memory_import);
     ReportDevice();
 }
 
-void VulkanContext::LoadDeviceFunctions(bool external_memory_fd) {
+void VulkanContext::LoadDeviceFunctions(bool external_memory_fd, bool host_memory_import) {
+    if (host_memory_import) {
+        get_host_pointer_properties_ = reinterpret_cast<PFN_vkGetMemoryHostPointerPropertiesEXT>(
+            vkGetDeviceProcAddr(device_, "vkGetMemoryHostPointerPropertiesEXT"));
+    }
     push_descriptor_set_ = reinterpret_cast<PFN_vkCmdPushDescriptorSetKHR>(
         vkGetDeviceProcAddr(device_, "vkCmdPushDescriptorSetKHR"));
     if (push_descriptor_set_ == nullptr) {
@@ -438,12 +461,14 @@ void VulkanContext::LoadDeviceFunctions(bool external_memory_fd) {
 void VulkanContext::ReportDevice() const {
     core::LogInfo(
         "Vulkan device: {} ({}), driver {} [{}], Vulkan {}, subgroup size {} (range {}..{}), "
-        "{} KiB shared memory, queue family {}{}, memory export {}, validation {}{}",
+        "{} KiB shared memory, queue family {}{}, memory export {}, host import {}, validation "
+        "{}{}",
         info_.name, info_.type, info_.driver_name, info_.driver_info,
         VersionString(info_.api_version), info_.subgroup_size, info_.min_subgroup_size,
         info_.max_subgroup_size, info_.max_compute_shared_memory / 1024, info_.queue_family_index,
         HasTransferQueue() ? fmt::format(" (+ transfer family {})", transfer_family_) : "",
-        SupportsExternalMemoryFd() ? "on" : "off", IsValidationEnabled() ? "on" : "off",
+        SupportsExternalMemoryFd() ? "on" : "off", CanImportHostMemory() ? "on" : "off",
+        IsValidationEnabled() ? "on" : "off",
         owns_handles_ ? "" : ", handles borrowed from the host application");
 }
 

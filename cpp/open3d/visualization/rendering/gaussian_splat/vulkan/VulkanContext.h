@@ -45,6 +45,9 @@ struct BorrowedVulkanHandles {
     /// The host created the device with VK_KHR_external_memory_fd (a context cannot ask a
     /// device which extensions it was created with): enables exporting image memory.
     bool external_memory_fd_enabled = false;
+    /// The host created the device with VK_EXT_external_memory_host: enables importing
+    /// BatchHostMemory (the device then copies batch colours straight into it).
+    bool host_memory_import_enabled = false;
     /// Optional: a queue of a transfer-only family (copy engines) that readback copies may
     /// use beside `queue`; VK_NULL_HANDLE for none.
     VkQueue transfer_queue = VK_NULL_HANDLE;
@@ -135,15 +138,27 @@ public:
     /// vkGetMemoryFdKHR of this device; nullptr unless SupportsExternalMemoryFd().
     PFN_vkGetMemoryFdKHR GetMemoryFd() const { return get_memory_fd_; }
 
+    /// True when VK_EXT_external_memory_host is enabled: host allocations can back buffers
+    /// (a batch's colours copied by the device straight into the caller's memory). Headless
+    /// contexts enable it whenever the device has it, unless the environment sets
+    /// OPEN3D_VULKAN_HOST_IMPORT=0; borrowed ones when BorrowedVulkanHandles says the host did.
+    bool CanImportHostMemory() const { return get_host_pointer_properties_ != nullptr; }
+    /// minImportedHostPointerAlignment: imported pointers and sizes are multiples of it.
+    uint64_t GetHostImportAlignment() const { return host_import_alignment_; }
+    /// vkGetMemoryHostPointerPropertiesEXT; nullptr unless CanImportHostMemory().
+    PFN_vkGetMemoryHostPointerPropertiesEXT GetMemoryHostPointerProperties() const {
+        return get_host_pointer_properties_;
+    }
+
     /// vkDeviceWaitIdle; for teardown and tests, not for frames.
     void WaitIdle() const;
 
 private:
     VulkanContext();
     void InitDevice(VkPhysicalDevice physical_device, uint32_t queue_family_index,
-                    bool external_memory_fd,
-                    std::optional<uint32_t> transfer_family = std::nullopt);
-    void LoadDeviceFunctions(bool external_memory_fd);
+                    bool external_memory_fd, std::optional<uint32_t> transfer_family = std::nullopt,
+                    bool host_memory_import = false);
+    void LoadDeviceFunctions(bool external_memory_fd, bool host_memory_import);
     void ReportDevice() const;
 
     bool owns_handles_ = false;
@@ -160,6 +175,8 @@ private:
     DeviceMemoryBudget memory_budget_;
     PFN_vkCmdPushDescriptorSetKHR push_descriptor_set_ = nullptr;
     PFN_vkGetMemoryFdKHR get_memory_fd_ = nullptr;
+    PFN_vkGetMemoryHostPointerPropertiesEXT get_host_pointer_properties_ = nullptr;
+    uint64_t host_import_alignment_ = 0;
     VulkanDeviceInfo info_;
 };
 
