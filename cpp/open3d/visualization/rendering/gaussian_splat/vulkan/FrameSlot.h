@@ -66,7 +66,10 @@ struct FrameSlot {
     UniqueSemaphore rendered;
     bool uses_transfer = false;  ///< of the recording
     bool copy_recorded = false;  ///< copy_cmd matches the recording and the target below
-    /// Where the colours are copied: host_color at 0, or an imported buffer at an offset.
+    /// With FrameRecordingKey::color_imported: the imported buffer and offset of this batch.
+    VkBuffer imported_target = VK_NULL_HANDLE;
+    VkDeviceSize imported_target_offset = 0;
+    /// Where the colours are copied (set by SubmitSlot): host_color at 0, or the import.
     VkBuffer color_target = VK_NULL_HANDLE;
     VkDeviceSize color_target_offset = 0;
     VkBuffer copied_color_target = VK_NULL_HANDLE;  ///< what copy_cmd holds

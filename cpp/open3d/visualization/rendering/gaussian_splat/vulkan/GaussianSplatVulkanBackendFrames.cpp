@@ -444,6 +444,10 @@ void GaussianSplatVulkanBackend::SubmitSlot(FrameSlot& slot) {
         ResetFence(*context_, slot.fence.Get());
     }
     const bool read_back = slot.recorded.options.read_back;
+    // Decided here, after any reallocation of the slot's buffers (a capacity growth
+    // re-prepares the slot and replaces host_color).
+    slot.color_target = slot.recorded.color_imported ? slot.imported_target : slot.host_color.Get();
+    slot.color_target_offset = slot.recorded.color_imported ? slot.imported_target_offset : 0;
     if (read_back && (!slot.copy_recorded || slot.copied_color_target != slot.color_target ||
                       slot.copied_color_target_offset != slot.color_target_offset)) {
         RecordReadback(slot);
@@ -503,12 +507,9 @@ uint64_t GaussianSplatVulkanBackend::SubmitBatch(const std::vector<camera::Pinho
     key.color_imported = import != nullptr;
     PrepareSlot(slot, key);
     if (import != nullptr) {
-        slot.color_target = import->buffer.Get();
-        slot.color_target_offset = VkDeviceSize(destination - options.color_memory.Data());
+        slot.imported_target = import->buffer.Get();
+        slot.imported_target_offset = VkDeviceSize(destination - options.color_memory.Data());
         import->last_serial = next_serial_;  // the serial SubmitSlot gives this submission
-    } else {
-        slot.color_target = slot.host_color ? slot.host_color.Get() : VK_NULL_HANDLE;
-        slot.color_target_offset = 0;
     }
     slot.color_destination = destination;
     auto* params = static_cast<GaussianViewParams*>(slot.params_upload.GetMapped());
@@ -684,14 +685,17 @@ std::vector<RenderOutput> GaussianSplatVulkanBackend::RenderBatch(
     std::vector<RenderOutput> outputs;
     if (cameras.empty()) return outputs;
     outputs.reserve(cameras.size());
-    // At least four submissions for eight views or more, so the host copies one out while
-    // the GPU renders the next (one submission of all views leaves the GPU idle during the
-    // copies and the host idle during the rendering).
+    // Several submissions, so one is copied out while the GPU renders the next (one
+    // submission of all views leaves the GPU idle during the copies and the host idle during
+    // the rendering): four for eight views or more, eight for sixteen or more. The first
+    // submission's rendering and the last one's copy overlap nothing, so smaller parts waste
+    // less: 64 RGBA32F 800x800 views read back into imported memory on an H200 reached 1,976
+    // views/s in four parts (docs/perf/h200.md).
     const uint32_t fit = MaxViewsPerSubmission(static_cast<uint32_t>(cameras[0].width),
                                                static_cast<uint32_t>(cameras[0].height), options);
-    const uint32_t chunk = std::min<uint32_t>(
-        fit, cameras.size() >= 8 ? static_cast<uint32_t>((cameras.size() + 3) / 4)
-                                 : static_cast<uint32_t>(cameras.size()));
+    const size_t parts = cameras.size() >= 16 ? 8 : cameras.size() >= 8 ? 4 : 1;
+    const uint32_t chunk =
+        std::min<uint32_t>(fit, static_cast<uint32_t>((cameras.size() + parts - 1) / parts));
     const uint64_t view_bytes =
         uint64_t(cameras[0].width) * cameras[0].height * ColorBytesPerPixel(options);
     uint8_t* const destination =
