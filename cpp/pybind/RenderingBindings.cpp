@@ -181,9 +181,11 @@ public:
         return depth ? filament_->RenderToDepthImage(true) : filament_->RenderToImage();
     }
 
-    /// Renders into `destination` (N x H x W x 4 elements of float32, or uint8 with `uint8`).
+    /// Renders into `destination` (N x H x W x 4 elements of float32, or uint8 with `uint8`),
+    /// which lies in `memory` when that is set (the device then copies into it directly).
     void RenderBatch(const std::vector<camera::PinholeCamera>& cameras, bool uint8,
-                     uint8_t* destination) {
+                     uint8_t* destination,
+                     const visualization::rendering::BatchHostMemory& memory = {}) {
         if (filament_) {
             core::ThrowError("render_batch: batches are for splat-only renderers (meshes=False)");
         }
@@ -193,6 +195,7 @@ public:
         visualization::rendering::BatchOptions options;
         options.color_uint8 = uint8;
         options.color_destination = destination;
+        options.color_memory = memory;
         py::gil_scoped_release release;
         renderer_->Prepare();
         // The batch replaces the view's sorted entries in the backend.
@@ -223,6 +226,41 @@ private:
 };
 
 using Offscreen = std::shared_ptr<SplatOffscreen>;
+
+// Arrays from OffscreenRenderer.batch_array own a BatchHostMemory through a capsule of this
+// name at the root of their base chain; render_batch(out=) finds it there.
+constexpr const char* kBatchMemoryCapsule = "open3d_gs.BatchHostMemory";
+
+py::array BatchArray(const std::vector<py::ssize_t>& shape, bool uint8) {
+    size_t bytes = uint8 ? 1 : 4;
+    for (py::ssize_t d : shape) bytes *= static_cast<size_t>(d);
+    auto* memory = new visualization::rendering::BatchHostMemory(bytes);
+    // The PyObject* destructor form: pybind11 2.10 (Debian 12) names no void* one with a name.
+    py::capsule owner(memory, kBatchMemoryCapsule, [](PyObject* capsule) {
+        delete static_cast<visualization::rendering::BatchHostMemory*>(
+            PyCapsule_GetPointer(capsule, kBatchMemoryCapsule));
+    });
+    if (uint8) return py::array_t<uint8_t>(shape, memory->Data(), owner);
+    return py::array_t<float>(shape, reinterpret_cast<float*>(memory->Data()), owner);
+}
+
+// The BatchHostMemory an array's data lies in (a batch_array or a view of one), or none.
+visualization::rendering::BatchHostMemory BatchMemoryOf(const py::array& array) {
+    py::handle base = array.base();
+    while (base && !base.is_none()) {
+        if (PyCapsule_CheckExact(base.ptr())) {
+            const char* name = PyCapsule_GetName(base.ptr());
+            if (name != nullptr && std::string(name) == kBatchMemoryCapsule) {
+                return *static_cast<visualization::rendering::BatchHostMemory*>(
+                    PyCapsule_GetPointer(base.ptr(), name));
+            }
+            return {};
+        }
+        if (!py::isinstance<py::array>(base)) return {};
+        base = py::reinterpret_borrow<py::array>(base).base();
+    }
+    return {};
+}
 
 struct SplatScene {
     Offscreen renderer;
@@ -428,15 +466,29 @@ void BindRendering(py::module_& m) {
                 } else {
                     images = py::array_t<float>(shape);
                 }
-                // Rendered straight into the array: one copy from the device's readback buffer.
-                r.RenderBatch(cameras, uint8, static_cast<uint8_t*>(images.mutable_data()));
+                // Rendered straight into the array: one copy from the device's readback buffer,
+                // none on the host when it is a batch_array.
+                r.RenderBatch(cameras, uint8, static_cast<uint8_t*>(images.mutable_data()),
+                              BatchMemoryOf(images));
                 return images;
             },
             py::arg("cameras"), py::arg("dtype") = "float32", py::arg("out") = py::none(),
             "(N, H, W, 4) for N cameras in one call: float32 premultiplied RGBA, or uint8 RGBA "
             "(the device's rounding); each equals render_to_image of that camera. `out`: an "
             "array of that shape and dtype to render into (reused across calls, it saves "
-            "allocating and faulting in fresh memory each time)");
+            "allocating and faulting in fresh memory each time); one from batch_array is "
+            "written by the GPU directly (Vulkan), with no copy on the host")
+        .def(
+            "batch_array",
+            [](SplatOffscreen& r, int count, const std::string& dtype) {
+                CheckDtype(dtype);
+                if (count < 1) core::ThrowError("batch_array: count must be >= 1, not {}", count);
+                return BatchArray({py::ssize_t(count), r.Height(), r.Width(), 4}, dtype == "uint8");
+            },
+            py::arg("count"), py::arg("dtype") = "float32",
+            "An uninitialised (count, H, W, 4) array for render_batch(out=...): page-aligned "
+            "host memory that the Vulkan backend lets the GPU write directly (no copy on the "
+            "host; the fastest readback). Any renderer of this size accepts it");
 }
 
 }  // namespace pybind

@@ -69,6 +69,22 @@ def test_batch_equals_single_renders(data, backend):
     batch8 = r.render_batch([v.camera for v in views], "uint8")
     assert batch8.dtype == np.uint8
     assert np.abs(batch8 / 255.0 - np.clip(batch, 0, 1)).max() <= 1.0 / 255 + 1e-6
+    # Into a batch_array (on Vulkan the GPU writes it directly): the same bytes, in both
+    # dtypes, also through a view of one; it outlives the renderer that made it.
+    for dtype, expected in (("float32", batch), ("uint8", batch8)):
+        arr = r.batch_array(3, dtype)
+        assert arr.shape == (3, 96, 96, 4) and arr.dtype == expected.dtype
+        assert arr.ctypes.data % 65536 == 0
+        arr.fill(7)
+        assert r.render_batch([v.camera for v in views], dtype, out=arr) is arr
+        np.testing.assert_array_equal(arr, expected, err_msg=dtype)
+    big = r.batch_array(4)
+    big.fill(-1)
+    r.render_batch([v.camera for v in views], out=big[1:])
+    np.testing.assert_array_equal(big[1:], batch)
+    assert (big[0] == -1).all()
+    del r
+    assert big.sum() != 0  # still readable after the renderer is gone
 
 
 def rss_mb():
