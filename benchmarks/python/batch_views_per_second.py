@@ -26,16 +26,21 @@ def main():
     r = o3d.visualization.rendering.OffscreenRenderer(args.size[0], args.size[1], args.backend)
     r.scene.add_geometry("scene", o3d.t.io.read_point_cloud(args.scene))
     for dtype in ("uint8", "float32"):
-        for reuse in (False, True):
+        # A new array per call, one numpy array reused, one batch_array reused (the GPU
+        # writes it directly on Vulkan).
+        for mode in ("new array", "out= reused", "out=batch_array"):
             out = r.render_batch(cameras, dtype)  # warm-up: pipelines, buffers, clocks
+            if mode == "out=batch_array":
+                out = r.batch_array(args.batch, dtype)
+            reused = out if mode != "new array" else None
             for _ in range(2):
-                r.render_batch(cameras, dtype, out=out if reuse else None)
+                r.render_batch(cameras, dtype, out=reused)
             batches, start = 0, time.monotonic()
             while time.monotonic() - start < args.seconds:
-                r.render_batch(cameras, dtype, out=out if reuse else None)
+                r.render_batch(cameras, dtype, out=reused)
                 batches += 1
             seconds = time.monotonic() - start
-            print(f"python render_batch {dtype}{', out= reused' if reuse else ', new array'}: "
+            print(f"python render_batch {dtype}, {mode}: "
                   f"{batches * args.batch / seconds:.0f} views/s ({batches} batches of {args.batch} "
                   f"at {args.size[0]}x{args.size[1]}, {r.backend})", flush=True)
 
