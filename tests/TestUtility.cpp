@@ -2,6 +2,8 @@
 
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 
 namespace open3d {
 namespace tests {
@@ -47,6 +49,11 @@ ScopedEnvironment::~ScopedEnvironment() {
     } else {
         unsetenv(name_.c_str());
     }
+}
+
+std::vector<uint8_t> ReadFileBytes(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    return std::vector<uint8_t>(std::istreambuf_iterator<char>(in), {});
 }
 
 }  // namespace tests

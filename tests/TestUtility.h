@@ -4,7 +4,9 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdint>
 #include <string>
+#include <vector>
 
 namespace open3d {
 namespace tests {
@@ -17,6 +19,9 @@ std::string DataPath(const std::string& relative);
 bool FileExists(const std::string& path);
 /// A fresh, empty folder for this test under $TMPDIR/open3d_tests (left for inspection).
 std::string TempDir();
+
+/// The bytes of a file (empty when it cannot be read).
+std::vector<uint8_t> ReadFileBytes(const std::string& path);
 /// True in CI (environment CI=true): there a test that lacks an X display, a Vulkan device,
 /// a tool or a shared scene fails instead of skipping, so the suite cannot pass by skipping.
 bool SkipsAreFailures();

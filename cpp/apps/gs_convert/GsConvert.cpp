@@ -5,17 +5,59 @@
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <optional>
 #include <string>
 
+#include <unistd.h>
+
 #include "open3d/core/Exception.h"
+#include "open3d/core/Progress.h"
 #include "open3d/core/Timer.h"
 #include "open3d/t/io/OutputFiles.h"
 #include "open3d/t/io/PointCloudIO.h"
 
+namespace {
+
+// A one-line bar on stderr for the stages the readers and writers report
+// (core::ReportProgress): drawn only on a terminal, only once the conversion has taken 0.3 s
+// (small files show none), at most ten times a second, and erased when done.
+class ProgressBar {
+public:
+    void Update(const char* stage, double fraction) {
+        const double ms = open3d::core::MillisecondsSince(start_);
+        if (ms < 300.0) return;
+        if (stage_ == stage && ms - drawn_ms_ < 100.0 && fraction < 1.0) return;
+        stage_ = stage;
+        drawn_ms_ = ms;
+        constexpr int kWidth = 30;
+        const int filled = static_cast<int>(fraction * kWidth + 0.5);
+        std::fprintf(stderr, "\r%-12s [%s%s] %3d%%  %.1f s", stage,
+                     std::string(filled, '#').c_str(), std::string(kWidth - filled, '.').c_str(),
+                     static_cast<int>(fraction * 100.0), ms / 1000.0);
+        std::fflush(stderr);
+        shown_ = true;
+    }
+    /// Erases the bar (before a line of output; the next update draws it again).
+    void Clear() {
+        if (shown_) std::fprintf(stderr, "\r%70s\r", "");
+        shown_ = false;
+        stage_.clear();
+    }
+    ~ProgressBar() { Clear(); }
+
+private:
+    std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
+    std::string stage_;
+    double drawn_ms_ = 0.0;
+    bool shown_ = false;
+};
+
+}  // namespace
+
 int main(int argc, char** argv) {
     using namespace open3d;
     std::string input, output;
-    bool drop_non_finite = false, force = false;
+    bool drop_non_finite = false, force = false, no_progress = false;
     CLI::App app{
         "gs-convert: converts a Gaussian splat scene between file formats.\n"
         "Reads .ply, .compressed.ply, .splat, .spz, .sog (or a SOG folder / its meta.json),\n"
@@ -32,6 +74,9 @@ int main(int argc, char** argv) {
     app.add_flag("--drop-non-finite", drop_non_finite,
                  "Drop splats with NaN or Inf values instead of refusing the file");
     app.add_flag("-f,--force", force, "Overwrite the output if it exists");
+    app.add_flag("--no-progress", no_progress,
+                 "No progress bar (drawn on a terminal for conversions longer than 0.3 s: "
+                 "reading, decoding, clustering and compressing as they happen)");
     CLI11_PARSE(app, argc, argv);
     try {
         // The output is checked before the input is read: a bad extension or folder fails
@@ -43,11 +88,18 @@ int main(int argc, char** argv) {
             core::ThrowError("'{}' exists; pass --force to overwrite it", output);
         }
         const auto start = std::chrono::steady_clock::now();
+        std::optional<ProgressBar> bar;
+        std::optional<core::ScopedProgressCallback> progress;
+        if (!no_progress && ::isatty(STDERR_FILENO)) {
+            bar.emplace();
+            progress.emplace([&bar](const char* stage, double f) { bar->Update(stage, f); });
+        }
         t::geometry::PointCloud cloud;
         t::io::ReadPointCloudOptions options;
         options.drop_non_finite = drop_non_finite;
         const t::io::PointCloudFileFormat format = t::io::DetectPointCloudFileFormat(input);
         const auto report = t::io::ReadPointCloud(input, cloud, options);
+        if (bar) bar->Clear();
         std::printf("read %s (%s): %lld splats, SH degree %d\n", input.c_str(),
                     t::io::PointCloudFileFormatName(format),
                     static_cast<long long>(report.num_points),
@@ -57,6 +109,8 @@ int main(int argc, char** argv) {
         t::io::OutputFileSet files;
         t::io::WritePointCloud(files.Add(output), cloud);
         files.Commit();
+        progress.reset();
+        bar.reset();  // erases the line before the summary
         std::printf("wrote %s (%llu bytes) in %.0f ms\n", output.c_str(),
                     static_cast<unsigned long long>(std::filesystem::file_size(output)),
                     core::MillisecondsSince(start));

@@ -8,6 +8,7 @@
 #include "TestUtility.h"
 #include "open3d/core/Exception.h"
 #include "open3d/core/Logging.h"
+#include "open3d/core/Progress.h"
 #include "open3d/t/geometry/SphericalHarmonics.h"
 #include "open3d/t/io/FileFormats.h"
 #include "open3d/t/io/PointCloudIO.h"
@@ -49,6 +50,62 @@ PointCloud RandomCloud(int64_t n, int degree, uint32_t seed) {
                                           [&] { return 0.2f * normal(rng); }));
     }
     return cloud;
+}
+
+// What a progress callback sees (gs-convert's bar): per stage, fractions that never go back
+// and end at 1. The values read or written are those of a run without a callback.
+struct ProgressLog {
+    std::vector<std::pair<std::string, double>> reports;
+    core::ScopedProgressCallback Install() {
+        return core::ScopedProgressCallback(
+            [this](const char* stage, double f) { reports.emplace_back(stage, f); });
+    }
+    void ExpectStage(const std::string& stage) const {
+        double last = -1.0;
+        int seen = 0;
+        for (const auto& [name, f] : reports) {
+            if (name != stage) continue;
+            EXPECT_GE(f, last) << stage;
+            last = f;
+            ++seen;
+        }
+        EXPECT_GT(seen, 2) << stage << " was reported " << seen << " times";
+        EXPECT_EQ(last, 1.0) << stage;
+    }
+};
+
+TEST(RoundTrip, LargeFilesReportProgress) {
+    const std::string dir = tests::TempDir();
+    // 1.25M splats of SH 0: a 70 MB PLY, above the 64 MB from which reading is reported in
+    // blocks and the 1M vertices from which decoding is.
+    const PointCloud large = RandomCloud(1250000, 0, 21);
+    WritePointCloud(dir + "/large.ply", large);
+    PointCloud quiet, watched;
+    ReadPointCloud(dir + "/large.ply", quiet);
+    ProgressLog log;
+    {
+        const core::ScopedProgressCallback installed = log.Install();
+        ReadPointCloud(dir + "/large.ply", watched);
+    }
+    log.ExpectStage("reading");
+    log.ExpectStage("decoding");
+    EXPECT_TRUE(watched == quiet);
+    // SOG: more distinct SH vectors than a palette holds are clustered, then every image is
+    // compressed; the file equals one written without a callback.
+    const PointCloud sh = RandomCloud(70000, 1, 22);
+    WritePointCloud(dir + "/quiet.sog", sh);
+    ProgressLog sog;
+    {
+        const core::ScopedProgressCallback installed = sog.Install();
+        WritePointCloud(dir + "/watched.sog", sh);
+    }
+    sog.ExpectStage("clustering");
+    sog.ExpectStage("compressing");
+    EXPECT_EQ(tests::ReadFileBytes(dir + "/watched.sog"), tests::ReadFileBytes(dir + "/quiet.sog"));
+    // Outside a scope nothing is called.
+    const size_t before = sog.reports.size();
+    WritePointCloud(dir + "/again.sog", sh);
+    EXPECT_EQ(sog.reports.size(), before);
 }
 
 TEST(RoundTrip, PlyIsExactInEveryEncoding) {

@@ -8,6 +8,7 @@
 #include <unordered_map>
 
 #include "open3d/core/ParallelFor.h"
+#include "open3d/core/Progress.h"
 #include "open3d/t/io/SogLayout.h"
 
 namespace open3d {
@@ -160,7 +161,11 @@ std::vector<float> Palette(const float* rows, int64_t n, int dims, std::vector<i
     std::vector<int32_t> sample_labels(sample_size);
     std::vector<double> sums(k * dims);
     std::vector<int64_t> counts(k);
+    // Progress ("clustering"): the iterations on the sample, then the assignment of every row
+    // (as long as the iterations together), in 16 reported blocks.
+    const double kFitShare = 0.5;
     for (int it = 0; it < kIterations; ++it) {
+        core::ReportProgress("clustering", kFitShare * it / kIterations);
         assign(
             sample_size, [&](int64_t i) { return sample[i]; }, sample_labels.data());
         std::fill(sums.begin(), sums.end(), 0.0);
@@ -177,8 +182,14 @@ std::vector<float> Palette(const float* rows, int64_t n, int dims, std::vector<i
             }
         }
     }
-    assign(
-        n, [](int64_t i) { return i; }, labels.data());
+    constexpr int64_t kBlocks = 16;
+    for (int64_t b = 0; b < kBlocks; ++b) {
+        core::ReportProgress("clustering", kFitShare + (1.0 - kFitShare) * b / kBlocks);
+        const int64_t begin = n * b / kBlocks, end = n * (b + 1) / kBlocks;
+        assign(
+            end - begin, [begin](int64_t i) { return begin + i; }, labels.data() + begin);
+    }
+    core::ReportProgress("clustering", 1.0);
     std::vector<float> palette(k * dims);
     for (int64_t p = 0; p < k; ++p) {
         for (int j = 0; j < dims; ++j) palette[p * dims + j] = columns[j * k + p];

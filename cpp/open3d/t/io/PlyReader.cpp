@@ -9,6 +9,7 @@
 #include "open3d/core/Exception.h"
 #include "open3d/core/Logging.h"
 #include "open3d/core/ParallelFor.h"
+#include "open3d/core/Progress.h"
 #include "open3d/t/io/FileFormats.h"
 #include "open3d/t/io/PlyHeader.h"
 #include "open3d/t/io/SplatColumns.h"
@@ -143,24 +144,32 @@ void ReadBinaryVertices(const PlyElement& vertex, const std::vector<Field>& fiel
     for (const Field& f : fields) {
         all_float = all_float && vertex.properties[f.property].type == PlyType::Float32;
     }
-    core::ParallelForRange(
-        vertex.count,
-        [&](int64_t begin, int64_t end) {
-            for (int64_t i = begin; i < end; ++i) {
-                const uint8_t* row = data + i * stride;
-                for (const Field& f : fields) {
-                    const PlyProperty& p = vertex.properties[f.property];
-                    if (all_float) {
-                        float value;
-                        std::memcpy(&value, row + p.offset, 4);
-                        Store(f, i, value);
-                    } else {
-                        Store(f, i, LoadValue(row + p.offset, p.type, swap));
+    // In 32 reported blocks when someone watches (the same values either way).
+    const int64_t blocks =
+        core::HasProgressCallback() && vertex.count > (int64_t(1) << 20) ? 32 : 1;
+    for (int64_t b = 0; b < blocks; ++b) {
+        if (blocks > 1) core::ReportProgress("decoding", double(b) / blocks);
+        const int64_t first = vertex.count * b / blocks;
+        core::ParallelForRange(
+            vertex.count * (b + 1) / blocks - first,
+            [&](int64_t begin, int64_t end) {
+                for (int64_t i = first + begin; i < first + end; ++i) {
+                    const uint8_t* row = data + i * stride;
+                    for (const Field& f : fields) {
+                        const PlyProperty& p = vertex.properties[f.property];
+                        if (all_float) {
+                            float value;
+                            std::memcpy(&value, row + p.offset, 4);
+                            Store(f, i, value);
+                        } else {
+                            Store(f, i, LoadValue(row + p.offset, p.type, swap));
+                        }
                     }
                 }
-            }
-        },
-        2048);
+            },
+            2048);
+    }
+    if (blocks > 1) core::ReportProgress("decoding", 1.0);
 }
 
 // Cursor over whitespace-separated ASCII tokens.

@@ -16,6 +16,7 @@
 #include "open3d/core/Exception.h"
 #include "open3d/core/Logging.h"
 #include "open3d/core/ParallelFor.h"
+#include "open3d/core/Progress.h"
 #include "open3d/t/geometry/SphericalHarmonics.h"
 #include "open3d/t/io/Codebook.h"
 #include "open3d/t/io/FileFormats.h"
@@ -247,10 +248,19 @@ void WriteSog(const std::string& filename, const geometry::PointCloud& cloud) {
                        {"files", Json::array({"shN_centroids.webp", "shN_labels.webp"})}};
     }
 
+    // Lossless WebP, images in parallel; in pairs with a progress report after each when
+    // someone watches (the last step of a large scene takes seconds).
     std::vector<std::vector<uint8_t>> encoded(images.size());
-    core::ParallelFor(
-        int64_t(images.size()),
-        [&](int64_t k) { encoded[k] = EncodeWebpLossless(images[k].second); }, 1);
+    const int64_t wave = core::HasProgressCallback() ? 2 : int64_t(images.size());
+    for (int64_t first = 0; first < int64_t(images.size()); first += wave) {
+        core::ReportProgress("compressing", double(first) / images.size());
+        const int64_t count = std::min<int64_t>(wave, int64_t(images.size()) - first);
+        core::ParallelFor(
+            count,
+            [&](int64_t k) { encoded[first + k] = EncodeWebpLossless(images[first + k].second); },
+            1);
+    }
+    core::ReportProgress("compressing", 1.0);
     ZipWriter zip;
     for (size_t k = 0; k < images.size(); ++k) zip.Add(images[k].first, encoded[k]);
     const std::string text = meta.dump();

@@ -18,6 +18,7 @@
 #include "open3d/core/HostMemory.h"
 #include "open3d/core/Logging.h"
 #include "open3d/core/ParallelFor.h"
+#include "open3d/core/Progress.h"
 #include "open3d/core/RegularFile.h"
 
 namespace open3d {
@@ -70,11 +71,26 @@ MappedFile::MappedFile(const std::string& filename) {
         ::close(fd);
         core::ThrowError("'{}' is empty", filename);
     }
-    // MAP_POPULATE maps the whole file in one go instead of one page fault per 4 KiB.
-    void* p = ::mmap(nullptr, size_, PROT_READ, MAP_PRIVATE | MAP_POPULATE, fd, 0);
+    // MAP_POPULATE maps the whole file in one go instead of one page fault per 4 KiB. With a
+    // progress callback a large file is populated in blocks instead, reported as "reading"
+    // (the disk is then what a large file waits for).
+    constexpr size_t kBlock = size_t(16) << 20;
+    const bool report = core::HasProgressCallback() && size_ > 4 * kBlock;
+    void* p = ::mmap(nullptr, size_, PROT_READ, MAP_PRIVATE | (report ? 0 : MAP_POPULATE), fd, 0);
     ::close(fd);
     if (p == MAP_FAILED) core::ThrowError("Cannot map '{}': {}", filename, std::strerror(errno));
     data_ = static_cast<const uint8_t*>(p);
+    if (report) {
+        const size_t page = static_cast<size_t>(::sysconf(_SC_PAGESIZE));
+        for (size_t at = 0; at < size_; at += kBlock) {
+            core::ReportProgress("reading", double(at) / size_);
+            const size_t end = std::min(size_, at + kBlock);
+            ::madvise(const_cast<uint8_t*>(data_) + at, end - at, MADV_WILLNEED);
+            volatile uint8_t sink = 0;
+            for (size_t q = at; q < end; q += page) sink = sink + data_[q];  // fault the pages in
+        }
+        core::ReportProgress("reading", 1.0);
+    }
 }
 
 MappedFile::~MappedFile() {
