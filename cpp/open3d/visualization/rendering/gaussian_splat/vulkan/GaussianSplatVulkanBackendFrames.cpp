@@ -687,13 +687,15 @@ std::vector<RenderOutput> GaussianSplatVulkanBackend::RenderBatch(
     outputs.reserve(cameras.size());
     // Several submissions, so one is copied out while the GPU renders the next (one
     // submission of all views leaves the GPU idle during the copies and the host idle during
-    // the rendering): four for eight views or more, eight for sixteen or more. The first
-    // submission's rendering and the last one's copy overlap nothing, so smaller parts waste
-    // less: 64 RGBA32F 800x800 views read back into imported memory on an H200 reached 1,976
-    // views/s in four parts (docs/perf/h200.md).
+    // the rendering): parts of four views (up to sixteen parts), four parts for eight to
+    // fifteen views. The first part's rendering and the last one's copy overlap nothing, so
+    // smaller parts waste less: 64 RGBA32F 800x800 views read back into imported memory on an
+    // H200 reached 1,976 views/s in four parts, 1,991-2,001 in eight (docs/perf/h200.md).
     const uint32_t fit = MaxViewsPerSubmission(static_cast<uint32_t>(cameras[0].width),
                                                static_cast<uint32_t>(cameras[0].height), options);
-    const size_t parts = cameras.size() >= 16 ? 8 : cameras.size() >= 8 ? 4 : 1;
+    const size_t parts = cameras.size() >= 16  ? std::min<size_t>(16, cameras.size() / 4)
+                         : cameras.size() >= 8 ? 4
+                                               : 1;
     const uint32_t chunk =
         std::min<uint32_t>(fit, static_cast<uint32_t>((cameras.size() + parts - 1) / parts));
     const uint64_t view_bytes =
