@@ -189,9 +189,11 @@ private:
         uint64_t last_serial = 0;  ///< the last submission that writes it
     };
     /// The import of `memory`, made on first use; nullptr when the context cannot import
-    /// it (then the colours are copied on the host as into any memory). Drops imports whose
-    /// memory nobody else holds and no frame in flight writes.
+    /// it (then the colours are copied on the host as into any memory).
     HostImport* ImportHostMemory(const BatchHostMemory& memory);
+    /// Drops the imports whose memory nobody else holds and no frame in flight writes (every
+    /// submission checks, so a dropped BatchHostMemory is freed by the next one).
+    void ReleaseUnusedImports();
     void RetireSceneBuffers(bool visibility_only);
     bool AnySlotBusy() const;
     /// Logs each error flag the first time a frame reports it.

@@ -166,15 +166,19 @@ void GaussianSplatVulkanBackend::EnsureScenePrecision(const RenderConfig& config
     geometry_.valid = false;
 }
 
-GaussianSplatVulkanBackend::HostImport* GaussianSplatVulkanBackend::ImportHostMemory(
-    const BatchHostMemory& memory) {
-    // Ours is the only reference left and nothing in flight writes it: let it go.
+void GaussianSplatVulkanBackend::ReleaseUnusedImports() {
+    // Ours is the only reference left and nothing in flight writes it: let it go (the
+    // memory is freed with it).
     std::erase_if(host_imports_, [&](const std::unique_ptr<HostImport>& import) {
         const bool unused =
             import->memory.UseCount() == 1 && import->last_serial <= completed_serial_;
         if (unused) ++counters_.host_import_releases;
         return unused;
     });
+}
+
+GaussianSplatVulkanBackend::HostImport* GaussianSplatVulkanBackend::ImportHostMemory(
+    const BatchHostMemory& memory) {
     for (auto& import : host_imports_) {
         if (import->memory.SameMemory(memory)) return import.get();
     }
@@ -491,6 +495,7 @@ uint64_t GaussianSplatVulkanBackend::SubmitBatch(const std::vector<camera::Pinho
     const auto start = std::chrono::steady_clock::now();
     EnsureScenePrecision(config);
     FrameSlot& slot = AcquireSlot();
+    ReleaseUnusedImports();
     const uint32_t n = static_cast<uint32_t>(geometry_stage_resources_.Layout().num_splats);
     // A slot keeps the capacity it grew to for this scene.
     const uint32_t capacity = slot.view && slot.view.NumSplats() == n
