@@ -76,9 +76,9 @@ struct ProgressLog {
 
 TEST(RoundTrip, LargeFilesReportProgress) {
     const std::string dir = tests::TempDir();
-    // 1.25M splats of SH 0: a 70 MB PLY, above the 64 MB from which reading is reported in
-    // blocks and the 1M vertices from which decoding is.
-    const PointCloud large = RandomCloud(1250000, 0, 21);
+    // 320k splats of SH 0: an 18 MB PLY, above the 16 MiB from which reading is reported in
+    // blocks and the 2^18 vertices from which decoding is.
+    const PointCloud large = RandomCloud(320000, 0, 21);
     WritePointCloud(dir + "/large.ply", large);
     PointCloud quiet, watched;
     ReadPointCloud(dir + "/large.ply", quiet);

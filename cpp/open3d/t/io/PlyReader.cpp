@@ -146,7 +146,7 @@ void ReadBinaryVertices(const PlyElement& vertex, const std::vector<Field>& fiel
     }
     // In 32 reported blocks when someone watches (the same values either way).
     const int64_t blocks =
-        core::HasProgressCallback() && vertex.count > (int64_t(1) << 20) ? 32 : 1;
+        core::HasProgressCallback() && vertex.count > (int64_t(1) << 18) ? 32 : 1;
     for (int64_t b = 0; b < blocks; ++b) {
         if (blocks > 1) core::ReportProgress("decoding", double(b) / blocks);
         const int64_t first = vertex.count * b / blocks;

@@ -254,6 +254,18 @@ TEST_F(SubmissionPath, ColoursIntoBatchHostMemoryEqualTheImages) {
                                         memory.Data() + memory.Size(),
                                         [](uint8_t b) { return b == 0xAB; }));
             }
+            // Five views (2 + 2 + 1: the last part reuses buffers made for two) land in five
+            // views' room, not a byte further.
+            std::memset(memory.Data(), 0xAB, memory.Size());
+            backend->RenderBatch({views.begin(), views.begin() + 5}, {}, options);
+            for (size_t i = 0; i < 5; ++i) {
+                EXPECT_EQ(std::memcmp(memory.Data() + (i + 1) * view_bytes,
+                                      images[i].color.AsTensor().RawData(), view_bytes),
+                          0)
+                    << "five views, view " << i;
+            }
+            EXPECT_TRUE(std::all_of(memory.Data() + 6 * view_bytes, memory.Data() + memory.Size(),
+                                    [](uint8_t b) { return b == 0xAB; }));
             // As many views as the (rounded-up) memory holds fit from its start, not from
             // the second view's place.
             options.color_destination = nullptr;

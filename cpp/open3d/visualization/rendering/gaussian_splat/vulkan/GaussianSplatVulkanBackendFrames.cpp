@@ -268,7 +268,9 @@ void GaussianSplatVulkanBackend::PrepareSlot(FrameSlot& slot, const FrameRecordi
         slot.color_format = format;
         slot.has_recording = false;
     }
-    const bool same_outputs = slot.params_upload && slot.view_capacity == key.views &&
+    // Per-view buffers for more views than this submission has serve it too (the last part of
+    // a split batch, or a smaller batch, then re-records without re-allocating).
+    const bool same_outputs = slot.params_upload && slot.view_capacity >= key.views &&
                               slot.has_recording && slot.recorded.width == key.width &&
                               slot.recorded.height == key.height &&
                               SameOptions(slot.recorded.options, key.options) &&
@@ -422,14 +424,17 @@ void GaussianSplatVulkanBackend::RecordReadback(FrameSlot& slot) {
                             VK_ACCESS_2_TRANSFER_WRITE_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
                             VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_READ_BIT);
     }
-    // The whole submission to host memory: one linear copy per kind.
-    const VkBufferCopy color{0, slot.color_target_offset, slot.device_color.GetSize()};
+    // The whole submission to host memory: one linear copy per kind, of the submission's views
+    // (the buffers may hold more).
+    const FrameRecordingKey& key = slot.recorded;
+    const VkDeviceSize pixels = VkDeviceSize(key.width) * key.height * key.views;
+    const VkBufferCopy color{0, slot.color_target_offset, pixels * ColorBytesPerPixel(key.options)};
     vkCmdCopyBuffer(copy_cmd, slot.device_color.Get(), slot.color_target, 1, &color);
     for (const auto& [device, host] :
          {std::pair<const Buffer*, const Buffer*>{&slot.device_depth, &slot.host_depth},
           {&slot.device_median, &slot.host_median}}) {
         if (!*host) continue;
-        const VkBufferCopy region{0, 0, device->GetSize()};
+        const VkBufferCopy region{0, 0, pixels * 4};
         vkCmdCopyBuffer(copy_cmd, device->Get(), host->Get(), 1, &region);
     }
     RecordMemoryBarrier(copy_cmd, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
@@ -692,15 +697,16 @@ std::vector<RenderOutput> GaussianSplatVulkanBackend::RenderBatch(
     outputs.reserve(cameras.size());
     // Several submissions, so one is copied out while the GPU renders the next (one
     // submission of all views leaves the GPU idle during the copies and the host idle during
-    // the rendering): parts of four views (up to sixteen parts), four parts for eight to
-    // fifteen views. The first part's rendering and the last one's copy overlap nothing, so
-    // smaller parts waste less: 64 RGBA32F 800x800 views read back into imported memory on an
-    // H200 reached 1,976 views/s in four parts, 1,991-2,001 in eight (docs/perf/h200.md).
+    // the rendering): four for eight views or more, eight for sixteen or more. The first
+    // part's rendering and the last one's copy overlap nothing, which smaller parts shorten,
+    // but each part costs host work: 64 RGBA32F 800x800 views read back into imported memory
+    // on an H200 reached 1,976 views/s in four parts, 1,988-2,001 in eight and 1,957-1,959 in
+    // sixteen (docs/perf/h200.md). Parts are of one size: a slot's recording and per-view
+    // buffers are for one view count, so a smaller first part (tried: 2 + 7 x 8 + 6 views)
+    // re-recorded and re-allocated at every submission, 1,451-1,602 views/s.
     const uint32_t fit = MaxViewsPerSubmission(static_cast<uint32_t>(cameras[0].width),
                                                static_cast<uint32_t>(cameras[0].height), options);
-    const size_t parts = cameras.size() >= 16  ? std::min<size_t>(16, cameras.size() / 4)
-                         : cameras.size() >= 8 ? 4
-                                               : 1;
+    const size_t parts = cameras.size() >= 16 ? 8 : cameras.size() >= 8 ? 4 : 1;
     const uint32_t chunk =
         std::min<uint32_t>(fit, static_cast<uint32_t>((cameras.size() + parts - 1) / parts));
     const uint64_t view_bytes =
