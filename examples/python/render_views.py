@@ -46,10 +46,12 @@ def main():
     out.mkdir(parents=True, exist_ok=True)
     renderer = o3d.visualization.rendering.OffscreenRenderer(width, height, args.backend)
     renderer.scene.add_geometry("scene", o3d.t.io.read_point_cloud(args.scene))
+    # One array for every batch, in memory the GPU writes directly (no copy on the host).
+    batch = renderer.batch_array(args.batch, "uint8")
     start = time.monotonic()
     for first in range(0, len(views), args.batch):
         chunk = views[first:first + args.batch]
-        images = renderer.render_batch([v.camera for v in chunk], "uint8")
+        images = renderer.render_batch([v.camera for v in chunk], "uint8", out=batch[:len(chunk)])
         for i, image in enumerate(images):
             write_png(out / f"view_{first + i:03d}.png", np.ascontiguousarray(image[..., :3]))
         done = first + len(chunk)
