@@ -65,14 +65,12 @@ struct FrameSlot {
     CommandBuffer copy_cmd;
     UniqueSemaphore rendered;
     bool uses_transfer = false;  ///< of the recording
-    bool copy_recorded = false;  ///< copy_cmd matches the recording and the target below
     /// With FrameRecordingKey::color_imported: the imported buffer and offset of this batch.
     VkBuffer imported_target = VK_NULL_HANDLE;
     VkDeviceSize imported_target_offset = 0;
-    /// Where the colours are copied (set by SubmitSlot): host_color at 0, or the import.
-    VkBuffer color_target = VK_NULL_HANDLE;
-    VkDeviceSize color_target_offset = 0;
-    VkBuffer copied_color_target = VK_NULL_HANDLE;  ///< what copy_cmd holds
+    /// Where copy_cmd copies the colours (host_color at 0, or the import); VK_NULL_HANDLE
+    /// when copy_cmd must be recorded again (a new recording).
+    VkBuffer copied_color_target = VK_NULL_HANDLE;
     VkDeviceSize copied_color_target_offset = 0;
     UniqueFence fence;              ///< the last submission of the job
     uint64_t serial = 0;            ///< of the last submission

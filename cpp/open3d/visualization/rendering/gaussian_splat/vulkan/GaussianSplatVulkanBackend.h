@@ -173,7 +173,9 @@ private:
     FrameSlot& AcquireSlot();
     void PrepareSlot(FrameSlot& slot, const FrameRecordingKey& key);
     void RecordSlot(FrameSlot& slot, const FrameRecordingKey& key);
-    void RecordReadback(FrameSlot& slot);
+    /// Records the slot's copies to host memory, the colours to `color_target` at
+    /// `color_offset`.
+    void RecordReadback(FrameSlot& slot, VkBuffer color_target, VkDeviceSize color_offset);
     void SubmitSlot(FrameSlot& slot);
     void WaitSlot(FrameSlot& slot);
     void WaitAllSlots();

@@ -402,7 +402,7 @@ void GaussianSplatVulkanBackend::RecordSlot(FrameSlot& slot, const FrameRecordin
     RecordMemoryBarrier(cmd, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
                         VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT);
     slot.uses_transfer = key.options.read_back && context_->HasTransferQueue();
-    slot.copy_recorded = false;
+    slot.copied_color_target = VK_NULL_HANDLE;  // copy_cmd is recorded again before use
     slot.job_timestamps.RecordEnd(cmd, 0u);
     slot.cmd.End();
     slot.recorded = key;
@@ -410,7 +410,8 @@ void GaussianSplatVulkanBackend::RecordSlot(FrameSlot& slot, const FrameRecordin
     ++counters_.recordings;
 }
 
-void GaussianSplatVulkanBackend::RecordReadback(FrameSlot& slot) {
+void GaussianSplatVulkanBackend::RecordReadback(FrameSlot& slot, VkBuffer color_target,
+                                                VkDeviceSize color_offset) {
     if (slot.copy_cmd.Get() == VK_NULL_HANDLE) {
         slot.copy_cmd = slot.uses_transfer ? transfer_pool_->Allocate() : pool_.Allocate();
     }
@@ -428,8 +429,8 @@ void GaussianSplatVulkanBackend::RecordReadback(FrameSlot& slot) {
     // (the buffers may hold more).
     const FrameRecordingKey& key = slot.recorded;
     const VkDeviceSize pixels = VkDeviceSize(key.width) * key.height * key.views;
-    const VkBufferCopy color{0, slot.color_target_offset, pixels * ColorBytesPerPixel(key.options)};
-    vkCmdCopyBuffer(copy_cmd, slot.device_color.Get(), slot.color_target, 1, &color);
+    const VkBufferCopy color{0, color_offset, pixels * ColorBytesPerPixel(key.options)};
+    vkCmdCopyBuffer(copy_cmd, slot.device_color.Get(), color_target, 1, &color);
     for (const auto& [device, host] :
          {std::pair<const Buffer*, const Buffer*>{&slot.device_depth, &slot.host_depth},
           {&slot.device_median, &slot.host_median}}) {
@@ -441,9 +442,8 @@ void GaussianSplatVulkanBackend::RecordReadback(FrameSlot& slot) {
                         VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT);
     slot.copy_cmd.End();
     if (slot.uses_transfer && !slot.rendered) slot.rendered = CreateBinarySemaphore(*context_);
-    slot.copied_color_target = slot.color_target;
-    slot.copied_color_target_offset = slot.color_target_offset;
-    slot.copy_recorded = true;
+    slot.copied_color_target = color_target;
+    slot.copied_color_target_offset = color_offset;
 }
 
 void GaussianSplatVulkanBackend::SubmitSlot(FrameSlot& slot) {
@@ -453,13 +453,14 @@ void GaussianSplatVulkanBackend::SubmitSlot(FrameSlot& slot) {
         ResetFence(*context_, slot.fence.Get());
     }
     const bool read_back = slot.recorded.options.read_back;
-    // Decided here, after any reallocation of the slot's buffers (a capacity growth
+    // Taken here, after any reallocation of the slot's buffers (a capacity growth
     // re-prepares the slot and replaces host_color).
-    slot.color_target = slot.recorded.color_imported ? slot.imported_target : slot.host_color.Get();
-    slot.color_target_offset = slot.recorded.color_imported ? slot.imported_target_offset : 0;
-    if (read_back && (!slot.copy_recorded || slot.copied_color_target != slot.color_target ||
-                      slot.copied_color_target_offset != slot.color_target_offset)) {
-        RecordReadback(slot);
+    const bool imported = slot.recorded.color_imported;
+    const VkBuffer color_target = imported ? slot.imported_target : slot.host_color.Get();
+    const VkDeviceSize color_offset = imported ? slot.imported_target_offset : 0;
+    if (read_back && (slot.copied_color_target != color_target ||
+                      slot.copied_color_target_offset != color_offset)) {
+        RecordReadback(slot, color_target, color_offset);
     }
     if (slot.uses_transfer) {
         SubmitToQueue(context_->GetQueue(), slot.cmd.Get(), VK_NULL_HANDLE, VK_NULL_HANDLE,
