@@ -39,6 +39,9 @@ std::optional<std::string> GetEnv(const char* name) {
     return std::string(value);
 }
 
+// An optional feature is on unless the environment variable `name` is "0".
+bool NotTurnedOff(const char* name) { return GetEnv(name) != std::string("0"); }
+
 std::string VersionString(uint32_t version) {
     return fmt::format("{}.{}.{}", VK_API_VERSION_MAJOR(version), VK_API_VERSION_MINOR(version),
                        VK_API_VERSION_PATCH(version));
@@ -297,15 +300,12 @@ std::unique_ptr<VulkanContext> VulkanContext::CreateHeadless(const VulkanContext
         core::ThrowError("Vulkan: no usable device.{}\n{}", rejected, kInstallHint);
     }
     const DeviceQuery chosen(best);
-    const char* transfer_env = std::getenv("OPEN3D_VULKAN_TRANSFER_QUEUE");
-    const bool transfer_wanted = transfer_env == nullptr || std::string(transfer_env) != "0";
-    const char* import_env = std::getenv("OPEN3D_VULKAN_HOST_IMPORT");
-    const bool import_wanted = import_env == nullptr || std::string(import_env) != "0";
     context->InitDevice(
         best, *chosen.FindQueueFamily(),
         chosen.HasExtension(VK_KHR_EXTERNAL_MEMORY_FD_EXTENSION_NAME),
-        transfer_wanted ? chosen.FindTransferFamily() : std::nullopt,
-        import_wanted && chosen.HasExtension(VK_EXT_EXTERNAL_MEMORY_HOST_EXTENSION_NAME));
+        NotTurnedOff("OPEN3D_VULKAN_TRANSFER_QUEUE") ? chosen.FindTransferFamily() : std::nullopt,
+        NotTurnedOff("OPEN3D_VULKAN_HOST_IMPORT") &&
+            chosen.HasExtension(VK_EXT_EXTERNAL_MEMORY_HOST_EXTENSION_NAME));
     return context;
 }
 
