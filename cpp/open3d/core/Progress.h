@@ -18,7 +18,7 @@ using ProgressCallback = std::function<void(const char* stage, double fraction)>
 /// True when the calling thread has a callback installed (work may then split itself into
 /// reportable steps).
 bool HasProgressCallback();
-/// Calls the calling thread's callback with `stage` ("reading", "decoding", "encoding",
+/// Calls the calling thread's callback with `stage` ("reading", "decoding", "clustering",
 /// "compressing") and `fraction` clamped to [0, 1]; nothing without one.
 void ReportProgress(const char* stage, double fraction);
 

@@ -163,7 +163,7 @@ std::vector<float> Palette(const float* rows, int64_t n, int dims, std::vector<i
     std::vector<int64_t> counts(k);
     // Progress ("clustering"): the iterations on the sample, then the assignment of every row
     // (as long as the iterations together), in 16 reported blocks.
-    const double kFitShare = 0.5;
+    constexpr double kFitShare = 0.5;
     for (int it = 0; it < kIterations; ++it) {
         core::ReportProgress("clustering", kFitShare * it / kIterations);
         assign(

@@ -73,8 +73,7 @@ MappedFile::MappedFile(const std::string& filename) {
     }
     // MAP_POPULATE maps the whole file in one go instead of one page fault per 4 KiB. With a
     // progress callback a file above 16 MiB is populated in 4 MiB blocks instead, reported as
-    // "reading"
-    // (the disk is then what a large file waits for).
+    // "reading" (the disk is then what a large file waits for).
     constexpr size_t kBlock = size_t(4) << 20;
     const bool report = core::HasProgressCallback() && size_ > 4 * kBlock;
     void* p = ::mmap(nullptr, size_, PROT_READ, MAP_PRIVATE | (report ? 0 : MAP_POPULATE), fd, 0);
