@@ -3,6 +3,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <functional>
 #include <random>
 
 #include "TestUtility.h"
@@ -56,9 +57,11 @@ PointCloud RandomCloud(int64_t n, int degree, uint32_t seed) {
 // and end at 1. The values read or written are those of a run without a callback.
 struct ProgressLog {
     std::vector<std::pair<std::string, double>> reports;
-    core::ScopedProgressCallback Install() {
-        return core::ScopedProgressCallback(
+    /// Runs `work` with this log as the thread's progress callback.
+    void Watch(const std::function<void()>& work) {
+        const core::ScopedProgressCallback installed(
             [this](const char* stage, double f) { reports.emplace_back(stage, f); });
+        work();
     }
     void ExpectStage(const std::string& stage) const {
         double last = -1.0;
@@ -83,10 +86,7 @@ TEST(RoundTrip, LargeFilesReportProgress) {
     PointCloud quiet, watched;
     ReadPointCloud(dir + "/large.ply", quiet);
     ProgressLog log;
-    {
-        const core::ScopedProgressCallback installed = log.Install();
-        ReadPointCloud(dir + "/large.ply", watched);
-    }
+    log.Watch([&] { ReadPointCloud(dir + "/large.ply", watched); });
     log.ExpectStage("reading");
     log.ExpectStage("decoding");
     EXPECT_TRUE(watched == quiet);
@@ -95,10 +95,7 @@ TEST(RoundTrip, LargeFilesReportProgress) {
     const PointCloud sh = RandomCloud(70000, 1, 22);
     WritePointCloud(dir + "/quiet.sog", sh);
     ProgressLog sog;
-    {
-        const core::ScopedProgressCallback installed = sog.Install();
-        WritePointCloud(dir + "/watched.sog", sh);
-    }
+    sog.Watch([&] { WritePointCloud(dir + "/watched.sog", sh); });
     sog.ExpectStage("clustering");
     sog.ExpectStage("compressing");
     EXPECT_EQ(tests::ReadFileBytes(dir + "/watched.sog"), tests::ReadFileBytes(dir + "/quiet.sog"));

@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cstdlib>
 #include <cstring>
+#include <functional>
 
 #include "open3d/core/Exception.h"
 #include "open3d/visualization/rendering/gaussian_splat/DefaultScene.h"
@@ -169,6 +170,21 @@ TEST_F(SubmissionPath, EightBitColourIsTheFloatResultRounded) {
     }
 }
 
+// Runs `check` for the Vulkan backend and the CPU reference, each with RGBA32F and RGBA8
+// colour (its options and the bytes of a 48 x 32 view), under a trace naming the case.
+void ForBothBackendsAndFormats(
+    GaussianSplatBackend& vulkan, GaussianSplatBackend& reference,
+    const std::function<void(GaussianSplatBackend&, BatchOptions, size_t view_bytes)>& check) {
+    for (GaussianSplatBackend* backend : {&vulkan, &reference}) {
+        for (const bool uint8 : {false, true}) {
+            SCOPED_TRACE(backend->GetName() + (uint8 ? " uint8" : " float32"));
+            BatchOptions options;
+            options.color_uint8 = uint8;
+            check(*backend, options, 48 * 32 * 4 * (uint8 ? 1 : 4));
+        }
+    }
+}
+
 // Colours rendered into the caller's memory (BatchOptions::color_destination, Python's
 // render_batch) equal the images of an ordinary batch, across submissions (3 + 3 + 1 views)
 // and for both colour formats; on the CPU backend too. Outputs then carry no colour image.
@@ -180,17 +196,13 @@ TEST_F(SubmissionPath, ColoursIntoTheCallersMemoryEqualTheImages) {
     reference.SetScene(scene);
     const auto views = SlidingViews(7, 48, 32);
     vulkan->SetBatchBudget(3 * 48 * 32 * 16);
-    for (GaussianSplatBackend* backend : {static_cast<GaussianSplatBackend*>(vulkan.get()),
-                                          static_cast<GaussianSplatBackend*>(&reference)}) {
-        for (const bool uint8 : {false, true}) {
-            SCOPED_TRACE(backend->GetName() + (uint8 ? " uint8" : " float32"));
-            BatchOptions options;
-            options.color_uint8 = uint8;
-            const std::vector<RenderOutput> images = backend->RenderBatch(views, {}, options);
-            const size_t view_bytes = 48 * 32 * 4 * (uint8 ? 1 : 4);
+    ForBothBackendsAndFormats(
+        *vulkan, reference,
+        [&](GaussianSplatBackend& backend, BatchOptions options, size_t view_bytes) {
+            const std::vector<RenderOutput> images = backend.RenderBatch(views, {}, options);
             std::vector<uint8_t> memory(views.size() * view_bytes, 0xAB);
             options.color_destination = memory.data();
-            const std::vector<RenderOutput> into = backend->RenderBatch(views, {}, options);
+            const std::vector<RenderOutput> into = backend.RenderBatch(views, {}, options);
             for (size_t i = 0; i < views.size(); ++i) {
                 SCOPED_TRACE("view " + std::to_string(i));
                 EXPECT_TRUE(into[i].color.IsEmpty());
@@ -199,8 +211,7 @@ TEST_F(SubmissionPath, ColoursIntoTheCallersMemoryEqualTheImages) {
                           0);
                 EXPECT_EQ(into[i].stats.num_tile_entries, images[i].stats.num_tile_entries);
             }
-        }
-    }
+        });
 }
 
 // BatchHostMemory: the Vulkan backend imports it and the device copies the colours straight
@@ -222,14 +233,10 @@ TEST_F(SubmissionPath, ColoursIntoBatchHostMemoryEqualTheImages) {
     if (std::getenv("CI") != nullptr) {
         EXPECT_TRUE(imports) << "lavapipe has VK_EXT_external_memory_host: it must be used";
     }
-    for (GaussianSplatBackend* backend : {static_cast<GaussianSplatBackend*>(vulkan.get()),
-                                          static_cast<GaussianSplatBackend*>(&reference)}) {
-        for (const bool uint8 : {false, true}) {
-            SCOPED_TRACE(backend->GetName() + (uint8 ? " uint8" : " float32"));
-            BatchOptions options;
-            options.color_uint8 = uint8;
-            const std::vector<RenderOutput> images = backend->RenderBatch(views, {}, options);
-            const size_t view_bytes = 48 * 32 * 4 * (uint8 ? 1 : 4);
+    ForBothBackendsAndFormats(
+        *vulkan, reference,
+        [&](GaussianSplatBackend& backend, BatchOptions options, size_t view_bytes) {
+            const std::vector<RenderOutput> images = backend.RenderBatch(views, {}, options);
             BatchHostMemory memory((views.size() + 1) * view_bytes);
             std::memset(memory.Data(), 0xAB, memory.Size());
             options.color_memory = memory;
@@ -237,8 +244,8 @@ TEST_F(SubmissionPath, ColoursIntoBatchHostMemoryEqualTheImages) {
             // By the third round both slots have recorded for this memory and reuse that.
             for (int round = 0; round < 3; ++round) {
                 const int64_t recordings = vulkan->GetCounters().recordings;
-                const std::vector<RenderOutput> into = backend->RenderBatch(views, {}, options);
-                if (round == 2 && backend == vulkan.get()) {
+                const std::vector<RenderOutput> into = backend.RenderBatch(views, {}, options);
+                if (round == 2 && &backend == vulkan.get()) {
                     EXPECT_EQ(vulkan->GetCounters().recordings, recordings);
                 }
                 for (size_t i = 0; i < views.size(); ++i) {
@@ -257,7 +264,7 @@ TEST_F(SubmissionPath, ColoursIntoBatchHostMemoryEqualTheImages) {
             // Five views (2 + 2 + 1: the last part reuses buffers made for two) land in five
             // views' room, not a byte further.
             std::memset(memory.Data(), 0xAB, memory.Size());
-            backend->RenderBatch({views.begin(), views.begin() + 5}, {}, options);
+            backend.RenderBatch({views.begin(), views.begin() + 5}, {}, options);
             for (size_t i = 0; i < 5; ++i) {
                 EXPECT_EQ(std::memcmp(memory.Data() + (i + 1) * view_bytes,
                                       images[i].color.AsTensor().RawData(), view_bytes),
@@ -270,20 +277,19 @@ TEST_F(SubmissionPath, ColoursIntoBatchHostMemoryEqualTheImages) {
             // the second view's place.
             options.color_destination = nullptr;
             const auto most = SlidingViews(static_cast<int>(memory.Size() / view_bytes), 48, 32);
-            EXPECT_NO_THROW(backend->RenderBatch(most, {}, options));
+            EXPECT_NO_THROW(backend.RenderBatch(most, {}, options));
             options.color_destination = memory.Data() + view_bytes;
             try {
-                backend->RenderBatch(most, {}, options);
+                backend.RenderBatch(most, {}, options);
                 ADD_FAILURE() << most.size() << " views at one view's offset were accepted";
             } catch (const core::Open3DError& e) {
                 EXPECT_NE(std::string(e.what()).find("do not fit in the batch memory"),
                           std::string::npos)
                     << e.what();
             }
-        }
-    }
-    // One import per block (two blocks: float32 and uint8); the first was dropped once its
-    // memory went out of scope, when the second was imported.
+        });
+    // One import per block (two blocks: float32 and uint8); the first was dropped by the
+    // first submission after its memory went out of scope.
     EXPECT_EQ(vulkan->GetCounters().host_imports, imports ? 2 : 0);
     EXPECT_EQ(vulkan->GetCounters().host_import_releases, imports ? 1 : 0);
 }
