@@ -82,6 +82,8 @@ struct Row {
     double batch_float_host_memory_vps = 0, batch_uint8_host_memory_vps = 0;
     double batch_gpu_ms_per_view = 0;
     int batch_submissions = 0;
+    // One device-to-host copy of the float32 batch's bytes alone: the readback's ceiling.
+    double batch_copy_gb_per_s = 0, batch_copy_ceiling_vps = 0;
     bool has_error = false;
     double psnr = 0, max_abs = 0, over_1_255 = 0, p999 = 0;
     uint32_t error_flags = 0;
@@ -282,10 +284,12 @@ void PrintTable(const std::vector<Row>& rows) {
             std::printf(
                 "%-11s batch: %.0f views/s float32 readback (%.0f into one reused buffer, %.0f "
                 "into BatchHostMemory), %.0f uint8 readback (%.0f into BatchHostMemory), %.0f on "
-                "the GPU only; GPU %.3f ms/view, %d submission(s) per batch\n",
+                "the GPU only; GPU %.3f ms/view, %d submission(s) per batch; the batch's float32 "
+                "bytes copied alone to host memory: %.1f GB/s (%.0f views/s)\n",
                 "", r.batch_float_vps, r.batch_float_into_buffer_vps, r.batch_float_host_memory_vps,
                 r.batch_uint8_vps, r.batch_uint8_host_memory_vps, r.batch_gpu_only_vps,
-                r.batch_gpu_ms_per_view, r.batch_submissions);
+                r.batch_gpu_ms_per_view, r.batch_submissions, r.batch_copy_gb_per_s,
+                r.batch_copy_ceiling_vps);
         }
     }
 }
@@ -471,6 +475,10 @@ int Run(const Options& opt) {
                         row.batch_gpu_only_vps = g.views_per_second;
                         row.batch_gpu_ms_per_view = f.gpu_ms_per_view;
                         row.batch_submissions = f.submissions_per_batch;
+                        row.batch_copy_gb_per_s = bench::MeasureDeviceToHostGBs(
+                            vulkan->GetContext(), buffer.size(), repeats);
+                        row.batch_copy_ceiling_vps =
+                            row.batch_copy_gb_per_s * 1e9 * opt.batch / double(buffer.size());
                     }
                 }
                 rows.push_back(row);
@@ -560,7 +568,9 @@ int Run(const Options& opt) {
                     {"views_per_second_uint8", r.batch_uint8_vps},
                     {"views_per_second_no_readback", r.batch_gpu_only_vps},
                     {"gpu_ms_per_view", r.batch_gpu_ms_per_view},
-                    {"submissions", r.batch_submissions}};
+                    {"submissions", r.batch_submissions},
+                    {"device_to_host_copy_gb_per_s", r.batch_copy_gb_per_s},
+                    {"float32_copy_ceiling_views_per_second", r.batch_copy_ceiling_vps}};
             }
             if (r.has_error) {
                 out.back()["psnr_db_worst_view"] = r.psnr;

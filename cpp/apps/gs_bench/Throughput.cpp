@@ -6,6 +6,9 @@
 #include <deque>
 
 #include "open3d/core/Timer.h"
+#include "open3d/visualization/rendering/gaussian_splat/BatchHostMemory.h"
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/Buffer.h"
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/Commands.h"
 
 namespace open3d {
 namespace bench {
@@ -61,6 +64,42 @@ BatchThroughput MeasureBatch(GaussianSplatVulkanBackend& backend,
     result.views_per_second = 1000.0 * batch * repeats / wall_ms;
     result.gpu_ms_per_view = gpu_ms / (double(batch) * repeats);
     return result;
+}
+
+double MeasureDeviceToHostGBs(const visualization::rendering::vulkan::VulkanContext& context,
+                              uint64_t bytes, int repeats) {
+    namespace vk = visualization::rendering::vulkan;
+    const uint64_t alignment = context.GetHostImportAlignment();
+    if (!context.CanImportHostMemory() || alignment == 0) return 0.0;
+    visualization::rendering::BatchHostMemory host(static_cast<size_t>(bytes));
+    if (reinterpret_cast<uintptr_t>(host.Data()) % alignment != 0 || host.Size() % alignment != 0) {
+        return 0.0;
+    }
+    const bool transfer = context.HasTransferQueue();
+    vk::Buffer device(context, bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, vk::MemoryUsage::kDevice,
+                      /*shared_with_transfer=*/true);
+    vk::Buffer target =
+        vk::Buffer::ImportHost(context, host.Data(), host.Size(), VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                               /*shared_with_transfer=*/true);
+    const vk::CommandPool pool(
+        context, transfer ? context.GetTransferQueueFamilyIndex() : context.GetQueueFamilyIndex());
+    const vk::CommandBuffer cmd = pool.Allocate();
+    cmd.Begin(/*one_time_submit=*/false);
+    const VkBufferCopy region{0, 0, bytes};
+    vkCmdCopyBuffer(cmd.Get(), device.Get(), target.Get(), 1, &region);
+    cmd.End();
+    const VkQueue queue = transfer ? context.GetTransferQueue() : context.GetQueue();
+    vk::UniqueFence fence = vk::CreateFence(context);
+    const auto copy = [&] {
+        vk::SubmitToQueue(queue, cmd.Get(), fence.Get(), VK_NULL_HANDLE, VK_PIPELINE_STAGE_2_NONE,
+                          VK_NULL_HANDLE);
+        vk::Wait(context, fence.Get());
+        vk::ResetFence(context, fence.Get());
+    };
+    copy();  // maps the pages for the device
+    const auto start = std::chrono::steady_clock::now();
+    for (int r = 0; r < repeats; ++r) copy();
+    return double(bytes) * repeats / (core::MillisecondsSince(start) * 1e6);
 }
 
 std::string ReadGpuClockMHz() {

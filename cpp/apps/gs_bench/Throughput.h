@@ -33,6 +33,13 @@ BatchThroughput MeasureBatch(visualization::rendering::vulkan::GaussianSplatVulk
                              const visualization::rendering::BatchOptions& options, int batch,
                              int repeats);
 
+/// GB/s (1e9 bytes) of one device-to-host copy of `bytes` repeated `repeats` times with
+/// nothing else running: from a device buffer into page-aligned host memory the device
+/// imports (the path of BatchOptions::color_memory), on the transfer queue where the device
+/// has one. 0 where host memory cannot be imported. The ceiling of every readback.
+double MeasureDeviceToHostGBs(const visualization::rendering::vulkan::VulkanContext& context,
+                              uint64_t bytes, int repeats);
+
 /// "current/max" SM clock in MHz from nvidia-smi, or "" where it is not available.
 std::string ReadGpuClockMHz();
 
