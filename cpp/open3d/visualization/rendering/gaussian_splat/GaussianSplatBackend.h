@@ -69,8 +69,8 @@ struct BatchOptions {
     /// With read_back, optional: memory the colours go into, view i at
     /// color_destination + i * (view bytes) when color_destination points inside it, at
     /// Data() + i * (view bytes) when color_destination is null. The Vulkan backend lets the
-    /// device copy straight into it (no copy on the host); other backends copy into it as
-    /// into any memory. The views must fit in it.
+    /// device write straight into it (RGBA32F from the composite, RGBA8 by a copy; no copy on
+    /// the host); other backends copy into it as into any memory. The views must fit in it.
     BatchHostMemory color_memory;
 };
 

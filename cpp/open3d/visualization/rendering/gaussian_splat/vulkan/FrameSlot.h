@@ -35,6 +35,10 @@ struct FrameRecordingKey {
     BatchOptions options;  ///< without its destination (which the readback copy names)
     /// The colours go to imported host memory: the slot keeps no host colour buffer.
     bool color_imported = false;
+    /// RGBA32F into imported memory: the composite writes the colours straight into it
+    /// (this buffer, the submission's first view at this offset); no copy.
+    VkBuffer direct_color = VK_NULL_HANDLE;
+    VkDeviceSize direct_color_offset = 0;
     bool operator==(const FrameRecordingKey& other) const;
 };
 

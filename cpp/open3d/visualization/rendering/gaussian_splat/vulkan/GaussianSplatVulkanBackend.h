@@ -183,7 +183,7 @@ private:
                               const RenderConfig& config, const BatchOptions& options,
                               uint32_t entry_capacity) const;
     void EnsureScenePrecision(const RenderConfig& config);
-    // BatchHostMemory the device copies colours into (VK_EXT_external_memory_host), kept
+    // BatchHostMemory the device writes colours into (VK_EXT_external_memory_host), kept
     // imported while the caller holds the memory and frames in flight still write it.
     struct HostImport {
         BatchHostMemory memory;

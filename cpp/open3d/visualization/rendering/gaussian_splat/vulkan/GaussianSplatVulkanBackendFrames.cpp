@@ -4,7 +4,9 @@
 // "Submission path"; per-frame host costs before and after: docs/perf/.
 #include <algorithm>
 #include <chrono>
+#include <cstdlib>
 #include <cstring>
+#include <string>
 
 #include "open3d/core/Exception.h"
 #include "open3d/core/Logging.h"
@@ -99,7 +101,8 @@ bool FrameRecordingKey::operator==(const FrameRecordingKey& other) const {
            entry_capacity == other.entry_capacity && scene_serial == other.scene_serial &&
            SameChoices(choices, other.choices) && SameGeometryConfig(config, other.config) &&
            config.background == other.config.background && SameOptions(options, other.options) &&
-           color_imported == other.color_imported;
+           color_imported == other.color_imported && direct_color == other.direct_color &&
+           direct_color_offset == other.direct_color_offset;
 }
 
 void GaussianSplatVulkanBackend::SetFramesInFlight(int count) {
@@ -172,8 +175,14 @@ void GaussianSplatVulkanBackend::ReleaseUnusedImports() {
     std::erase_if(host_imports_, [&](const std::unique_ptr<HostImport>& import) {
         const bool unused =
             import->memory.UseCount() == 1 && import->last_serial <= completed_serial_;
-        if (unused) ++counters_.host_import_releases;
-        return unused;
+        if (!unused) return false;
+        ++counters_.host_import_releases;
+        // A recording that writes it must not be reused, even by a later import that gets
+        // the same handle (lavapipe reuses handles).
+        for (auto& slot : slots_) {
+            if (slot->recorded.direct_color == import->buffer.Get()) slot->has_recording = false;
+        }
+        return true;
     });
 }
 
@@ -190,9 +199,10 @@ GaussianSplatVulkanBackend::HostImport* GaussianSplatVulkanBackend::ImportHostMe
     }
     auto import = std::make_unique<HostImport>();
     try {
-        import->buffer = Buffer::ImportHost(*context_, memory.Data(), memory.Size(),
-                                            VK_BUFFER_USAGE_TRANSFER_DST_BIT,
-                                            /*shared_with_transfer=*/true);
+        import->buffer = Buffer::ImportHost(
+            *context_, memory.Data(), memory.Size(),
+            VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
+            /*shared_with_transfer=*/true);
     } catch (const core::Open3DError& error) {
         core::LogWarning("Vulkan backend: {}; batch colours are copied on the host instead",
                          error.what());
@@ -270,11 +280,12 @@ void GaussianSplatVulkanBackend::PrepareSlot(FrameSlot& slot, const FrameRecordi
     }
     // Per-view buffers for more views than this submission has serve it too (the last part of
     // a split batch, or a smaller batch, then re-records without re-allocating).
-    const bool same_outputs = slot.params_upload && slot.view_capacity >= key.views &&
-                              slot.has_recording && slot.recorded.width == key.width &&
-                              slot.recorded.height == key.height &&
-                              SameOptions(slot.recorded.options, key.options) &&
-                              slot.recorded.color_imported == key.color_imported;
+    const bool same_outputs =
+        slot.params_upload && slot.view_capacity >= key.views && slot.has_recording &&
+        slot.recorded.width == key.width && slot.recorded.height == key.height &&
+        SameOptions(slot.recorded.options, key.options) &&
+        slot.recorded.color_imported == key.color_imported &&
+        (slot.recorded.direct_color == VK_NULL_HANDLE) == (key.direct_color == VK_NULL_HANDLE);
     if (!same_outputs) {
         const VkDeviceSize pixels = VkDeviceSize(key.width) * key.height;
         const auto per_view = [&](bool wanted, VkDeviceSize bytes, MemoryUsage memory,
@@ -290,9 +301,11 @@ void GaussianSplatVulkanBackend::PrepareSlot(FrameSlot& slot, const FrameRecordi
         // 0.65 ms of GPU time per 800x800 RGBA32F view, copying each image straight into host
         // memory 1.13 ms. A single view without readback stays in the images, copied nowhere.
         const bool on_device = o.read_back || key.views > 1;
-        // The composite writes RGBA32F colours into it (RecordSlot).
-        slot.device_color = per_view(on_device, color_bytes, MemoryUsage::kDevice,
-                                     kTransfer | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+        // The composite writes RGBA32F colours into it (RecordSlot), or straight into the
+        // caller's imported memory (then it is not needed).
+        slot.device_color =
+            per_view(on_device && key.direct_color == VK_NULL_HANDLE, color_bytes,
+                     MemoryUsage::kDevice, kTransfer | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
         slot.device_depth =
             per_view(on_device && o.expected_depth, pixels * 4, MemoryUsage::kDevice);
         slot.device_median =
@@ -350,9 +363,10 @@ void GaussianSplatVulkanBackend::RecordSlot(FrameSlot& slot, const FrameRecordin
     // RGBA32F views bound for the device buffer are composited straight into it: the image
     // and its copy (0.18 ms per 800x800 view on an H200) are skipped. Every view's offset is
     // a multiple of the first's, so one check covers the batch.
+    const bool direct = key.direct_color != VK_NULL_HANDLE;
     const bool color_into_buffer =
-        slot.device_color && slot.color_format == CompositeColorFormat::kRgba32f &&
-        composite_stage_.ColorBufferFits(key.width, key.height, color_bytes);
+        direct || (slot.device_color && slot.color_format == CompositeColorFormat::kRgba32f &&
+                   composite_stage_.ColorBufferFits(key.width, key.height, color_bytes));
     for (uint32_t i = 0; i < key.views; ++i) {
         FullBarrier(cmd);
         const BufferRange source =
@@ -374,9 +388,11 @@ void GaussianSplatVulkanBackend::RecordSlot(FrameSlot& slot, const FrameRecordin
                                VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
                                VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
         }
-        targets.color_buffer = color_into_buffer
-                                   ? slot.device_color.Range(i * color_bytes, color_bytes)
-                                   : BufferRange{};
+        targets.color_buffer =
+            direct ? BufferRange{key.direct_color, key.direct_color_offset + i * color_bytes,
+                                 color_bytes}
+            : color_into_buffer ? slot.device_color.Range(i * color_bytes, color_bytes)
+                                : BufferRange{};
         if (one_view) slot.pass_timestamps.RecordBegin(cmd, TimedPass::kComposite);
         composite_stage_.RecordComposite(cmd, inputs, targets, slot.composite_state.Range(),
                                          params);
@@ -398,8 +414,10 @@ void GaussianSplatVulkanBackend::RecordSlot(FrameSlot& slot, const FrameRecordin
                                i * bytes);
         }
     }
-    // The host reads the counters after the fence; the images reach it through copy_cmd.
-    RecordMemoryBarrier(cmd, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
+    // The host reads the counters (and colours written straight to it) after the fence; the
+    // other images reach it through copy_cmd.
+    RecordMemoryBarrier(cmd, VK_PIPELINE_STAGE_2_COPY_BIT | VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                        VK_ACCESS_2_TRANSFER_WRITE_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
                         VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT);
     slot.uses_transfer = key.options.read_back && context_->HasTransferQueue();
     slot.copied_color_target = VK_NULL_HANDLE;  // copy_cmd is recorded again before use
@@ -429,8 +447,10 @@ void GaussianSplatVulkanBackend::RecordReadback(FrameSlot& slot, VkBuffer color_
     // (the buffers may hold more).
     const FrameRecordingKey& key = slot.recorded;
     const VkDeviceSize pixels = VkDeviceSize(key.width) * key.height * key.views;
-    const VkBufferCopy color{0, color_offset, pixels * ColorBytesPerPixel(key.options)};
-    vkCmdCopyBuffer(copy_cmd, slot.device_color.Get(), color_target, 1, &color);
+    if (key.direct_color == VK_NULL_HANDLE) {
+        const VkBufferCopy color{0, color_offset, pixels * ColorBytesPerPixel(key.options)};
+        vkCmdCopyBuffer(copy_cmd, slot.device_color.Get(), color_target, 1, &color);
+    }
     for (const auto& [device, host] :
          {std::pair<const Buffer*, const Buffer*>{&slot.device_depth, &slot.host_depth},
           {&slot.device_median, &slot.host_median}}) {
@@ -516,10 +536,28 @@ uint64_t GaussianSplatVulkanBackend::SubmitBatch(const std::vector<camera::Pinho
                              ? ImportHostMemory(options.color_memory)
                              : nullptr;
     key.color_imported = import != nullptr;
+    const VkDeviceSize import_offset =
+        import != nullptr ? VkDeviceSize(destination - options.color_memory.Data()) : 0;
+    // RGBA32F colours are composited straight into the imported memory where every view's
+    // offset suits a storage buffer: no copy, and the device's copy engine does not compete
+    // with the compute work (on an H200 the two slowed each other down so much that a batch
+    // took about as long as rendering and then copying it). The recording then names the
+    // destination: a slot records again when its destination moved.
+    // OPEN3D_VULKAN_COMPOSITE_TO_HOST=0 copies instead (for measurements).
+    static const bool kDirect = [] {
+        const char* v = std::getenv("OPEN3D_VULKAN_COMPOSITE_TO_HOST");
+        return v == nullptr || std::string(v) != "0";
+    }();
+    if (import != nullptr && kDirect && !options.color_uint8 &&
+        composite_stage_.ColorBufferFits(w, h, import_offset) &&
+        composite_stage_.ColorBufferFits(w, h, color_bytes)) {
+        key.direct_color = import->buffer.Get();
+        key.direct_color_offset = import_offset;
+    }
     PrepareSlot(slot, key);
     if (import != nullptr) {
         slot.imported_target = import->buffer.Get();
-        slot.imported_target_offset = VkDeviceSize(destination - options.color_memory.Data());
+        slot.imported_target_offset = import_offset;
         import->last_serial = next_serial_;  // the serial SubmitSlot gives this submission
     }
     slot.color_destination = destination;
@@ -582,6 +620,8 @@ std::vector<RenderOutput> GaussianSplatVulkanBackend::WaitBatch(uint64_t ticket)
         slot.has_recording = false;
         FrameRecordingKey key = MakeKey(slot.cameras, slot.config, slot.options, capacity);
         key.color_imported = slot.recorded.color_imported;
+        key.direct_color = slot.recorded.direct_color;
+        key.direct_color_offset = slot.recorded.direct_color_offset;
         PrepareSlot(slot, key);
         auto* params = static_cast<GaussianViewParams*>(slot.params_upload.GetMapped());
         for (size_t i = 0; i < views; ++i) {
