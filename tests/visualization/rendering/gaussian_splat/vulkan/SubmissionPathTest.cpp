@@ -233,10 +233,6 @@ TEST_F(SubmissionPath, ColoursIntoBatchHostMemoryEqualTheImages) {
     if (std::getenv("CI") != nullptr) {
         EXPECT_TRUE(imports) << "lavapipe has VK_EXT_external_memory_host: it must be used";
     }
-    // OPEN3D_VULKAN_COMPOSITE_TO_HOST=0 has RGBA32F copied too (a measurement switch).
-    const char* direct = std::getenv("OPEN3D_VULKAN_COMPOSITE_TO_HOST");
-    const bool composites_into_memory =
-        imports && (direct == nullptr || direct != std::string("0"));
     ForBothBackendsAndFormats(
         *vulkan, reference,
         [&](GaussianSplatBackend& backend, BatchOptions options, size_t view_bytes) {
@@ -251,10 +247,9 @@ TEST_F(SubmissionPath, ColoursIntoBatchHostMemoryEqualTheImages) {
                 const std::vector<RenderOutput> into = backend.RenderBatch(views, {}, options);
                 if (round == 2 && &backend == vulkan.get()) {
                     // RGBA8: only the copies move. RGBA32F is composited into the memory
-                    // itself, so a recording names its destination, and the slots take the
-                    // three parts in turn: each submission records again.
-                    const int64_t again = vulkan->GetCounters().recordings - recordings;
-                    EXPECT_EQ(again, options.color_uint8 || !composites_into_memory ? 0 : 3);
+                    // itself, so a recording names its destination; the slots take the three
+                    // parts in turn and keep a recording for each (spare recordings).
+                    EXPECT_EQ(vulkan->GetCounters().recordings, recordings);
                 }
                 for (size_t i = 0; i < views.size(); ++i) {
                     SCOPED_TRACE("view " + std::to_string(i));

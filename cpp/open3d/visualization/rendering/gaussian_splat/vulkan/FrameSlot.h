@@ -83,6 +83,16 @@ struct FrameSlot {
     GpuTimestamps job_timestamps;   ///< the whole job
     FrameRecordingKey recorded;
     bool has_recording = false;
+    /// Earlier recordings of this slot for other keys, kept while its buffers stay (each part
+    /// of a batch split over imported memory has its own destination, so the slots take
+    /// several in turn): a submission whose key one of them matches swaps it with `cmd`
+    /// instead of recording. Cleared whenever has_recording is reset
+    /// (GaussianSplatVulkanBackend::ForgetRecordings).
+    struct SpareRecording {
+        FrameRecordingKey key;
+        CommandBuffer cmd;
+    };
+    std::vector<SpareRecording> spare_recordings;
 
     // The batch in the slot, from SubmitBatch until its WaitBatch.
     bool pending = false;

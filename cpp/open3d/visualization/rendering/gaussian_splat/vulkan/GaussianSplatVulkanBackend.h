@@ -173,6 +173,11 @@ private:
     FrameSlot& AcquireSlot();
     void PrepareSlot(FrameSlot& slot, const FrameRecordingKey& key);
     void RecordSlot(FrameSlot& slot, const FrameRecordingKey& key);
+    /// The slot's recordings (current and spare) may no longer be submitted.
+    static void ForgetRecordings(FrameSlot& slot);
+    /// Makes slot.cmd a recording of `key`: the current one, a spare, or a new recording (the
+    /// current one kept as a spare). Returns whether no recording was made.
+    bool UseRecording(FrameSlot& slot, const FrameRecordingKey& key);
     /// Records the slot's copies to host memory, the colours to `color_target` at
     /// `color_offset`.
     void RecordReadback(FrameSlot& slot, VkBuffer color_target, VkDeviceSize color_offset);

@@ -25,6 +25,9 @@ using shader::GaussianGeometryStageCounters;
 using shader::GaussianViewParams;
 
 constexpr int kMaxFramesInFlight = 4;
+// Spare recordings a slot keeps (FrameSlot::spare_recordings): RenderBatch's eight parts over
+// two slots give each slot at most eight destinations.
+constexpr size_t kMaxSpareRecordings = 8;
 constexpr VkBufferUsageFlags kTransfer =
     VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
 
@@ -177,10 +180,16 @@ void GaussianSplatVulkanBackend::ReleaseUnusedImports() {
             import->memory.UseCount() == 1 && import->last_serial <= completed_serial_;
         if (!unused) return false;
         ++counters_.host_import_releases;
-        // A recording that writes it must not be reused, even by a later import that gets
-        // the same handle (lavapipe reuses handles).
+        // A recording or readback copy that writes it must not be reused, even by a later
+        // import that gets the same handle (lavapipe reuses handles).
         for (auto& slot : slots_) {
-            if (slot->recorded.direct_color == import->buffer.Get()) slot->has_recording = false;
+            if (slot->recorded.direct_color == import->buffer.Get()) ForgetRecordings(*slot);
+            std::erase_if(slot->spare_recordings, [&](const FrameSlot::SpareRecording& spare) {
+                return spare.key.direct_color == import->buffer.Get();
+            });
+            if (slot->copied_color_target == import->buffer.Get()) {
+                slot->copied_color_target = VK_NULL_HANDLE;
+            }
         }
         return true;
     });
@@ -257,7 +266,7 @@ void GaussianSplatVulkanBackend::PrepareSlot(FrameSlot& slot, const FrameRecordi
     if (!slot.view || slot.view.NumSplats() != n ||
         slot.view.EntryCapacity() != key.entry_capacity) {
         slot.view.Allocate(context, n, key.entry_capacity);
-        slot.has_recording = false;
+        ForgetRecordings(slot);
     }
     const CompositeColorFormat format =
         key.options.color_uint8 ? CompositeColorFormat::kRgba8 : CompositeColorFormat::kRgba32f;
@@ -276,7 +285,7 @@ void GaussianSplatVulkanBackend::PrepareSlot(FrameSlot& slot, const FrameRecordi
         slot.width = key.width;
         slot.height = key.height;
         slot.color_format = format;
-        slot.has_recording = false;
+        ForgetRecordings(slot);
     }
     // Per-view buffers for more views than this submission has serve it too (the last part of
     // a split batch, or a smaller batch, then re-records without re-allocating).
@@ -320,8 +329,39 @@ void GaussianSplatVulkanBackend::PrepareSlot(FrameSlot& slot, const FrameRecordi
         slot.counters_readback =
             per_view(true, sizeof(GaussianGeometryStageCounters), MemoryUsage::kHostReadback);
         slot.view_capacity = key.views;
-        slot.has_recording = false;
+        ForgetRecordings(slot);
     }
+}
+
+void GaussianSplatVulkanBackend::ForgetRecordings(FrameSlot& slot) {
+    slot.has_recording = false;
+    slot.spare_recordings.clear();
+}
+
+bool GaussianSplatVulkanBackend::UseRecording(FrameSlot& slot, const FrameRecordingKey& key) {
+    if (slot.has_recording && slot.recorded == key) return true;
+    auto spare = std::find_if(slot.spare_recordings.begin(), slot.spare_recordings.end(),
+                              [&](const FrameSlot::SpareRecording& s) { return s.key == key; });
+    if (slot.has_recording) {
+        // The current recording becomes a spare (the oldest spare goes when there are many).
+        if (spare == slot.spare_recordings.end() &&
+            slot.spare_recordings.size() >= kMaxSpareRecordings) {
+            slot.spare_recordings.erase(slot.spare_recordings.begin());
+            spare = slot.spare_recordings.end();
+        }
+        FrameSlot::SpareRecording parked{slot.recorded, std::move(slot.cmd)};
+        if (spare != slot.spare_recordings.end()) {
+            slot.cmd = std::move(spare->cmd);
+            slot.recorded = spare->key;
+            *spare = std::move(parked);
+            slot.uses_transfer = key.options.read_back && context_->HasTransferQueue();
+            slot.copied_color_target = VK_NULL_HANDLE;  // copy_cmd followed the other one
+            return true;
+        }
+        slot.spare_recordings.push_back(std::move(parked));
+    }
+    RecordSlot(slot, key);
+    return false;
 }
 
 void GaussianSplatVulkanBackend::RecordSlot(FrameSlot& slot, const FrameRecordingKey& key) {
@@ -565,8 +605,7 @@ uint64_t GaussianSplatVulkanBackend::SubmitBatch(const std::vector<camera::Pinho
     for (size_t i = 0; i < cameras.size(); ++i) {
         params[i] = geometry_stage_resources_.ViewParams(cameras[i], config, capacity).params;
     }
-    const bool reuse = slot.has_recording && slot.recorded == key;
-    if (!reuse) RecordSlot(slot, key);
+    const bool reuse = UseRecording(slot, key);
     slot.record_ms = core::MillisecondsSince(start);
     slot.recording_reused = reuse;
     slot.cameras = cameras;
@@ -617,7 +656,7 @@ std::vector<RenderOutput> GaussianSplatVulkanBackend::WaitBatch(uint64_t ticket)
         const uint32_t capacity =
             static_cast<uint32_t>(std::min<uint64_t>(limit, asked + asked / 4));
         slot.view.Allocate(*context_, slot.view.NumSplats(), capacity);
-        slot.has_recording = false;
+        ForgetRecordings(slot);
         FrameRecordingKey key = MakeKey(slot.cameras, slot.config, slot.options, capacity);
         key.color_imported = slot.recorded.color_imported;
         key.direct_color = slot.recorded.direct_color;
@@ -740,10 +779,11 @@ std::vector<RenderOutput> GaussianSplatVulkanBackend::RenderBatch(
     // submission of all views leaves the GPU idle during the copies and the host idle during
     // the rendering): four for eight views or more, eight for sixteen or more. The first
     // part's rendering and the last one's copy overlap nothing, which smaller parts shorten,
-    // but each part costs host work: 64 RGBA32F 800x800 views read back into imported memory
+    // but each part costs host work: 64 RGBA32F 800x800 views copied into imported memory
     // on an H200 reached 1,976 views/s in four parts, 1,988-2,001 in eight and 1,957-1,959 in
-    // sixteen (docs/perf/h200.md). Parts are of one size: a slot's recording and per-view
-    // buffers are for one view count, so a smaller first part (tried: 2 + 7 x 8 + 6 views)
+    // sixteen (docs/perf/h200.md; composited straight into it, eight parts: 2,185-2,187; other
+    // part counts were not measured that way). Parts are of one size: a slot's recording and
+    // per-view buffers are for one view count, so a smaller first part (tried: 2 + 7 x 8 + 6 views)
     // re-recorded and re-allocated at every submission, 1,451-1,602 views/s.
     const uint32_t fit = MaxViewsPerSubmission(static_cast<uint32_t>(cameras[0].width),
                                                static_cast<uint32_t>(cameras[0].height), options);
