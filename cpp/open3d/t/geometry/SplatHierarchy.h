@@ -1,7 +1,7 @@
 // A level-of-detail hierarchy over a Gaussian splat cloud (docs/lod.md): an octree over the
 // splats' positions whose inner nodes are Gaussians merged from their children by moment
 // matching, and the cut that picks, for one view, the nodes to draw under a splat budget.
-// CPU only: the GPU cut and the file layout are not built yet.
+// CPU only: the GPU cut is not built yet; the file is t/io/SplatHierarchyIO.h.
 #pragma once
 
 #include <Eigen/Core>

@@ -1,0 +1,169 @@
+#include "open3d/t/io/SplatHierarchyIO.h"
+
+#include <bit>
+#include <cmath>
+#include <cstring>
+#include <vector>
+
+#include "open3d/core/Exception.h"
+#include "open3d/t/io/SplatColumns.h"
+
+namespace open3d {
+namespace t {
+namespace io {
+
+namespace {
+
+static_assert(std::endian::native == std::endian::little,
+              "the hierarchy file is little-endian and read by memcpy");
+
+constexpr char kMagic[8] = {'O', '3', 'D', 'G', 'S', 'L', 'O', 'D'};
+constexpr uint32_t kVersion = 1;
+constexpr int kMaxChildren = 8;
+constexpr size_t kHeaderBytes = 8 + 4 + 4 + 3 * 8;
+
+// The inner nodes' attributes in file order, with their float count per node.
+struct Attribute {
+    const char* name;
+    int64_t width;
+};
+std::vector<Attribute> Attributes(int num_rest) {
+    std::vector<Attribute> list = {{geometry::gs_attr::kPositions, 3},
+                                   {geometry::gs_attr::kScale, 3},
+                                   {geometry::gs_attr::kRot, 4},
+                                   {geometry::gs_attr::kOpacity, 1},
+                                   {geometry::gs_attr::kFDc, 3}};
+    if (num_rest > 0) list.push_back({geometry::gs_attr::kFRest, 3 * int64_t(num_rest)});
+    return list;
+}
+
+template <typename T>
+void Append(std::vector<uint8_t>& bytes, const T* values, size_t count) {
+    const size_t at = bytes.size();
+    bytes.resize(at + count * sizeof(T));
+    if (count > 0) std::memcpy(bytes.data() + at, values, count * sizeof(T));
+}
+
+}  // namespace
+
+void WriteSplatHierarchy(const std::string& filename, const geometry::SplatHierarchy& hierarchy) {
+    const int64_t k = hierarchy.NumInner();
+    const int degree = k > 0 ? hierarchy.inner.GaussianSplatGetSHOrder() : 0;
+    const int64_t counts[] = {hierarchy.num_leaves, k,
+                              static_cast<int64_t>(hierarchy.children.size())};
+    std::vector<uint8_t> bytes;
+    Append(bytes, kMagic, 8);
+    Append(bytes, &kVersion, 1);
+    const uint32_t sh_degree = static_cast<uint32_t>(degree);
+    Append(bytes, &sh_degree, 1);
+    Append(bytes, counts, 3);
+    Append(bytes, hierarchy.child_offsets.data(), hierarchy.child_offsets.size());
+    Append(bytes, hierarchy.children.data(), hierarchy.children.size());
+    if (k > 0) {
+        for (const Attribute& a : Attributes(geometry::NumSHRestCoeffs(degree))) {
+            const core::Tensor& values = hierarchy.inner.GetPointAttr(a.name);
+            Append(bytes, values.Data<float>(), static_cast<size_t>(k * a.width));
+        }
+    }
+    WriteFileBytes(filename, bytes);
+}
+
+geometry::SplatHierarchy ReadSplatHierarchy(const std::string& filename) {
+    const MappedFile file(filename);
+    const uint8_t* data = file.data();
+    const size_t size = file.size();
+    const auto fail = [&](const std::string& why) {
+        core::ThrowError("'{}': not a splat hierarchy file written by this version: {}", filename,
+                         why);
+    };
+    if (size < kHeaderBytes || std::memcmp(data, kMagic, 8) != 0) {
+        fail("it does not start with the magic 'O3DGSLOD' and a full header");
+    }
+    uint32_t version = 0, sh_degree = 0;
+    int64_t counts[3] = {0, 0, 0};
+    std::memcpy(&version, data + 8, 4);
+    std::memcpy(&sh_degree, data + 12, 4);
+    std::memcpy(counts, data + 16, 24);
+    if (version != kVersion) fail("version " + std::to_string(version) + ", not 1");
+    if (sh_degree > 3) fail("sh_degree " + std::to_string(sh_degree) + " (0..3)");
+    const int64_t leaves = counts[0], inner = counts[1], links = counts[2];
+    // Every count bounded by the file before any product is formed.
+    const int64_t limit = static_cast<int64_t>(size / 4);
+    if (leaves < 1 || inner < 0 || inner > limit || links < 0 || links > limit ||
+        leaves > links + 1) {
+        fail("counts leaves " + std::to_string(leaves) + ", inner " + std::to_string(inner) +
+             ", children " + std::to_string(links) + " do not fit a file of " +
+             std::to_string(size) + " bytes");
+    }
+    const int num_rest = geometry::NumSHRestCoeffs(static_cast<int>(sh_degree));
+    const std::vector<Attribute> attributes = Attributes(num_rest);
+    int64_t floats_per_node = 0;
+    for (const Attribute& a : attributes) floats_per_node += a.width;
+    const uint64_t expected = kHeaderBytes + 8 * uint64_t(inner + 1) + 8 * uint64_t(links) +
+                              4 * uint64_t(inner) * uint64_t(floats_per_node);
+    if (expected != size) {
+        fail("the counts need " + std::to_string(expected) + " bytes, the file has " +
+             std::to_string(size));
+    }
+
+    geometry::SplatHierarchy h;
+    h.num_leaves = leaves;
+    h.child_offsets = std::vector<int64_t>(static_cast<size_t>(inner + 1));
+    h.children = std::vector<int64_t>(static_cast<size_t>(links));
+    const uint8_t* at = data + kHeaderBytes;
+    std::memcpy(h.child_offsets.data(), at, 8 * (inner + 1));
+    at += 8 * (inner + 1);
+    if (links > 0) std::memcpy(h.children.data(), at, 8 * links);
+    at += 8 * links;
+
+    if (h.child_offsets[0] != 0 || h.child_offsets[inner] != links) {
+        fail("child_offsets must run from 0 to the number of children");
+    }
+    if (inner == 0 && leaves != 1) fail("a hierarchy of several leaves needs inner nodes");
+    std::vector<uint8_t> parents(leaves + inner, 0);
+    for (int64_t k = 0; k < inner; ++k) {
+        const int64_t count = h.child_offsets[k + 1] - h.child_offsets[k];
+        if (count < 2 || count > kMaxChildren) {
+            fail("inner node " + std::to_string(k) + " has " + std::to_string(count) +
+                 " children (2..8)");
+        }
+        for (int64_t c = h.child_offsets[k]; c < h.child_offsets[k + 1]; ++c) {
+            const int64_t child = h.children[c];
+            if (child < 0 || child >= leaves + k) {
+                fail("child " + std::to_string(child) + " of inner node " + std::to_string(k) +
+                     " is not a node built before it");
+            }
+            if (++parents[child] > 1) fail("node " + std::to_string(child) + " has two parents");
+        }
+    }
+    for (int64_t node = 0; node + 1 < leaves + inner; ++node) {
+        if (parents[node] != 1) fail("node " + std::to_string(node) + " has no parent");
+    }
+
+    if (inner > 0) {
+        for (const Attribute& a : attributes) {
+            core::SizeVector shape = {inner, a.width};
+            if (a.name == std::string(geometry::gs_attr::kFRest)) shape = {inner, num_rest, 3};
+            core::Tensor values(shape, core::Dtype::Float32);
+            std::memcpy(values.Data<float>(), at, 4 * inner * a.width);
+            at += 4 * inner * a.width;
+            const float* v = values.Data<float>();
+            for (int64_t i = 0; i < inner * a.width; ++i) {
+                if (!std::isfinite(v[i])) {
+                    fail(std::string("a non-finite ") + a.name + " of inner node " +
+                         std::to_string(i / a.width));
+                }
+            }
+            if (a.name == std::string(geometry::gs_attr::kPositions)) {
+                h.inner = geometry::PointCloud(values);
+            } else {
+                h.inner.SetPointAttr(a.name, values);
+            }
+        }
+    }
+    return h;
+}
+
+}  // namespace io
+}  // namespace t
+}  // namespace open3d
