@@ -7,14 +7,17 @@
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include <unistd.h>
 
 #include "open3d/core/Exception.h"
 #include "open3d/core/Progress.h"
 #include "open3d/core/Timer.h"
+#include "open3d/t/geometry/SplatHierarchy.h"
 #include "open3d/t/io/OutputFiles.h"
 #include "open3d/t/io/PointCloudIO.h"
+#include "open3d/t/io/SplatHierarchyIO.h"
 
 namespace {
 
@@ -57,7 +60,7 @@ private:
 int main(int argc, char** argv) {
     using namespace open3d;
     std::string input, output;
-    bool drop_non_finite = false, force = false, no_progress = false;
+    bool drop_non_finite = false, force = false, no_progress = false, lod = false;
     CLI::App app{
         "gs-convert: converts a Gaussian splat scene between file formats.\n"
         "Reads .ply, .compressed.ply, .splat, .spz, .sog (or a SOG folder / its meta.json),\n"
@@ -73,7 +76,10 @@ int main(int argc, char** argv) {
         ->required();
     app.add_flag("--drop-non-finite", drop_non_finite,
                  "Drop splats with NaN or Inf values instead of refusing the file");
-    app.add_flag("-f,--force", force, "Overwrite the output if it exists");
+    app.add_flag("-f,--force", force, "Overwrite the output (and its .lod) if it exists");
+    app.add_flag("--lod", lod,
+                 "Also build the level-of-detail hierarchy (docs/lod.md) and write it beside "
+                 "the output as <output>.lod");
     app.add_flag("--no-progress", no_progress,
                  "No progress bar (drawn on a terminal for conversions longer than 0.3 s: "
                  "reading, decoding, clustering and compressing as they happen)");
@@ -83,9 +89,13 @@ int main(int argc, char** argv) {
         // at once, not after a large scene has been decoded.
         t::io::PointCloudFileFormatForWriting(output);
         t::io::CheckOutputPath("output", output);
+        const std::string lod_path = output + ".lod";
         std::error_code ec;
-        if (!force && std::filesystem::exists(output, ec)) {
-            core::ThrowError("'{}' exists; pass --force to overwrite it", output);
+        for (const std::string& path :
+             lod ? std::vector<std::string>{output, lod_path} : std::vector<std::string>{output}) {
+            if (!force && std::filesystem::exists(path, ec)) {
+                core::ThrowError("'{}' exists; pass --force to overwrite it", path);
+            }
         }
         const auto start = std::chrono::steady_clock::now();
         std::optional<ProgressBar> bar;
@@ -108,12 +118,28 @@ int main(int argc, char** argv) {
         // partial file, and --force onto the input never truncates what is being read.
         t::io::OutputFileSet files;
         t::io::WritePointCloud(files.Add(output), cloud);
+        int64_t lod_nodes = 0;
+        if (lod) {
+            if (!cloud.IsGaussianSplat()) {
+                core::ThrowError("--lod: '{}' holds points without Gaussian attributes", input);
+            }
+            // Built from the cloud as read: a lossy output format's splats differ slightly
+            // from the leaves it was built on.
+            const t::geometry::SplatHierarchy hierarchy = t::geometry::BuildSplatHierarchy(cloud);
+            t::io::WriteSplatHierarchy(files.Add(lod_path), hierarchy);
+            lod_nodes = hierarchy.NumInner();
+        }
         files.Commit();
         progress.reset();
         bar.reset();  // erases the line before the summary
         std::printf("wrote %s (%llu bytes) in %.0f ms\n", output.c_str(),
                     static_cast<unsigned long long>(std::filesystem::file_size(output)),
                     core::MillisecondsSince(start));
+        if (lod) {
+            std::printf("wrote %s (%lld inner nodes over %lld splats)\n", lod_path.c_str(),
+                        static_cast<long long>(lod_nodes),
+                        static_cast<long long>(report.num_points));
+        }
     } catch (const core::Open3DError& e) {
         std::fprintf(stderr, "gs-convert: error: %s\n", e.what());
         return 1;

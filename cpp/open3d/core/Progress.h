@@ -19,7 +19,7 @@ using ProgressCallback = std::function<void(const char* stage, double fraction)>
 /// reportable steps).
 bool HasProgressCallback();
 /// Calls the calling thread's callback with `stage` ("reading", "decoding", "clustering",
-/// "compressing") and `fraction` clamped to [0, 1]; nothing without one.
+/// "compressing", "level of detail") and `fraction` clamped to [0, 1]; nothing without one.
 void ReportProgress(const char* stage, double fraction);
 
 /// Installs `callback` for the calling thread until destroyed (then restores the previous).

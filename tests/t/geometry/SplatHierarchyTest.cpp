@@ -6,11 +6,13 @@
 #include "RandomGeometry.h"
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <random>
 #include <vector>
 
 #include "open3d/core/Exception.h"
+#include "open3d/core/Progress.h"
 #include "open3d/t/geometry/SplatHierarchy.h"
 
 namespace open3d {
@@ -247,6 +249,25 @@ TEST(SplatHierarchy, ABudgetOfEveryLeafGivesTheSourceCloud) {
     EXPECT_LE(coarse.NumPoints(), 20);
     EXPECT_EQ(coarse.GaussianSplatGetSHOrder(), 2);
     EXPECT_THROW(ExtractSplatNodes(h, cloud, {h.NumNodes()}), core::Open3DError);
+}
+
+TEST(SplatHierarchy, ReportsProgressByLeavesPlaced) {
+    // 2^17 + 20 splats: reports at 1/2 and 1 (every 2^16 leaves), then 1 at the end; never
+    // going back.
+    std::mt19937 rng(13);
+    const PointCloud cloud = Cloud(RandomSplats(rng, 1 << 17));
+    std::vector<double> fractions;
+    {
+        core::ScopedProgressCallback progress([&](const char* stage, double fraction) {
+            EXPECT_STREQ(stage, "level of detail");
+            fractions.push_back(fraction);
+        });
+        BuildSplatHierarchy(cloud);
+    }
+    ASSERT_GE(fractions.size(), 3u);
+    EXPECT_TRUE(std::is_sorted(fractions.begin(), fractions.end()));
+    EXPECT_NEAR(fractions.front(), 65536.0 / (131072 + 20), 1e-12);
+    EXPECT_EQ(fractions.back(), 1.0);
 }
 
 }  // namespace

@@ -10,6 +10,7 @@
 #include <utility>
 
 #include "open3d/core/Exception.h"
+#include "open3d/core/Progress.h"
 
 namespace open3d {
 namespace t {
@@ -79,6 +80,7 @@ public:
         codes_.resize(n);
         for (int64_t i = 0; i < n; ++i) codes_[i] = codes[order_[i]];
         BuildRange(0, n, kMortonBits - 1);
+        core::ReportProgress(kStage, 1.0);
         Finish();
         return std::move(hierarchy_);
     }
@@ -162,8 +164,16 @@ private:
     }
 
     // Splats order_[b, e) that share their code above bit group `level`; returns the node.
+    // Leaves are placed left to right: their count is the progress.
+    int64_t PlaceLeaf(int64_t i) {
+        if (++placed_ % kProgressStep == 0) {
+            core::ReportProgress(kStage, double(placed_) / double(hierarchy_.num_leaves));
+        }
+        return order_[i];
+    }
+
     int64_t BuildRange(int64_t b, int64_t e, int level) {
-        if (e - b == 1) return order_[b];
+        if (e - b == 1) return PlaceLeaf(b);
         if (level < 0) return GroupEqual(b, e);  // identical codes
         std::vector<int64_t> children;
         int64_t start = b;
@@ -185,7 +195,8 @@ private:
 
     // Splats with one Morton code, eight (or fewer) to a node, nodes grouped likewise.
     int64_t GroupEqual(int64_t b, int64_t e) {
-        std::vector<int64_t> nodes(order_.begin() + b, order_.begin() + e);
+        std::vector<int64_t> nodes;
+        for (int64_t i = b; i < e; ++i) nodes.push_back(PlaceLeaf(i));
         while (nodes.size() > 1) {
             std::vector<int64_t> up;
             for (size_t i = 0; i < nodes.size(); i += kMaxChildren) {
@@ -246,6 +257,9 @@ private:
     std::vector<uint64_t> codes_;  // in order_
     std::vector<Gaussian> inner_;
     Gaussian leaf_cache_;
+    int64_t placed_ = 0;  // leaves placed in the tree so far
+    static constexpr const char* kStage = "level of detail";
+    static constexpr int64_t kProgressStep = int64_t(1) << 16;
 };
 
 }  // namespace
