@@ -4,10 +4,10 @@
 
 #include <cstring>
 #include <fstream>
-#include <random>
 #include <string>
 #include <vector>
 
+#include "RandomSplatCloud.h"
 #include "TestUtility.h"
 #include "open3d/core/Exception.h"
 #include "open3d/t/geometry/SplatHierarchy.h"
@@ -18,35 +18,8 @@ namespace t {
 namespace io {
 namespace {
 
-using core::Tensor;
 using geometry::PointCloud;
 using geometry::SplatHierarchy;
-
-PointCloud RandomSplatCloud(int64_t n, int degree, uint32_t seed) {
-    std::mt19937 rng(seed);
-    std::uniform_real_distribution<float> uniform(-1.0f, 1.0f), size(0.01f, 0.2f);
-    const auto fill = [&](const core::SizeVector& shape, auto gen) {
-        Tensor t(shape, core::Dtype::Float32);
-        for (int64_t i = 0; i < t.NumElements(); ++i) t.Data<float>()[i] = gen();
-        return t;
-    };
-    PointCloud cloud(fill({n, 3}, [&] { return 4.0f * uniform(rng); }));
-    cloud.SetPointAttr("scale", fill({n, 3}, [&] { return size(rng); }));
-    Tensor rot({n, 4}, core::Dtype::Float32);
-    for (int64_t i = 0; i < n; ++i) {
-        float q[4] = {1.0f + uniform(rng), uniform(rng), uniform(rng), uniform(rng)};
-        const float norm = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
-        for (int c = 0; c < 4; ++c) rot.Data<float>()[4 * i + c] = q[c] / norm;
-    }
-    cloud.SetPointAttr("rot", rot);
-    cloud.SetPointAttr("opacity", fill({n, 1}, [&] { return 2.0f * uniform(rng); }));
-    cloud.SetPointAttr("f_dc", fill({n, 3}, [&] { return uniform(rng); }));
-    if (degree > 0) {
-        cloud.SetPointAttr("f_rest", fill({n, geometry::NumSHRestCoeffs(degree), 3},
-                                          [&] { return 0.2f * uniform(rng); }));
-    }
-    return cloud;
-}
 
 void WriteBytes(const std::string& path, const std::vector<uint8_t>& bytes) {
     std::ofstream out(path, std::ios::binary);
@@ -70,7 +43,7 @@ TEST(SplatHierarchyFile, RoundTripsBitForBit) {
     const std::string dir = tests::TempDir();
     for (const int degree : {0, 3}) {
         SCOPED_TRACE("SH degree " + std::to_string(degree));
-        const PointCloud cloud = RandomSplatCloud(400, degree, 17 + degree);
+        const PointCloud cloud = RandomCloud(400, degree, 17 + degree);
         const SplatHierarchy built = geometry::BuildSplatHierarchy(cloud);
         const std::string path = dir + "/scene" + std::to_string(degree) + ".lod";
         WriteSplatHierarchy(path, built);
@@ -87,7 +60,7 @@ TEST(SplatHierarchyFile, RoundTripsBitForBit) {
                   geometry::CutSplatHierarchy(built, view, 60));
     }
     // One splat: no inner node.
-    const SplatHierarchy one = geometry::BuildSplatHierarchy(RandomSplatCloud(1, 1, 3));
+    const SplatHierarchy one = geometry::BuildSplatHierarchy(RandomCloud(1, 1, 3));
     WriteSplatHierarchy(dir + "/one.lod", one);
     const SplatHierarchy read = ReadSplatHierarchy(dir + "/one.lod");
     EXPECT_EQ(read.num_leaves, 1);
@@ -112,7 +85,7 @@ TEST(SplatHierarchyFile, AFileWrittenFromTheDocumentedLayoutIsRead) {
 
 TEST(SplatHierarchyFile, MalformedFilesAreRefusedNamingTheField) {
     const std::string dir = tests::TempDir();
-    const SplatHierarchy built = geometry::BuildSplatHierarchy(RandomSplatCloud(50, 1, 5));
+    const SplatHierarchy built = geometry::BuildSplatHierarchy(RandomCloud(50, 1, 5));
     const std::string good = dir + "/good.lod";
     WriteSplatHierarchy(good, built);
     const std::vector<uint8_t> bytes = tests::ReadFileBytes(good);

@@ -68,7 +68,6 @@ struct FrameSlot {
     // follow `cmd` on the same queue.
     CommandBuffer copy_cmd;
     UniqueSemaphore rendered;
-    bool uses_transfer = false;  ///< of the recording
     /// With FrameRecordingKey::color_imported: the imported buffer and offset of this batch.
     VkBuffer imported_target = VK_NULL_HANDLE;
     VkDeviceSize imported_target_offset = 0;

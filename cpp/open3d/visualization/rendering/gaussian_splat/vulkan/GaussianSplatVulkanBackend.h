@@ -263,6 +263,13 @@ private:
     std::vector<std::unique_ptr<FrameSlot>> slots_;
     std::vector<std::unique_ptr<HostImport>> host_imports_;
     bool host_import_failed_ = false;  ///< warned once; later blocks are copied on the host
+    /// RGBA32F batches into imported memory are composited straight into it (SubmitBatch);
+    /// OPEN3D_VULKAN_COMPOSITE_TO_HOST=0 copies them instead, for measurements.
+    const bool composite_to_host_ = EnvironmentSwitchOn("OPEN3D_VULKAN_COMPOSITE_TO_HOST");
+    /// Whether the slot's recording reads back through the transfer queue.
+    bool UsesTransfer(const FrameSlot& slot) const {
+        return slot.recorded.options.read_back && context_->HasTransferQueue();
+    }
     DeferredReleaseQueue deferred_;
     uint64_t next_serial_ = 1;       ///< serial of the next submission of the submission path
     uint64_t completed_serial_ = 0;  ///< every submission up to it has completed

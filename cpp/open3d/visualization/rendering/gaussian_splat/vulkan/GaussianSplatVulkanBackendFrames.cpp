@@ -4,9 +4,7 @@
 // "Submission path"; per-frame host costs before and after: docs/perf/.
 #include <algorithm>
 #include <chrono>
-#include <cstdlib>
 #include <cstring>
-#include <string>
 
 #include "open3d/core/Exception.h"
 #include "open3d/core/Logging.h"
@@ -354,7 +352,6 @@ bool GaussianSplatVulkanBackend::UseRecording(FrameSlot& slot, const FrameRecord
             slot.cmd = std::move(spare->cmd);
             slot.recorded = spare->key;
             *spare = std::move(parked);
-            slot.uses_transfer = key.options.read_back && context_->HasTransferQueue();
             slot.copied_color_target = VK_NULL_HANDLE;  // copy_cmd followed the other one
             return true;
         }
@@ -459,7 +456,6 @@ void GaussianSplatVulkanBackend::RecordSlot(FrameSlot& slot, const FrameRecordin
     RecordMemoryBarrier(cmd, VK_PIPELINE_STAGE_2_COPY_BIT | VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
                         VK_ACCESS_2_TRANSFER_WRITE_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
                         VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT);
-    slot.uses_transfer = key.options.read_back && context_->HasTransferQueue();
     slot.copied_color_target = VK_NULL_HANDLE;  // copy_cmd is recorded again before use
     slot.job_timestamps.RecordEnd(cmd, 0u);
     slot.cmd.End();
@@ -471,11 +467,11 @@ void GaussianSplatVulkanBackend::RecordSlot(FrameSlot& slot, const FrameRecordin
 void GaussianSplatVulkanBackend::RecordReadback(FrameSlot& slot, VkBuffer color_target,
                                                 VkDeviceSize color_offset) {
     if (slot.copy_cmd.Get() == VK_NULL_HANDLE) {
-        slot.copy_cmd = slot.uses_transfer ? transfer_pool_->Allocate() : pool_.Allocate();
+        slot.copy_cmd = UsesTransfer(slot) ? transfer_pool_->Allocate() : pool_.Allocate();
     }
     const VkCommandBuffer copy_cmd = slot.copy_cmd.Get();
     slot.copy_cmd.Begin(/*one_time_submit=*/false);
-    if (!slot.uses_transfer) {
+    if (!UsesTransfer(slot)) {
         // Same queue, after cmd: its per-view copies and the composite's buffer writes first.
         // (On the transfer queue the semaphore orders the copies after the rendering.)
         RecordMemoryBarrier(copy_cmd,
@@ -501,7 +497,7 @@ void GaussianSplatVulkanBackend::RecordReadback(FrameSlot& slot, VkBuffer color_
     RecordMemoryBarrier(copy_cmd, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
                         VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT);
     slot.copy_cmd.End();
-    if (slot.uses_transfer && !slot.rendered) slot.rendered = CreateBinarySemaphore(*context_);
+    if (UsesTransfer(slot) && !slot.rendered) slot.rendered = CreateBinarySemaphore(*context_);
     slot.copied_color_target = color_target;
     slot.copied_color_target_offset = color_offset;
 }
@@ -522,7 +518,7 @@ void GaussianSplatVulkanBackend::SubmitSlot(FrameSlot& slot) {
                       slot.copied_color_target_offset != color_offset)) {
         RecordReadback(slot, color_target, color_offset);
     }
-    if (slot.uses_transfer) {
+    if (UsesTransfer(slot)) {
         SubmitToQueue(context_->GetQueue(), slot.cmd.Get(), VK_NULL_HANDLE, VK_NULL_HANDLE,
                       VK_PIPELINE_STAGE_2_NONE, slot.rendered.Get());
         SubmitToQueue(context_->GetTransferQueue(), slot.copy_cmd.Get(), slot.fence.Get(),
@@ -582,13 +578,8 @@ uint64_t GaussianSplatVulkanBackend::SubmitBatch(const std::vector<camera::Pinho
     // offset suits a storage buffer: no copy, and the device's copy engine does not compete
     // with the compute work (on an H200 the two slowed each other down so much that a batch
     // took about as long as rendering and then copying it). The recording then names the
-    // destination: a slot records again when its destination moved.
-    // OPEN3D_VULKAN_COMPOSITE_TO_HOST=0 copies instead (for measurements).
-    static const bool kDirect = [] {
-        const char* v = std::getenv("OPEN3D_VULKAN_COMPOSITE_TO_HOST");
-        return v == nullptr || std::string(v) != "0";
-    }();
-    if (import != nullptr && kDirect && !options.color_uint8 &&
+    // destination; UseRecording keeps one per destination (FrameSlot::spare_recordings).
+    if (import != nullptr && composite_to_host_ && !options.color_uint8 &&
         composite_stage_.ColorBufferFits(w, h, import_offset) &&
         composite_stage_.ColorBufferFits(w, h, color_bytes)) {
         key.direct_color = import->buffer.Get();

@@ -39,9 +39,6 @@ std::optional<std::string> GetEnv(const char* name) {
     return std::string(value);
 }
 
-// An optional feature is on unless the environment variable `name` is "0".
-bool NotTurnedOff(const char* name) { return GetEnv(name) != std::string("0"); }
-
 std::string VersionString(uint32_t version) {
     return fmt::format("{}.{}.{}", VK_API_VERSION_MAJOR(version), VK_API_VERSION_MINOR(version),
                        VK_API_VERSION_PATCH(version));
@@ -190,6 +187,8 @@ struct DeviceQuery {
 
 }  // namespace
 
+bool EnvironmentSwitchOn(const char* name) { return GetEnv(name) != std::string("0"); }
+
 VulkanContext::VulkanContext() = default;
 
 VulkanContext::~VulkanContext() {
@@ -300,12 +299,13 @@ std::unique_ptr<VulkanContext> VulkanContext::CreateHeadless(const VulkanContext
         core::ThrowError("Vulkan: no usable device.{}\n{}", rejected, kInstallHint);
     }
     const DeviceQuery chosen(best);
-    context->InitDevice(
-        best, *chosen.FindQueueFamily(),
-        chosen.HasExtension(VK_KHR_EXTERNAL_MEMORY_FD_EXTENSION_NAME),
-        NotTurnedOff("OPEN3D_VULKAN_TRANSFER_QUEUE") ? chosen.FindTransferFamily() : std::nullopt,
-        NotTurnedOff("OPEN3D_VULKAN_HOST_IMPORT") &&
-            chosen.HasExtension(VK_EXT_EXTERNAL_MEMORY_HOST_EXTENSION_NAME));
+    context->InitDevice(best, *chosen.FindQueueFamily(),
+                        chosen.HasExtension(VK_KHR_EXTERNAL_MEMORY_FD_EXTENSION_NAME),
+                        EnvironmentSwitchOn("OPEN3D_VULKAN_TRANSFER_QUEUE")
+                            ? chosen.FindTransferFamily()
+                            : std::nullopt,
+                        EnvironmentSwitchOn("OPEN3D_VULKAN_HOST_IMPORT") &&
+                            chosen.HasExtension(VK_EXT_EXTERNAL_MEMORY_HOST_EXTENSION_NAME));
     return context;
 }
 

@@ -85,6 +85,10 @@ struct ValidationMessageCounts {
     uint64_t Problems() const { return errors + warnings; }
 };
 
+/// An optional feature is on unless the environment variable `name` is "0" (the switches
+/// OPEN3D_VULKAN_TRANSFER_QUEUE, OPEN3D_VULKAN_HOST_IMPORT, OPEN3D_VULKAN_COMPOSITE_TO_HOST).
+bool EnvironmentSwitchOn(const char* name);
+
 class VulkanContext {
 public:
     /// Creates its own instance and device. Throws core::Open3DError with what to install
