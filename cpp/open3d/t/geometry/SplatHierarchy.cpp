@@ -110,12 +110,8 @@ private:
         return g;
     }
 
-    const Gaussian& Node(int64_t id) {
-        if (id < hierarchy_.num_leaves) {
-            leaf_cache_ = Leaf(id);
-            return leaf_cache_;
-        }
-        return inner_[id - hierarchy_.num_leaves];
+    Gaussian Node(int64_t id) const {
+        return id < hierarchy_.num_leaves ? Leaf(id) : inner_[id - hierarchy_.num_leaves];
     }
 
     // Moment matching of the children (docs/lod.md "Merging").
@@ -256,11 +252,16 @@ private:
     std::vector<int64_t> order_;
     std::vector<uint64_t> codes_;  // in order_
     std::vector<Gaussian> inner_;
-    Gaussian leaf_cache_;
     int64_t placed_ = 0;  // leaves placed in the tree so far
     static constexpr const char* kStage = "level of detail";
     static constexpr int64_t kProgressStep = int64_t(1) << 16;
 };
+
+// The inner nodes' attribute arrays (none for a hierarchy of one splat).
+GaussianSplatArrays InnerArrays(const SplatHierarchy& hierarchy) {
+    return hierarchy.inner.IsEmpty() ? GaussianSplatArrays{}
+                                     : hierarchy.inner.GetGaussianSplatArrays();
+}
 
 }  // namespace
 
@@ -274,9 +275,7 @@ std::vector<int64_t> CutSplatHierarchy(const SplatHierarchy& hierarchy, const Sp
     if (budget < 1) core::ThrowError("CutSplatHierarchy: the budget must be >= 1, not {}", budget);
     const Eigen::Matrix3d r = view.world_to_camera.topLeftCorner<3, 3>();
     const Eigen::Vector3d t = view.world_to_camera.topRightCorner<3, 1>();
-    const GaussianSplatArrays inner = hierarchy.inner.IsEmpty()
-                                          ? GaussianSplatArrays{}
-                                          : hierarchy.inner.GetGaussianSplatArrays();
+    const GaussianSplatArrays inner = InnerArrays(hierarchy);
     // Projected size of inner node k: 3 sigma of its largest axis over its depth; a node
     // nearer than its own size counts as its size in pixels times a large factor.
     const auto size = [&](int64_t k) {
@@ -322,9 +321,7 @@ PointCloud ExtractSplatNodes(const SplatHierarchy& hierarchy, const PointCloud& 
         core::ThrowError("ExtractSplatNodes: the source has {} splats, the hierarchy {} leaves",
                          leaves.num_points, hierarchy.num_leaves);
     }
-    const GaussianSplatArrays inner = hierarchy.inner.IsEmpty()
-                                          ? GaussianSplatArrays{}
-                                          : hierarchy.inner.GetGaussianSplatArrays();
+    const GaussianSplatArrays inner = InnerArrays(hierarchy);
     const int64_t n = static_cast<int64_t>(nodes.size());
     const int rest = leaves.num_rest;
     struct Column {
