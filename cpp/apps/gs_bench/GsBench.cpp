@@ -15,12 +15,14 @@
 #include <vector>
 
 #include "BenchScenes.h"
+#include "LodBudgets.h"
 #include "Throughput.h"
 #include "open3d/camera/CamerasJson.h"
 #include "open3d/core/Exception.h"
 #include "open3d/core/ParallelFor.h"
 #include "open3d/core/Timer.h"
 #include "open3d/t/geometry/ImageMetrics.h"
+#include "open3d/t/geometry/SplatHierarchy.h"
 #include "open3d/t/io/OutputFiles.h"
 #include "open3d/t/io/PointCloudIO.h"
 #include "open3d/visualization/rendering/gaussian_splat/GaussianSplatBackend.h"
@@ -46,6 +48,7 @@ struct Options {
     std::string depth = "none";
     int batch = 0;
     int frames_in_flight = 2;
+    std::string lod_budgets;  // --lod-budgets, empty: no level-of-detail rows
 };
 
 struct Knob {
@@ -87,6 +90,11 @@ struct Row {
     bool has_error = false;
     double psnr = 0, max_abs = 0, over_1_255 = 0, p999 = 0;
     uint32_t error_flags = 0;
+    // Level-of-detail rows (--lod-budgets): the budget, the cut's nodes (mean over views) and
+    // the CPU time of the cut and its extraction; their error columns compare with the exact
+    // render of the whole scene, not the CPU reference.
+    int64_t lod_budget = 0;
+    double lod_nodes = 0, lod_cut_ms = 0, hierarchy_build_ms = 0;
 };
 
 std::pair<int, int> ParseResolution(const std::string& text) {
@@ -247,6 +255,44 @@ TimedFrames RunTimedFrames(rendering::GaussianSplatBackend& backend,
     return m;
 }
 
+// Adds one view's timed frames and its full frame's counts to `row`, as the mean over
+// `num_views` views.
+void AddView(Row& row, const TimedFrames& timed, const rendering::RenderStats& full,
+             size_t num_views) {
+    const rendering::RenderStats& med = timed.gpu;
+    const double n = static_cast<double>(num_views);
+    row.project_ms += med.gpu_project_ms / n;
+    row.sort_ms += med.gpu_sort_ms / n;
+    row.composite_ms += med.gpu_composite_ms / n;
+    row.depth_sort_ms += med.gpu_depth_sort_ms / n;
+    row.scan_emit_ms += med.gpu_scan_emit_ms / n;
+    row.tile_sort_ms += med.gpu_tile_sort_ms / n;
+    row.cpu_frame_ms += timed.cpu_frame_ms / n;
+    row.frame_ms += timed.frame_ms / n;
+    row.frame_gpu_ms += timed.frame_gpu_ms / n;
+    row.frame_job_gpu_ms += timed.frame_job_gpu_ms / n;
+    for (auto [sum, part] : {std::pair{&row.stage_host, &timed.stage_host},
+                             std::pair{&row.frame_host, &timed.frame_host}}) {
+        sum->host_record_ms += part->host_record_ms / n;
+        sum->host_submit_ms += part->host_submit_ms / n;
+        sum->host_wait_ms += part->host_wait_ms / n;
+        sum->host_readback_ms += part->host_readback_ms / n;
+    }
+    row.visible += full.num_visible / static_cast<int64_t>(num_views);
+    row.entries += full.num_tile_entries / static_cast<int64_t>(num_views);
+    row.error_flags |= full.error_flags;
+}
+
+// Worst-view error columns: folds one view's colour error against `reference` into `row`.
+void AddViewError(Row& row, const t::geometry::Image& image, const t::geometry::Image& reference) {
+    const auto m = t::geometry::ComputeImageErrorMetrics(image, reference, 1.0, 1.0 / 255.0);
+    row.psnr = row.has_error ? std::min(row.psnr, m.psnr_db) : m.psnr_db;
+    row.has_error = true;
+    row.max_abs = std::max(row.max_abs, m.max_abs_error);
+    row.over_1_255 = std::max(row.over_1_255, m.fraction_over_threshold);
+    row.p999 = std::max(row.p999, t::geometry::ComputeAbsErrorPercentile(image, reference, 0.999));
+}
+
 void PrintTable(const std::vector<Row>& rows) {
     std::string last;
     for (const Row& r : rows) {
@@ -270,6 +316,13 @@ void PrintTable(const std::vector<Row>& rows) {
             r.project_ms, r.sort_ms, r.composite_ms, r.gpu_total_ms, r.cpu_frame_ms,
             r.bytes_per_splat, err, r.depth_sort_ms, r.scan_emit_ms, r.tile_sort_ms,
             r.error_flags ? "  (entries dropped!)" : "");
+        if (r.lod_budget > 0) {
+            std::printf(
+                "%-11s level of detail: cut of %.0f nodes (budget %lld) in %.1f ms on the CPU; "
+                "error against the exact render of all %lld splats\n",
+                "", r.lod_nodes, static_cast<long long>(r.lod_budget), r.lod_cut_ms,
+                static_cast<long long>(r.splats));
+        }
         if (r.pipelined_ms > 0) {
             std::printf(
                 "%-11s wall ms/frame: one submission %.3f (GPU: passes %.3f, submission %.3f), "
@@ -306,6 +359,58 @@ void WriteJson(const std::string& path, const nlohmann::json& rows) {
     files.Commit();
 }
 
+// Level-of-detail rows (--lod-budgets), timed with the knobs before any CPU reference: per
+// budget, every view's cut of the hierarchy is rendered exactly by a backend of its own (the
+// cut set as its scene) and its colour compared with the exact render of the whole scene.
+void AddLodRows(const Options& opt, const std::vector<int64_t>& budgets, const SceneJob& job,
+                const t::geometry::SplatHierarchy& hierarchy, double hierarchy_ms,
+                rendering::GaussianSplatBackend& backend,
+                const std::vector<camera::PinholeCamera>& cams, const std::string& resolution,
+                std::vector<Row>& rows) {
+    rendering::RenderConfig config;  // the default knob: exact order, float32 storage
+    config.reuse_geometry = false;
+    std::vector<t::geometry::Image> exact;
+    for (const auto& cam : cams) exact.push_back(backend.Render(cam, config).color);
+    auto lod_backend = rendering::CreateGaussianSplatBackend(opt.backend);
+    auto* vulkan = dynamic_cast<rendering::vulkan::GaussianSplatVulkanBackend*>(lod_backend.get());
+    if (vulkan != nullptr) vulkan->SetFramesInFlight(opt.frames_in_flight);
+    const double n = static_cast<double>(cams.size());
+    for (const int64_t budget : budgets) {
+        Row row;
+        row.scene = job.name;
+        row.resolution = resolution;
+        row.knob = "lod " + bench::BudgetLabel(budget);
+        row.splats = job.cloud.NumPoints();
+        row.lod_budget = budget;
+        row.hierarchy_build_ms = hierarchy_ms;
+        for (size_t v = 0; v < cams.size(); ++v) {
+            const bench::LodCut cut = bench::CutForView(hierarchy, job.cloud, cams[v], budget);
+            row.lod_nodes += static_cast<double>(cut.nodes) / n;
+            row.lod_cut_ms += cut.cut_ms / n;
+            lod_backend->SetScene(cut.cloud);
+            const rendering::RenderOutput out = lod_backend->Render(cams[v], config);
+            const TimedFrames timed =
+                RunTimedFrames(*lod_backend, cams[v], config, opt.repeat, opt.depth);
+            AddView(row, timed, out.stats, cams.size());
+            row.bytes_per_splat +=
+                static_cast<double>(out.stats.gpu_scene_bytes) / static_cast<double>(cut.nodes) / n;
+            if (vulkan != nullptr) {
+                rendering::BatchOptions colour;  // colour only, as the knobs' rows
+                colour.read_back = false;
+                const int frames = std::max(50, opt.repeat);
+                row.pipelined_ms +=
+                    bench::PipelinedMsPerFrame(*vulkan, {cams[v]}, config, colour, frames) / n;
+                colour.read_back = true;
+                row.pipelined_readback_ms +=
+                    bench::PipelinedMsPerFrame(*vulkan, {cams[v]}, config, colour, frames) / n;
+            }
+            AddViewError(row, out.color, exact[v]);
+        }
+        row.gpu_total_ms = row.project_ms + row.sort_ms + row.composite_ms;
+        rows.push_back(row);
+    }
+}
+
 int Run(const Options& opt) {
     // The JSON output is checked before minutes of benchmarking, not after them.
     if (!opt.json.empty()) {
@@ -317,6 +422,8 @@ int Run(const Options& opt) {
     if (opt.batch > 0 && opt.backend != "vulkan") {
         core::ThrowError("--batch measures the Vulkan backend's batches: use --backend vulkan");
     }
+    const std::vector<int64_t> budgets =
+        opt.lod_budgets.empty() ? std::vector<int64_t>{} : bench::ParseBudgets(opt.lod_budgets);
     rendering::vulkan::RegisterVulkanBackend();
     std::vector<SceneJob> jobs;
     if (opt.inputs.empty()) core::ThrowError("--input is required (a .ply or .splat scene)");
@@ -380,6 +487,18 @@ int Run(const Options& opt) {
         backend->SetScene(job.cloud);
         const bool reference =
             opt.reference_max_splats > 0 && job.cloud.NumPoints() <= opt.reference_max_splats;
+        t::geometry::SplatHierarchy hierarchy;
+        double hierarchy_ms = 0.0;
+        if (!budgets.empty()) {
+            const auto start = std::chrono::steady_clock::now();
+            hierarchy = t::geometry::BuildSplatHierarchy(job.cloud);
+            hierarchy_ms = core::MillisecondsSince(start);
+            std::printf(
+                "%s: level-of-detail hierarchy of %lld splats and %lld inner nodes built "
+                "in %.0f ms\n",
+                job.name.c_str(), static_cast<long long>(hierarchy.num_leaves),
+                static_cast<long long>(hierarchy.NumInner()), hierarchy_ms);
+        }
         auto job_resolutions = resolutions;
         if (job_resolutions.empty()) job_resolutions.push_back(job.native);
         for (const auto& [w, h] : job_resolutions) {
@@ -404,28 +523,7 @@ int Run(const Options& opt) {
                     rendering::RenderOutput out = backend->Render(cams[v], config);
                     const TimedFrames timed =
                         RunTimedFrames(*backend, cams[v], config, opt.repeat, opt.depth);
-                    const rendering::RenderStats& med = timed.gpu;
-                    const double n = static_cast<double>(cams.size());  // mean over views
-                    row.project_ms += med.gpu_project_ms / n;
-                    row.sort_ms += med.gpu_sort_ms / n;
-                    row.composite_ms += med.gpu_composite_ms / n;
-                    row.depth_sort_ms += med.gpu_depth_sort_ms / n;
-                    row.scan_emit_ms += med.gpu_scan_emit_ms / n;
-                    row.tile_sort_ms += med.gpu_tile_sort_ms / n;
-                    row.cpu_frame_ms += timed.cpu_frame_ms / n;
-                    row.frame_ms += timed.frame_ms / n;
-                    row.frame_gpu_ms += timed.frame_gpu_ms / n;
-                    row.frame_job_gpu_ms += timed.frame_job_gpu_ms / n;
-                    for (auto [sum, part] : {std::pair{&row.stage_host, &timed.stage_host},
-                                             std::pair{&row.frame_host, &timed.frame_host}}) {
-                        sum->host_record_ms += part->host_record_ms / n;
-                        sum->host_submit_ms += part->host_submit_ms / n;
-                        sum->host_wait_ms += part->host_wait_ms / n;
-                        sum->host_readback_ms += part->host_readback_ms / n;
-                    }
-                    row.visible += out.stats.num_visible / static_cast<int64_t>(cams.size());
-                    row.entries += out.stats.num_tile_entries / static_cast<int64_t>(cams.size());
-                    row.error_flags |= out.stats.error_flags;
+                    AddView(row, timed, out.stats, cams.size());
                     row.bytes_per_splat =
                         static_cast<double>(out.stats.gpu_scene_bytes) / row.splats;
                     if (reference) images[k].push_back(std::move(out.color));
@@ -483,6 +581,10 @@ int Run(const Options& opt) {
                 }
                 rows.push_back(row);
             }
+            if (!budgets.empty()) {
+                AddLodRows(opt, budgets, job, hierarchy, hierarchy_ms, *backend, cams,
+                           fmt::format("{}x{}", w, h), rows);
+            }
             if (!reference) continue;
             // Phase 2: the error columns against CPU references, keyed by what changes the
             // reference image (SH cap, antialias).
@@ -491,7 +593,6 @@ int Run(const Options& opt) {
                 rendering::RenderConfig config;
                 knobs[k].apply(config);
                 Row& row = rows[first_row + k];
-                double worst_psnr = INFINITY;
                 for (size_t v = 0; v < cams.size(); ++v) {
                     auto& ref = refs[{config.sh_degree, config.antialias}];
                     if (ref.size() <= v) {
@@ -501,17 +602,8 @@ int Run(const Options& opt) {
                         ref.push_back(
                             rendering::cpu::RenderReference(job.cloud, cams[v], ref_config).color);
                     }
-                    const t::geometry::Image& gpu = images[k][v];
-                    const auto m =
-                        t::geometry::ComputeImageErrorMetrics(gpu, ref[v], 1.0, 1.0 / 255.0);
-                    row.has_error = true;
-                    worst_psnr = std::min(worst_psnr, m.psnr_db);
-                    row.max_abs = std::max(row.max_abs, m.max_abs_error);
-                    row.over_1_255 = std::max(row.over_1_255, m.fraction_over_threshold);
-                    row.p999 = std::max(row.p999,
-                                        t::geometry::ComputeAbsErrorPercentile(gpu, ref[v], 0.999));
+                    AddViewError(row, images[k][v], ref[v]);
                 }
-                row.psnr = worst_psnr;  // the worst view
             }
         }
     }
@@ -571,6 +663,13 @@ int Run(const Options& opt) {
                     {"submissions", r.batch_submissions},
                     {"device_to_host_copy_gb_per_s", r.batch_copy_gb_per_s},
                     {"float32_copy_ceiling_views_per_second", r.batch_copy_ceiling_vps}};
+            }
+            if (r.lod_budget > 0) {
+                out.back()["lod"] = {{"budget", r.lod_budget},
+                                     {"nodes", r.lod_nodes},
+                                     {"cut_cpu_ms", r.lod_cut_ms},
+                                     {"hierarchy_build_ms", r.hierarchy_build_ms},
+                                     {"error_against", "exact render of the whole scene"}};
             }
             if (r.has_error) {
                 out.back()["psnr_db_worst_view"] = r.psnr;
@@ -634,6 +733,11 @@ int main(int argc, char** argv) {
                    "Vulkan: frame slots of the submission path (1: no overlap)")
         ->check(CLI::Range(1, 4))
         ->capture_default_str();
+    app.add_option("--lod-budgets", opt.lod_budgets,
+                   "Also render each view's level-of-detail cut under these splat budgets (comma "
+                   "list, k = 1000, M = 1000000, e.g. 500k,1M,2M): one row per budget, its error "
+                   "columns against the exact render of the whole scene (the hierarchy is built "
+                   "once per scene, the cut on the CPU; docs/lod.md)");
     app.add_option("--reference-max-splats", opt.reference_max_splats,
                    "Skip the CPU reference for scenes larger than this (0: never compare)")
         ->capture_default_str();

@@ -232,6 +232,43 @@ TEST(SplatHierarchy, CutsPartitionTheLeavesWithinTheBudget) {
     EXPECT_THROW(CutSplatHierarchy(h, view, 0), core::Open3DError);
 }
 
+// The budget goes to what the view sees: 100 splats in front of the camera, 100 behind it
+// and 100 in front but beside the image's frustum. With a budget of 110 every splat in view
+// is a leaf of the cut and the other two clusters keep at most 10 nodes; with every leaf's
+// budget all are leaves. (Before the frustum test, nodes behind the camera had a negative
+// depth and counted as the largest: opened first.)
+TEST(SplatHierarchy, CutsRefineOnlyWhatTheViewSees) {
+    std::mt19937 rng(17);
+    std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+    std::vector<Splat> splats;
+    const auto cluster = [&](float x, float z) {
+        for (int i = 0; i < 100; ++i) {
+            splats.push_back(
+                Splat{{x + unit(rng), unit(rng) - 0.5f, z + unit(rng)}, {0.02f, 0.02f, 0.02f}});
+        }
+    };
+    cluster(-0.5f, 5.0f);   // in view: x / z within +-0.2 of the image's +-0.5
+    cluster(-0.5f, -6.0f);  // behind the camera
+    cluster(50.0f, 5.0f);   // x / z ~ 10: far beside the frustum
+    const SplatHierarchy h = BuildSplatHierarchy(Cloud(splats));
+    SplatCutView view;  // camera at the origin looking down +z
+    view.focal_px = 100.0;
+    view.width = view.height = 100;
+    view.fx = view.fy = 100.0;
+    view.cx = view.cy = 49.5;
+    const std::vector<int64_t> cut = CutSplatHierarchy(h, view, 110);
+    const auto in_view = [](int64_t node) { return node < 100; };
+    EXPECT_EQ(std::count_if(cut.begin(), cut.end(), in_view), 100);
+    EXPECT_LE(cut.size(), 110u);
+    EXPECT_EQ(CutSplatHierarchy(h, view, 300).size(), 300u);
+    // Without the image only the camera's back bounds the cut: the cluster beside the
+    // frustum competes with the one in view, and the one behind the camera stays closed.
+    view.width = view.height = 0;
+    const std::vector<int64_t> unbounded = CutSplatHierarchy(h, view, 110);
+    EXPECT_LT(std::count_if(unbounded.begin(), unbounded.end(), in_view), 100);
+    for (int64_t node : unbounded) EXPECT_FALSE(node >= 100 && node < 200) << node;
+}
+
 TEST(SplatHierarchy, ABudgetOfEveryLeafGivesTheSourceCloud) {
     std::mt19937 rng(11);
     const PointCloud cloud = Cloud(RandomSplats(rng, 300), 2);

@@ -263,6 +263,29 @@ GaussianSplatArrays InnerArrays(const SplatHierarchy& hierarchy) {
                                      : hierarchy.inner.GetGaussianSplatArrays();
 }
 
+// Whether a sphere of `radius` about camera-space point `c` lies wholly behind the camera
+// or, where the view has an image, wholly outside one of its frustum's four side planes,
+// widened like the renderer's guard band: splats up to 1.3x the half-angle out are still
+// projected, and the footprint's 0.3 px dilation reaches 1.6 px beyond the ellipse
+// (docs/lod.md "Cut").
+bool OutsideView(const SplatCutView& view, const Eigen::Vector3d& c, double radius) {
+    if (c.z() + radius <= 0.0) return true;
+    if (view.width <= 0 || view.height <= 0) return false;
+    // x / z on the image lies in [lo, hi], widened by 15% of the span and 2 px each side;
+    // the plane x = m z is at signed distance (x - m z) / sqrt(1 + m^2) from c.
+    const auto outside = [&](double x, double lo, double hi, double f) {
+        const double margin = 0.15 * (hi - lo) + 2.0 / f;
+        lo -= margin;
+        hi += margin;
+        return (x - lo * c.z()) / std::sqrt(1.0 + lo * lo) < -radius ||
+               (hi * c.z() - x) / std::sqrt(1.0 + hi * hi) < -radius;
+    };
+    return outside(c.x(), (-0.5 - view.cx) / view.fx, (view.width - 0.5 - view.cx) / view.fx,
+                   view.fx) ||
+           outside(c.y(), (-0.5 - view.cy) / view.fy, (view.height - 0.5 - view.cy) / view.fy,
+                   view.fy);
+}
+
 }  // namespace
 
 SplatHierarchy BuildSplatHierarchy(const PointCloud& splats) {
@@ -278,12 +301,15 @@ std::vector<int64_t> CutSplatHierarchy(const SplatHierarchy& hierarchy, const Sp
     const GaussianSplatArrays inner = InnerArrays(hierarchy);
     // Projected size of inner node k: 3 sigma of its largest axis over its depth; a node
     // nearer than its own size counts as its size in pixels times a large factor.
+    // A node wholly outside the view (OutsideView) gets -1: it is opened only after every
+    // node in view, where the budget still allows (so a budget of every leaf stays exact).
     const auto size = [&](int64_t k) {
         const float* p = inner.positions + 3 * k;
         const float* s = inner.scale + 3 * k;
         const double radius = 3.0 * std::max({std::abs(s[0]), std::abs(s[1]), std::abs(s[2])});
-        const double depth = (r * Eigen::Vector3d(p[0], p[1], p[2]) + t).z();
-        return view.focal_px * radius / std::max(depth, 1e-3 * radius + 1e-30);
+        const Eigen::Vector3d c = r * Eigen::Vector3d(p[0], p[1], p[2]) + t;
+        if (OutsideView(view, c, radius)) return -1.0;
+        return view.focal_px * radius / std::max(c.z(), 1e-3 * radius + 1e-30);
     };
     std::vector<int64_t> cut;
     std::priority_queue<std::pair<double, int64_t>> open;  // (size, inner index)

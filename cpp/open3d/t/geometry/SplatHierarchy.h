@@ -42,17 +42,23 @@ struct SplatHierarchy {
 SplatHierarchy BuildSplatHierarchy(const PointCloud& splats);
 
 /// The camera a cut is chosen for: p_cam = R p_world + t from world_to_camera, focal length
-/// in pixels (the larger of fx and fy).
+/// in pixels (the larger of fx and fy), and, where width > 0, the image whose frustum bounds
+/// what the cut refines (pinhole fx, fy, cx, cy in pixels, OpenCV axes: z forward).
 struct SplatCutView {
     Eigen::Matrix4d world_to_camera = Eigen::Matrix4d::Identity();
     double focal_px = 1.0;
+    int width = 0, height = 0;  ///< 0: no frustum test beyond the camera's back
+    double fx = 1.0, fy = 1.0, cx = 0.0, cy = 0.0;
 };
 
 /// A cut of at most `budget` (>= 1) nodes, every leaf under exactly one of them, in ascending
 /// node id. From the root, the node of largest projected size (focal_px * 3 * largest scale /
 /// depth, nodes nearer than their own size first) is replaced by its children while that
-/// keeps the cut within the budget; a node whose children do not fit stays whole. A budget of
-/// at least num_leaves gives every leaf: the source cloud itself.
+/// keeps the cut within the budget; a node whose children do not fit stays whole. Nodes whose
+/// bounding sphere (3 x the largest scale) lies wholly behind the camera or, with the view's
+/// image, outside its frustum (with a guard band) are opened only after every node in view:
+/// the budget goes to what the view sees. A budget of at least num_leaves gives every leaf:
+/// the source cloud itself.
 std::vector<int64_t> CutSplatHierarchy(const SplatHierarchy& hierarchy, const SplatCutView& view,
                                        int64_t budget);
 
