@@ -49,7 +49,7 @@ std::string BudgetLabel(int64_t budget) {
         return s;
     };
     if (budget >= 1000000 && budget % 1000 == 0) return shortest(budget / 1e6) + "M";
-    if (budget >= 1000 && budget % 1000 == 0) return shortest(budget / 1e3) + "k";
+    if (budget >= 1000 && budget % 10 == 0) return shortest(budget / 1e3) + "k";
     return std::to_string(budget);
 }
 

@@ -18,7 +18,7 @@ namespace bench {
 /// splats). Throws core::Open3DError naming the item that is not one.
 std::vector<int64_t> ParseBudgets(const std::string& text);
 
-/// The budget as --lod-budgets would spell it: "500k", "1M", "2.5M", "3000".
+/// The budget as --lod-budgets would spell it: "500k", "12.5k", "1M", "2.5M", "3001".
 std::string BudgetLabel(int64_t budget);
 
 /// A view's cut: the cloud of its nodes, how many, and the CPU time the cut and the
