@@ -48,7 +48,8 @@ struct Options {
     std::string depth = "none";
     int batch = 0;
     int frames_in_flight = 2;
-    std::string lod_budgets;  // --lod-budgets, empty: no level-of-detail rows
+    std::string lod_budgets;        // --lod-budgets, empty: no level-of-detail rows
+    uint64_t max_tile_entries = 0;  // --max-tile-entries, 0: RenderConfig's default
 };
 
 struct Knob {
@@ -369,6 +370,7 @@ void AddLodRows(const Options& opt, const std::vector<int64_t>& budgets, const S
                 std::vector<Row>& rows) {
     rendering::RenderConfig config;  // the default knob: exact order, float32 storage
     config.reuse_geometry = false;
+    if (opt.max_tile_entries > 0) config.max_tile_entries_total = opt.max_tile_entries;
     std::vector<t::geometry::Image> exact;
     for (const auto& cam : cams) exact.push_back(backend.Render(cam, config).color);
     auto lod_backend = rendering::CreateGaussianSplatBackend(opt.backend);
@@ -511,6 +513,9 @@ int Run(const Options& opt) {
             for (size_t k = 0; k < knobs.size(); ++k) {
                 rendering::RenderConfig config;
                 config.reuse_geometry = false;
+                if (opt.max_tile_entries > 0) {
+                    config.max_tile_entries_total = opt.max_tile_entries;
+                }
                 knobs[k].apply(config);
                 Row row;
                 row.scene = job.name;
@@ -738,6 +743,11 @@ int main(int argc, char** argv) {
                    "list, k = 1000, M = 1000000, e.g. 500k,1M,2M): one row per budget, its error "
                    "columns against the exact render of the whole scene (the hierarchy is built "
                    "once per scene, the cut on the CPU; docs/lod.md)");
+    app.add_option("--max-tile-entries", opt.max_tile_entries,
+                   "Tile entries a frame may hold before the farthest splats' are dropped "
+                   "(RenderConfig::max_tile_entries_total; default 2^26 = 67,108,864; the "
+                   "Vulkan sort takes at most 134,215,680)")
+        ->check(CLI::Range(uint64_t(1), uint64_t(1) << 40));
     app.add_option("--reference-max-splats", opt.reference_max_splats,
                    "Skip the CPU reference for scenes larger than this (0: never compare)")
         ->capture_default_str();
