@@ -39,6 +39,7 @@ struct Gaussian {
     Eigen::Vector3d mean;
     Eigen::Matrix3d covariance;
     Eigen::Vector3d scale;  // sorted descending
+    Eigen::Matrix3d axes;   // merged nodes: the covariance's eigenvectors, largest first
     double alpha = 0.0;
     std::vector<double> color;  // f_dc then f_rest, flattened
 };
@@ -142,6 +143,7 @@ private:
         const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(m.covariance);
         const Eigen::Vector3d values = eigen.eigenvalues().cwiseMax(0.0);
         m.scale = Eigen::Vector3d(std::sqrt(values[2]), std::sqrt(values[1]), std::sqrt(values[0]));
+        m.axes = eigen.eigenvectors().rowwise().reverse();  // columns largest first, as scale
         const double area = m.scale[0] * m.scale[1];
         double transmitted = 1.0;
         for (const Gaussian& g : parts) {
@@ -159,7 +161,6 @@ private:
         return hierarchy_.num_leaves + static_cast<int64_t>(inner_.size()) - 1;
     }
 
-    // Splats order_[b, e) that share their code above bit group `level`; returns the node.
     // Leaves are placed left to right: their count is the progress.
     int64_t PlaceLeaf(int64_t i) {
         if (++placed_ % kProgressStep == 0) {
@@ -168,6 +169,7 @@ private:
         return order_[i];
     }
 
+    // Splats order_[b, e) that share their code above bit group `level`; returns the node.
     int64_t BuildRange(int64_t b, int64_t e, int level) {
         if (e - b == 1) return PlaceLeaf(b);
         if (level < 0) return GroupEqual(b, e);  // identical codes
@@ -219,8 +221,7 @@ private:
         core::Tensor f_rest({k, a_.num_rest, 3}, core::Dtype::Float32);
         for (int64_t j = 0; j < k; ++j) {
             const Gaussian& g = inner_[j];
-            const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(g.covariance);
-            Eigen::Matrix3d axes = eigen.eigenvectors().rowwise().reverse();  // largest first
+            Eigen::Matrix3d axes = g.axes;  // a proper rotation: flip the smallest axis
             if (axes.determinant() < 0.0) axes.col(2) *= -1.0;
             Eigen::Quaterniond q(axes);
             q.normalize();
