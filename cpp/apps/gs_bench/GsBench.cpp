@@ -12,6 +12,8 @@
 #include <map>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <tuple>
+#include <utility>
 #include <vector>
 
 #include "BenchScenes.h"
@@ -256,6 +258,29 @@ TimedFrames RunTimedFrames(rendering::GaussianSplatBackend& backend,
     return m;
 }
 
+// The configuration every timed row starts from: geometry re-run per frame, and the entry
+// cap of --max-tile-entries where given.
+rendering::RenderConfig TimedConfig(const Options& opt) {
+    rendering::RenderConfig config;
+    config.reuse_geometry = false;
+    if (opt.max_tile_entries > 0) config.max_tile_entries_total = opt.max_tile_entries;
+    return config;
+}
+
+// Wall ms per frame with frames in flight over `cams`, colour only, without and with the
+// RGBA32F readback, each over max(50, --repeat) frames.
+std::pair<double, double> PipelinedMs(const Options& opt,
+                                      rendering::vulkan::GaussianSplatVulkanBackend& vulkan,
+                                      const std::vector<camera::PinholeCamera>& cams,
+                                      const rendering::RenderConfig& config) {
+    rendering::BatchOptions colour;  // colour only, as the timed frames
+    const int frames = std::max(50, opt.repeat);
+    colour.read_back = false;
+    const double no_readback = bench::PipelinedMsPerFrame(vulkan, cams, config, colour, frames);
+    colour.read_back = true;
+    return {no_readback, bench::PipelinedMsPerFrame(vulkan, cams, config, colour, frames)};
+}
+
 // Adds one view's timed frames and its full frame's counts to `row`, as the mean over
 // `num_views` views.
 void AddView(Row& row, const TimedFrames& timed, const rendering::RenderStats& full,
@@ -368,9 +393,8 @@ void AddLodRows(const Options& opt, const std::vector<int64_t>& budgets, const S
                 rendering::GaussianSplatBackend& backend,
                 const std::vector<camera::PinholeCamera>& cams, const std::string& resolution,
                 std::vector<Row>& rows) {
-    rendering::RenderConfig config;  // the default knob: exact order, float32 storage
-    config.reuse_geometry = false;
-    if (opt.max_tile_entries > 0) config.max_tile_entries_total = opt.max_tile_entries;
+    // The default knob: exact order, float32 storage.
+    const rendering::RenderConfig config = TimedConfig(opt);
     std::vector<t::geometry::Image> exact;
     for (const auto& cam : cams) exact.push_back(backend.Render(cam, config).color);
     auto lod_backend = rendering::CreateGaussianSplatBackend(opt.backend);
@@ -397,14 +421,10 @@ void AddLodRows(const Options& opt, const std::vector<int64_t>& budgets, const S
             row.bytes_per_splat +=
                 static_cast<double>(out.stats.gpu_scene_bytes) / static_cast<double>(cut.nodes) / n;
             if (vulkan != nullptr) {
-                rendering::BatchOptions colour;  // colour only, as the knobs' rows
-                colour.read_back = false;
-                const int frames = std::max(50, opt.repeat);
-                row.pipelined_ms +=
-                    bench::PipelinedMsPerFrame(*vulkan, {cams[v]}, config, colour, frames) / n;
-                colour.read_back = true;
-                row.pipelined_readback_ms +=
-                    bench::PipelinedMsPerFrame(*vulkan, {cams[v]}, config, colour, frames) / n;
+                const auto [in_flight, with_readback] =
+                    PipelinedMs(opt, *vulkan, {cams[v]}, config);
+                row.pipelined_ms += in_flight / n;
+                row.pipelined_readback_ms += with_readback / n;
             }
             AddViewError(row, out.color, exact[v]);
         }
@@ -511,11 +531,7 @@ int Run(const Options& opt) {
             const size_t first_row = rows.size();
             std::vector<std::vector<t::geometry::Image>> images(knobs.size());
             for (size_t k = 0; k < knobs.size(); ++k) {
-                rendering::RenderConfig config;
-                config.reuse_geometry = false;
-                if (opt.max_tile_entries > 0) {
-                    config.max_tile_entries_total = opt.max_tile_entries;
-                }
+                rendering::RenderConfig config = TimedConfig(opt);
                 knobs[k].apply(config);
                 Row row;
                 row.scene = job.name;
@@ -535,14 +551,8 @@ int Run(const Options& opt) {
                 }
                 row.gpu_total_ms = row.project_ms + row.sort_ms + row.composite_ms;
                 if (vulkan != nullptr) {
-                    rendering::BatchOptions colour;  // colour only, as the timed frames
-                    colour.read_back = false;
-                    const int frames = std::max(50, opt.repeat);
-                    row.pipelined_ms =
-                        bench::PipelinedMsPerFrame(*vulkan, cams, config, colour, frames);
-                    colour.read_back = true;
-                    row.pipelined_readback_ms =
-                        bench::PipelinedMsPerFrame(*vulkan, cams, config, colour, frames);
+                    std::tie(row.pipelined_ms, row.pipelined_readback_ms) =
+                        PipelinedMs(opt, *vulkan, cams, config);
                     if (opt.batch > 0) {
                         const int repeats = 5;
                         rendering::BatchOptions o;
