@@ -114,15 +114,15 @@ int main(int argc, char** argv) {
                     t::io::PointCloudFileFormatName(format),
                     static_cast<long long>(report.num_points),
                     cloud.IsGaussianSplat() ? cloud.GetGaussianSplatArrays().sh_degree : 0);
+        if (lod && !cloud.IsGaussianSplat()) {
+            core::ThrowError("--lod: '{}' holds points without Gaussian attributes", input);
+        }
         // Written beside the output and renamed when complete: a failed write leaves no
         // partial file, and --force onto the input never truncates what is being read.
         t::io::OutputFileSet files;
         t::io::WritePointCloud(files.Add(output), cloud);
         int64_t lod_nodes = 0;
         if (lod) {
-            if (!cloud.IsGaussianSplat()) {
-                core::ThrowError("--lod: '{}' holds points without Gaussian attributes", input);
-            }
             // Built from the cloud as read: a lossy output format's splats differ slightly
             // from the leaves it was built on.
             const t::geometry::SplatHierarchy hierarchy = t::geometry::BuildSplatHierarchy(cloud);
