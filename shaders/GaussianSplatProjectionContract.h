@@ -94,7 +94,10 @@ struct GaussianViewParams {
     // (ReferenceViewDepth, ReferenceDepthRow).
     float reference_m2, reference_m6, reference_m10, reference_m14;
     uint depth_order;  // kDepthOrderReference / kDepthOrderCameraRelative
-    uint reserved1, reserved2, reserved3;
+    // Nodes the level-of-detail cut may keep (RenderConfig::lod_budget, 0xFFFFFFFF: every
+    // leaf); read only for a scene with a hierarchy (GaussianSplatLodContract.h).
+    uint lod_budget;
+    uint reserved2, reserved3;
 };
 
 // One projected splat, written for visible splats only, indexed by splat index (std430).
@@ -189,6 +192,7 @@ static_assert(offsetof(GaussianViewParams, reference_m6) == 164);
 static_assert(offsetof(GaussianViewParams, reference_m10) == 168);
 static_assert(offsetof(GaussianViewParams, reference_m14) == 172);
 static_assert(offsetof(GaussianViewParams, depth_order) == 176);
+static_assert(offsetof(GaussianViewParams, lod_budget) == 180);
 static_assert(offsetof(GaussianViewParams, reserved3) == 188);
 
 static_assert(sizeof(GaussianProjectedSplat) == 64);

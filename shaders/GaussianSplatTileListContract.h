@@ -62,6 +62,11 @@ struct GaussianGeometryStageCounters {
     uint emit_dispatch_z;
     uint num_splats;  // N: the element count of the exact mode's depth sort
     GaussianScanLevel scan_levels[kScanMaxLevels];
+    // Scenes with a level-of-detail hierarchy (gaussian_lod_cut.comp): the nodes of the
+    // view's cut and the size bucket it opens above (kLodOpenAll: every inner node).
+    uint lod_cut_nodes;
+    uint lod_threshold;
+    uint lod_reserved0, lod_reserved1;
 };
 
 // Push constants of gaussian_dispatch_args.comp.
@@ -170,7 +175,8 @@ static_assert(kScanBlockSize == kScanWorkgroupSize * kScanItemsPerInvocation);
 static_assert(kCounterVisibleIndex * 4 == 0 && kCounterEntriesIndex * 4 == 8);
 
 static_assert(sizeof(GaussianScanLevel) == 16);
-static_assert(sizeof(GaussianGeometryStageCounters) == 32 + 16 * kScanMaxLevels);
+static_assert(sizeof(GaussianGeometryStageCounters) == 48 + 16 * kScanMaxLevels);
+static_assert(offsetof(GaussianGeometryStageCounters, lod_cut_nodes) == 32 + 16 * kScanMaxLevels);
 static_assert(offsetof(GaussianGeometryStageCounters, visible_count) == 4 * kCounterVisibleIndex);
 static_assert(offsetof(GaussianGeometryStageCounters, num_splats) == 4 * kCounterNumSplatsIndex);
 static_assert(offsetof(GaussianGeometryStageCounters, requested_entries) == 4);

@@ -98,6 +98,7 @@ struct Row {
     // render of the whole scene, not the CPU reference.
     int64_t lod_budget = 0;
     double lod_nodes = 0, lod_cut_ms = 0, hierarchy_build_ms = 0;
+    bool lod_on_gpu = false;  // the cut chosen by the Vulkan backend, not on the CPU
 };
 
 std::pair<int, int> ParseResolution(const std::string& text) {
@@ -342,7 +343,13 @@ void PrintTable(const std::vector<Row>& rows) {
             r.project_ms, r.sort_ms, r.composite_ms, r.gpu_total_ms, r.cpu_frame_ms,
             r.bytes_per_splat, err, r.depth_sort_ms, r.scan_emit_ms, r.tile_sort_ms,
             r.error_flags ? "  (entries dropped!)" : "");
-        if (r.lod_budget > 0) {
+        if (r.lod_budget > 0 && r.lod_on_gpu) {
+            std::printf(
+                "%-11s level of detail: cut of %.0f nodes (budget %lld) chosen on the GPU (in "
+                "project); error against the exact render of all %lld splats\n",
+                "", r.lod_nodes, static_cast<long long>(r.lod_budget),
+                static_cast<long long>(r.splats));
+        } else if (r.lod_budget > 0) {
             std::printf(
                 "%-11s level of detail: cut of %.0f nodes (budget %lld) in %.1f ms on the CPU; "
                 "error against the exact render of all %lld splats\n",
@@ -386,20 +393,25 @@ void WriteJson(const std::string& path, const nlohmann::json& rows) {
 }
 
 // Level-of-detail rows (--lod-budgets), timed with the knobs before any CPU reference: per
-// budget, every view's cut of the hierarchy is rendered exactly by a backend of its own (the
-// cut set as its scene) and its colour compared with the exact render of the whole scene.
+// budget, every view's cut rendered and its colour compared with the exact render of the
+// whole scene. With Vulkan the scene is the hierarchy's nodes and the cut is chosen on the
+// GPU each frame (RenderConfig::lod_budget: its passes are in the projection's time); other
+// backends render the CPU cut (CutSplatHierarchy) set as their scene.
 void AddLodRows(const Options& opt, const std::vector<int64_t>& budgets, const SceneJob& job,
                 const t::geometry::SplatHierarchy& hierarchy, double hierarchy_ms,
                 rendering::GaussianSplatBackend& backend,
                 const std::vector<camera::PinholeCamera>& cams, const std::string& resolution,
                 std::vector<Row>& rows) {
     // The default knob: exact order, float32 storage.
-    const rendering::RenderConfig config = TimedConfig(opt);
+    rendering::RenderConfig config = TimedConfig(opt);
     std::vector<t::geometry::Image> exact;
     for (const auto& cam : cams) exact.push_back(backend.Render(cam, config).color);
     auto lod_backend = rendering::CreateGaussianSplatBackend(opt.backend);
     auto* vulkan = dynamic_cast<rendering::vulkan::GaussianSplatVulkanBackend*>(lod_backend.get());
-    if (vulkan != nullptr) vulkan->SetFramesInFlight(opt.frames_in_flight);
+    if (vulkan != nullptr) {
+        vulkan->SetFramesInFlight(opt.frames_in_flight);
+        vulkan->SetSceneHierarchy(job.cloud, hierarchy);
+    }
     const double n = static_cast<double>(cams.size());
     for (const int64_t budget : budgets) {
         Row row;
@@ -408,18 +420,25 @@ void AddLodRows(const Options& opt, const std::vector<int64_t>& budgets, const S
         row.knob = "lod " + bench::BudgetLabel(budget);
         row.splats = job.cloud.NumPoints();
         row.lod_budget = budget;
+        row.lod_on_gpu = vulkan != nullptr;
         row.hierarchy_build_ms = hierarchy_ms;
+        config.lod_budget = static_cast<uint64_t>(budget);
         for (size_t v = 0; v < cams.size(); ++v) {
-            const bench::LodCut cut = bench::CutForView(hierarchy, job.cloud, cams[v], budget);
-            row.lod_nodes += static_cast<double>(cut.nodes) / n;
-            row.lod_cut_ms += cut.cut_ms / n;
-            lod_backend->SetScene(cut.cloud);
+            double scene_nodes = static_cast<double>(hierarchy.NumNodes());
+            if (vulkan == nullptr) {
+                const bench::LodCut cut = bench::CutForView(hierarchy, job.cloud, cams[v], budget);
+                row.lod_nodes += static_cast<double>(cut.nodes) / n;
+                row.lod_cut_ms += cut.cut_ms / n;
+                lod_backend->SetScene(cut.cloud);
+                scene_nodes = static_cast<double>(cut.nodes);
+            }
             const rendering::RenderOutput out = lod_backend->Render(cams[v], config);
+            if (vulkan != nullptr)
+                row.lod_nodes += static_cast<double>(out.stats.lod_cut_nodes) / n;
             const TimedFrames timed =
                 RunTimedFrames(*lod_backend, cams[v], config, opt.repeat, opt.depth);
             AddView(row, timed, out.stats, cams.size());
-            row.bytes_per_splat +=
-                static_cast<double>(out.stats.gpu_scene_bytes) / static_cast<double>(cut.nodes) / n;
+            row.bytes_per_splat += static_cast<double>(out.stats.gpu_scene_bytes) / scene_nodes / n;
             if (vulkan != nullptr) {
                 const auto [in_flight, with_readback] =
                     PipelinedMs(opt, *vulkan, {cams[v]}, config);
@@ -683,6 +702,7 @@ int Run(const Options& opt) {
                 out.back()["lod"] = {{"budget", r.lod_budget},
                                      {"nodes", r.lod_nodes},
                                      {"cut_cpu_ms", r.lod_cut_ms},
+                                     {"cut_on_gpu", r.lod_on_gpu},
                                      {"hierarchy_build_ms", r.hierarchy_build_ms},
                                      {"error_against", "exact render of the whole scene"}};
             }
@@ -748,11 +768,13 @@ int main(int argc, char** argv) {
                    "Vulkan: frame slots of the submission path (1: no overlap)")
         ->check(CLI::Range(1, 4))
         ->capture_default_str();
-    app.add_option("--lod-budgets", opt.lod_budgets,
-                   "Also render each view's level-of-detail cut under these splat budgets (comma "
-                   "list, k = 1000, M = 1000000, e.g. 500k,1M,2M): one row per budget, its error "
-                   "columns against the exact render of the whole scene (the hierarchy is built "
-                   "once per scene, the cut on the CPU; docs/lod.md)");
+    app.add_option(
+        "--lod-budgets", opt.lod_budgets,
+        "Also render each view's level-of-detail cut under these splat budgets (comma "
+        "list, k = 1000, M = 1000000, e.g. 500k,1M,2M): one row per budget, its error "
+        "columns against the exact render of the whole scene (the hierarchy is built "
+        "once per scene; with Vulkan the cut is chosen on the GPU each frame, else on the "
+        "CPU; docs/lod.md)");
     app.add_option("--max-tile-entries", opt.max_tile_entries,
                    "Tile entries a frame may hold before the farthest splats' are dropped "
                    "(RenderConfig::max_tile_entries_total; default 2^26 = 67,108,864; the "

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 
+#include "GaussianSplatLodContract.h"
 #include "open3d/core/Exception.h"
 #include "open3d/t/geometry/SphericalHarmonics.h"
 #include "open3d/visualization/rendering/gaussian_splat/cpu/Projection.h"
@@ -279,6 +280,10 @@ PackedView PackGaussianView(const camera::PinholeCamera& camera, const RenderCon
     p.depth_order = config.depth_order == DepthOrder::kReference
                         ? shader::kDepthOrderReference
                         : shader::kDepthOrderCameraRelative;
+    p.lod_budget =
+        config.lod_budget == 0
+            ? shader::kLodOpenAll
+            : static_cast<uint32_t>(std::min<uint64_t>(config.lod_budget, shader::kLodOpenAll));
     return {p, choices};
 }
 

@@ -12,7 +12,8 @@ bool SameGeometryConfig(const RenderConfig& a, const RenderConfig& b) {
     return a.near_plane == b.near_plane && a.sh_degree == b.sh_degree &&
            a.antialias == b.antialias && a.max_tiles_per_splat == b.max_tiles_per_splat &&
            a.max_tile_entries_total == b.max_tile_entries_total && a.sort_mode == b.sort_mode &&
-           a.depth_order == b.depth_order && a.compact_storage == b.compact_storage;
+           a.depth_order == b.depth_order && a.compact_storage == b.compact_storage &&
+           a.lod_budget == b.lod_budget;
 }
 
 void RenderConfig::Validate() const {

@@ -59,6 +59,10 @@ struct RenderConfig {
     /// `compact` (fp16 scale, rotation, colour and SH; <= 140 B/splat at SH degree 3). GPU
     /// backends re-upload the scene when it changes; the CPU reference ignores it.
     bool compact_storage = false;
+    /// A scene drawn through a level-of-detail hierarchy (GPU backends'
+    /// SetSceneHierarchy): the most nodes the view's cut may keep; 0 (the default) keeps
+    /// every leaf, the exact scene. Ignored for plain scenes.
+    uint64_t lod_budget = 0;
     /// GPU backends skip the geometry stage when the scene, the camera and this config are
     /// unchanged since the last frame; benchmarks turn it off to time the whole pipeline every
     /// frame.
@@ -83,6 +87,7 @@ struct RenderStats {
     int64_t num_splats = 0;
     int64_t num_visible = 0;       ///< splats that survived projection (>= 1 tile)
     int64_t num_tile_entries = 0;  ///< (tile, splat) pairs composited
+    int64_t lod_cut_nodes = 0;     ///< nodes of the level-of-detail cut (0: no hierarchy)
     uint32_t error_flags = 0;      ///< kEntriesDropped | kCountsClamped
     double geometry_ms = 0.0;      ///< project + tile entries + sort
     double composite_ms = 0.0;

@@ -186,6 +186,7 @@ TEST_F(GaussianSplatContractGpu, ShaderLayoutMatchesCpp) {
     EXPECT_EQ(v.reference_m10, 342.0f);
     EXPECT_EQ(v.reference_m14, 343.0f);
     EXPECT_EQ(v.depth_order, 344u);
+    EXPECT_EQ(v.lod_budget, 345u);
     EXPECT_EQ(v.reserved3, 347u);
 
     shader::GaussianProjectedSplat s;

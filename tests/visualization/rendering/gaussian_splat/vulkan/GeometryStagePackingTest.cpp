@@ -29,7 +29,11 @@ TEST(GeometryStagePacking, ContractLayoutsArePinned) {
     EXPECT_EQ(offsetof(shader::GaussianViewParams, depth_order), 176u);
     EXPECT_EQ(sizeof(shader::GaussianProjectedSplat), 64u);
     EXPECT_EQ(offsetof(shader::GaussianProjectedSplat, rect_min), 48u);
-    EXPECT_EQ(sizeof(shader::GaussianGeometryStageCounters), 32u + 16u * shader::kScanMaxLevels);
+    EXPECT_EQ(offsetof(shader::GaussianViewParams, lod_budget), 180u);
+    // The scan levels, then the level-of-detail cut's counts.
+    EXPECT_EQ(sizeof(shader::GaussianGeometryStageCounters), 48u + 16u * shader::kScanMaxLevels);
+    EXPECT_EQ(offsetof(shader::GaussianGeometryStageCounters, lod_cut_nodes),
+              32u + 16u * shader::kScanMaxLevels);
     EXPECT_EQ(offsetof(shader::GaussianGeometryStageCounters, entry_count),
               4u * shader::kCounterEntriesIndex);
     EXPECT_EQ(sizeof(shader::GaussianScanPushConstants), 32u);

@@ -41,7 +41,7 @@ void ComputeBarrier(VkCommandBuffer cmd) {
 }  // namespace
 
 GaussianGeometryStage::GaussianGeometryStage(const VulkanContext& context)
-    : context_(context), sort_(context) {
+    : context_(context), sort_(context), lod_cut_(context) {
     set_layout_ = CreateStorageBufferPushLayout(context, kGeometryStageNumBindings);
     const uint32_t push_bytes = static_cast<uint32_t>(
         std::max(sizeof(GaussianScanPushConstants), sizeof(GaussianDispatchArgsPushConstants)));
@@ -165,11 +165,14 @@ void GaussianGeometryStage::PushBindings(VkCommandBuffer cmd,
                                        0, kGeometryStageNumBindings, writes.data());
 }
 
-void GaussianGeometryStage::Record(VkCommandBuffer cmd, const GeometryStageSceneBuffers& scene,
+void GaussianGeometryStage::Record(VkCommandBuffer cmd, const GeometryStageSceneBuffers& in_scene,
                                    const GeometryStageViewBuffers& buffers, const PackedView& view,
                                    const GpuTimestamps* timestamps,
                                    const BufferRange* params_source) {
     if (timestamps) timestamps->RecordBegin(cmd, TimedPass::kProject);
+    // A hierarchy's nodes are drawn through the view's cut, not the scene's mask.
+    GeometryStageSceneBuffers scene = in_scene;
+    if (scene.lod) scene.visibility = buffers.lod_visibility;
     const uint32_t n = scene.num_splats;
     const GaussianViewParams& params = view.params;
     const GeometryStageChoices& choices = view.choices;
@@ -224,6 +227,26 @@ void GaussianGeometryStage::Record(VkCommandBuffer cmd, const GeometryStageScene
         VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_DRAW_INDIRECT_BIT,
         VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT |
             VK_ACCESS_2_INDIRECT_COMMAND_READ_BIT);
+
+    // 0. Level of detail: the view's cut of the hierarchy becomes the projection's mask.
+    if (scene.lod) {
+        LodCutBuffers cut;
+        cut.view_params = buffers.view_params;
+        cut.positions = scene.positions;
+        cut.nodes = scene.lod_nodes;
+        cut.buckets = buffers.lod_buckets;
+        cut.histogram = buffers.lod_histogram;
+        cut.counters = buffers.counters;
+        cut.visibility = buffers.lod_visibility;
+        cut.num_leaves = scene.lod_leaves;
+        cut.num_inner = scene.lod_inner;
+        if (cut.num_leaves + cut.num_inner != n) {
+            core::ThrowError("GaussianGeometryStage: a hierarchy of {} + {} nodes for {} splats",
+                             cut.num_leaves, cut.num_inner, n);
+        }
+        lod_cut_.Record(cmd, cut);
+        ComputeBarrier(cmd);
+    }
 
     // 1. Project: visible splats -> (depth key, splat index) list, visible_count.
     PushBindings(cmd, scene, buffers);

@@ -15,6 +15,7 @@
 #include "GaussianSplatTileListContract.h"
 #include "open3d/visualization/rendering/gaussian_splat/GaussianSplatDataPacking.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/Buffer.h"
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/GaussianLodCut.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/GpuTimestamps.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/RadixSort.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/VulkanHandle.h"
@@ -59,8 +60,13 @@ struct GeometryStageSceneBuffers {
     /// uint32 [N, sh words]. At SH degree 0 nothing is read from it; any small buffer
     /// serves (the binding must still name a valid buffer).
     BufferRange sh;
-    BufferRange visibility;  ///< uint32 [ceil(N / 32)]
+    BufferRange visibility;  ///< uint32 [ceil(N / 32)]; unread for a hierarchy (lod)
     uint32_t num_splats = 0;
+    /// The splats are the nodes of a level-of-detail hierarchy (GaussianSplatLodPacking.h):
+    /// the cut (GaussianLodCut) writes the view's mask into GeometryStageViewBuffers.
+    bool lod = false;
+    BufferRange lod_nodes;  ///< shader::GaussianLodNode [N]
+    uint32_t lod_leaves = 0, lod_inner = 0;
     int packed_sh_degree = 0;
     uint32_t sh_words_per_splat = 0;
     SplatPrecision precision = SplatPrecision::kExact;
@@ -79,6 +85,9 @@ struct GeometryStageViewBuffers {
     BufferRange entry_values;   ///< after Record: splat index per entry, front to back
     RadixSortScratch sort_scratch;
     BufferRange tile_counts;  ///< scratch: each visible splat's tile count, by splat index
+    /// A hierarchy's cut (GaussianLodCut; unused otherwise): effective size buckets, their
+    /// histogram, and the cut as the visibility mask the projection reads.
+    BufferRange lod_buckets, lod_histogram, lod_visibility;
 };
 
 class GaussianGeometryStage {
@@ -93,7 +102,8 @@ public:
                                                                    uint32_t entry_capacity);
 
     /// Records geometry stage for one view: writes view.params into buffers.view_params, zeroes the
-    /// counters (and, from N, the scan and emit sizes and the depth sort's parameters), then
+    /// counters (and, from N, the scan and emit sizes and the depth sort's parameters), for a
+    /// hierarchy's nodes (scene.lod) chooses the cut into buffers.lod_visibility, then
     /// project (slot i = splat i) -> one stable sort of all
     /// N slots by depth (culled splats last, ties by index) -> scan tile counts of the N slots
     /// -> dispatch args (entries that fit; the tile sort's parameters, so no sort runs its setup
@@ -130,6 +140,7 @@ private:
 
     const VulkanContext& context_;
     RadixSort sort_;
+    GaussianLodCut lod_cut_;
     UniqueDescriptorSetLayout set_layout_;
     UniquePipelineLayout pipeline_layout_;
     UniquePipeline scan_;

@@ -55,6 +55,24 @@ void GeometryStageResources::UploadScene(const VulkanContext& context, const Com
     view_ = GeometryStageViewResources();
 }
 
+void GeometryStageResources::UploadLod(const VulkanContext& context, const CommandPool& pool,
+                                       const PackedLodNodes& lod) {
+    if (int64_t(lod.num_leaves) + lod.num_inner != layout_.num_splats) {
+        core::ThrowError("a hierarchy of {} + {} nodes for a scene of {} splats", lod.num_leaves,
+                         lod.num_inner, layout_.num_splats);
+    }
+    lod_nodes = UploadStorageBuffer(context, pool, lod.nodes.data(),
+                                    lod.nodes.size() * sizeof(shader::GaussianLodNode));
+    lod_leaves_ = lod.num_leaves;
+    lod_inner_ = lod.num_inner;
+    view_ = GeometryStageViewResources();  // the view needs the cut's buffers
+}
+
+void GeometryStageResources::ClearLod() {
+    lod_nodes = Buffer();
+    lod_leaves_ = lod_inner_ = 0;
+}
+
 void GeometryStageResources::UploadVisibility(const VulkanContext& context, const CommandPool& pool,
                                               const std::vector<uint32_t>& mask) {
     const size_t words = (static_cast<size_t>(layout_.num_splats) + 31) / 32;
@@ -66,11 +84,12 @@ void GeometryStageResources::UploadVisibility(const VulkanContext& context, cons
 }
 
 void GeometryStageResources::AllocateView(const VulkanContext& context, uint32_t entry_capacity) {
-    view_.Allocate(context, static_cast<uint32_t>(layout_.num_splats), entry_capacity);
+    view_.Allocate(context, static_cast<uint32_t>(layout_.num_splats), entry_capacity, LodInner());
 }
 
 void GeometryStageViewResources::Allocate(const VulkanContext& context, uint32_t n,
-                                          uint32_t entry_capacity) {
+                                          uint32_t entry_capacity,
+                                          std::optional<uint32_t> lod_inner) {
     const GeometryStageStorageRequirements need =
         GaussianGeometryStage::GetStorageRequirements(n, entry_capacity);
     const auto make = [&](VkDeviceSize bytes, VkBufferUsageFlags usage) {
@@ -90,6 +109,15 @@ void GeometryStageViewResources::Allocate(const VulkanContext& context, uint32_t
     values_alt = make(need.sort.values_alt_bytes, need.sort.scratch_usage);
     histogram = make(need.sort.histogram_bytes, need.sort.scratch_usage);
     sort_params = make(need.sort.params_bytes, need.sort.params_usage);
+    lod_buckets = Buffer();
+    lod_histogram = Buffer();
+    lod_visibility = Buffer();
+    if (lod_inner) {
+        lod_buckets = make(GaussianLodCut::BucketsBytes(*lod_inner), need.usage);
+        lod_histogram = make(GaussianLodCut::HistogramBytes(), need.usage);
+        lod_visibility = make(GaussianLodCut::VisibilityBytes(n), need.usage);
+    }
+    lod_inner_ = lod_inner;
     num_splats_ = n;
     entry_capacity_ = entry_capacity;
 }
@@ -100,6 +128,12 @@ GeometryStageSceneBuffers GeometryStageResources::Scene() const {
     scene.shape = shape.Range();
     scene.sh = sh.Range();
     scene.visibility = visibility.Range();
+    scene.lod = HasLod();
+    if (scene.lod) {
+        scene.lod_nodes = lod_nodes.Range();
+        scene.lod_leaves = lod_leaves_;
+        scene.lod_inner = lod_inner_;
+    }
     scene.num_splats = static_cast<uint32_t>(layout_.num_splats);
     scene.packed_sh_degree = layout_.sh_degree;
     scene.sh_words_per_splat = layout_.sh_words_per_splat;
@@ -122,6 +156,11 @@ GeometryStageViewBuffers GeometryStageViewResources::Buffers() const {
     view.entry_values = entry_values.Range();
     view.sort_scratch = {keys_alt.Range(), values_alt.Range(), histogram.Range(),
                          sort_params.Range()};
+    if (lod_inner_) {
+        view.lod_buckets = lod_buckets.Range();
+        view.lod_histogram = lod_histogram.Range();
+        view.lod_visibility = lod_visibility.Range();
+    }
     return view;
 }
 

@@ -4,10 +4,12 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "open3d/camera/PinholeCamera.h"
 #include "open3d/visualization/rendering/gaussian_splat/GaussianSplatDataPacking.h"
+#include "open3d/visualization/rendering/gaussian_splat/GaussianSplatLodPacking.h"
 #include "open3d/visualization/rendering/gaussian_splat/RenderConfig.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/Buffer.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/Commands.h"
@@ -27,18 +29,24 @@ Buffer UploadStorageBuffer(const VulkanContext& context, const CommandPool& pool
 /// capacity. The backend keeps one per frame slot, so frames in flight never share them.
 class GeometryStageViewResources {
 public:
-    /// (Re)allocates every buffer for `num_splats` splats and `entry_capacity` entries.
-    void Allocate(const VulkanContext& context, uint32_t num_splats, uint32_t entry_capacity);
+    /// (Re)allocates every buffer for `num_splats` splats and `entry_capacity` entries, and,
+    /// where the splats are a hierarchy's nodes (lod_inner has a value: its inner nodes),
+    /// the cut's buffers.
+    void Allocate(const VulkanContext& context, uint32_t num_splats, uint32_t entry_capacity,
+                  std::optional<uint32_t> lod_inner = std::nullopt);
     /// Bindings for GaussianGeometryStage::Record.
     GeometryStageViewBuffers Buffers() const;
     uint32_t EntryCapacity() const { return entry_capacity_; }
     uint32_t NumSplats() const { return num_splats_; }
+    std::optional<uint32_t> LodInner() const { return lod_inner_; }
     explicit operator bool() const { return static_cast<bool>(projected); }
 
     Buffer view_params, projected, counters, depth_keys, splat_indices, tile_counts, scan;
     Buffer entry_keys, entry_values, keys_alt, values_alt, histogram, sort_params;
+    Buffer lod_buckets, lod_histogram, lod_visibility;  ///< empty without a hierarchy
 
 private:
+    std::optional<uint32_t> lod_inner_;
     uint32_t num_splats_ = 0;
     uint32_t entry_capacity_ = 0;
 };
@@ -49,6 +57,15 @@ public:
     /// binding must name a buffer) and keeps the packing's sizes.
     void UploadScene(const VulkanContext& context, const CommandPool& pool,
                      const PackedGaussianSplats& packed);
+    /// Uploads the nodes of the hierarchy the scene's splats are (GaussianSplatLodPacking.h);
+    /// ClearLod forgets them (a plain scene).
+    void UploadLod(const VulkanContext& context, const CommandPool& pool,
+                   const PackedLodNodes& lod);
+    void ClearLod();
+    bool HasLod() const { return static_cast<bool>(lod_nodes); }
+    std::optional<uint32_t> LodInner() const {
+        return HasLod() ? std::optional<uint32_t>(lod_inner_) : std::nullopt;
+    }
     /// Replaces the visibility mask ([ceil(N / 32)] words).
     void UploadVisibility(const VulkanContext& context, const CommandPool& pool,
                           const std::vector<uint32_t>& mask);
@@ -75,8 +92,10 @@ public:
 
     // Scene.
     Buffer positions, shape, sh, visibility;
+    Buffer lod_nodes;  ///< shader::GaussianLodNode per splat, for a hierarchy's nodes
 
 private:
+    uint32_t lod_leaves_ = 0, lod_inner_ = 0;
     PackedGaussianSplats layout_;
     // One view's outputs (projected splats, counters, sorted entries) and scratch.
     GeometryStageViewResources view_;

@@ -90,7 +90,22 @@ void GaussianSplatVulkanBackend::SetScene(const t::geometry::PointCloud& cloud) 
     geometry_ = GeometryState{};
     cloud_ = cloud;
     visibility_mask_.clear();
+    RetireLod();
     UploadScene(SplatPrecision::kExact);
+}
+
+void GaussianSplatVulkanBackend::SetSceneHierarchy(const t::geometry::PointCloud& source,
+                                                   const t::geometry::SplatHierarchy& hierarchy) {
+    source.ValidateGaussianSplat();
+    const PackedLodNodes lod = PackLodNodes(hierarchy);
+    t::geometry::PointCloud nodes = HierarchyNodeCloud(hierarchy, source);
+    if (geometry_.in_flight) Wait(*context_, geometry_stage_fence_.Get());
+    geometry_ = GeometryState{};
+    cloud_ = std::move(nodes);
+    visibility_mask_.clear();
+    RetireLod();
+    UploadScene(SplatPrecision::kExact);
+    geometry_stage_resources_.UploadLod(*context_, pool_, lod);
 }
 
 void GaussianSplatVulkanBackend::UploadScene(SplatPrecision precision) {
@@ -113,6 +128,11 @@ void GaussianSplatVulkanBackend::UploadScene(SplatPrecision precision) {
 
 void GaussianSplatVulkanBackend::SetVisibility(const std::vector<uint32_t>& mask) {
     if (!cloud_) core::ThrowError("Vulkan backend: SetVisibility before SetScene");
+    if (geometry_stage_resources_.HasLod()) {
+        core::ThrowError(
+            "Vulkan backend: a scene drawn through its hierarchy takes no visibility mask (the "
+            "level-of-detail cut is its mask)");
+    }
     if (geometry_.in_flight) Wait(*context_, geometry_stage_fence_.Get());
     geometry_.in_flight = false;
     RetireSceneBuffers(true);
@@ -558,6 +578,7 @@ RenderStats GaussianSplatVulkanBackend::RenderComposite(CompositeSink& sink) {
     RenderStats s = geometry_.reused ? RenderStats{} : geometry_.times;
     s.num_splats = geometry_stage_resources_.Layout().num_splats;
     s.num_visible = gpu_counters.visible_count;
+    s.lod_cut_nodes = geometry_stage_resources_.HasLod() ? gpu_counters.lod_cut_nodes : 0;
     s.num_tile_entries = gpu_counters.entry_count;
     s.error_flags = gpu_counters.error_flags;
     s.geometry_reused = geometry_.reused;

@@ -132,6 +132,13 @@ public:
     };
     const BatchStats& GetLastBatchStats() const { return last_batch_; }
 
+    /// The scene as the nodes of `hierarchy` (built from `source`), each frame drawing the
+    /// view's level-of-detail cut chosen on the GPU under RenderConfig::lod_budget nodes
+    /// (docs/lod.md "The cut on the GPU"); 0, the default, draws every leaf: `source` exactly.
+    /// SetScene returns to a plain scene. Throws for an invalid source or hierarchy.
+    void SetSceneHierarchy(const t::geometry::PointCloud& source,
+                           const t::geometry::SplatHierarchy& hierarchy);
+
     /// Replaces the visibility mask: bit i of word i / 32 shows splat i ([ceil(N / 32)]).
     void SetVisibility(const std::vector<uint32_t>& mask);
     bool SetVisibilityMask(const std::vector<uint32_t>& mask) override {
@@ -202,6 +209,8 @@ private:
     /// submission checks, so a dropped BatchHostMemory is freed by the next one).
     void ReleaseUnusedImports();
     void RetireSceneBuffers(bool visibility_only);
+    /// Drops the hierarchy's nodes (kept until frames in flight complete).
+    void RetireLod();
     bool AnySlotBusy() const;
     /// Logs each error flag the first time a frame reports it.
     void WarnNewFlags(uint32_t flags);

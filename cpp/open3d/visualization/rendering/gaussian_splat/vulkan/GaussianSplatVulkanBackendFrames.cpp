@@ -160,6 +160,14 @@ void GaussianSplatVulkanBackend::RetireSceneBuffers(bool visibility_only) {
     }
 }
 
+void GaussianSplatVulkanBackend::RetireLod() {
+    if (geometry_stage_resources_.lod_nodes && AnySlotBusy()) {
+        deferred_.Defer(next_serial_ - 1, std::move(geometry_stage_resources_.lod_nodes));
+        ++counters_.deferred_releases;
+    }
+    geometry_stage_resources_.ClearLod();
+}
+
 void GaussianSplatVulkanBackend::EnsureScenePrecision(const RenderConfig& config) {
     const SplatPrecision precision =
         config.compact_storage ? SplatPrecision::kCompact : SplatPrecision::kExact;
@@ -261,9 +269,10 @@ FrameRecordingKey GaussianSplatVulkanBackend::MakeKey(
 void GaussianSplatVulkanBackend::PrepareSlot(FrameSlot& slot, const FrameRecordingKey& key) {
     const VulkanContext& context = *context_;
     const uint32_t n = static_cast<uint32_t>(geometry_stage_resources_.Layout().num_splats);
+    const std::optional<uint32_t> lod_inner = geometry_stage_resources_.LodInner();
     if (!slot.view || slot.view.NumSplats() != n ||
-        slot.view.EntryCapacity() != key.entry_capacity) {
-        slot.view.Allocate(context, n, key.entry_capacity);
+        slot.view.EntryCapacity() != key.entry_capacity || slot.view.LodInner() != lod_inner) {
+        slot.view.Allocate(context, n, key.entry_capacity, lod_inner);
         ForgetRecordings(slot);
     }
     const CompositeColorFormat format =
@@ -646,7 +655,7 @@ std::vector<RenderOutput> GaussianSplatVulkanBackend::WaitBatch(uint64_t ticket)
         const auto start = std::chrono::steady_clock::now();
         const uint32_t capacity =
             static_cast<uint32_t>(std::min<uint64_t>(limit, asked + asked / 4));
-        slot.view.Allocate(*context_, slot.view.NumSplats(), capacity);
+        slot.view.Allocate(*context_, slot.view.NumSplats(), capacity, slot.view.LodInner());
         ForgetRecordings(slot);
         FrameRecordingKey key = MakeKey(slot.cameras, slot.config, slot.options, capacity);
         key.color_imported = slot.recorded.color_imported;
@@ -679,6 +688,7 @@ std::vector<RenderOutput> GaussianSplatVulkanBackend::WaitBatch(uint64_t ticket)
         RenderStats& s = outputs[i].stats;
         s.num_splats = geometry_stage_resources_.Layout().num_splats;
         s.num_visible = c.visible_count;
+        s.lod_cut_nodes = geometry_stage_resources_.HasLod() ? c.lod_cut_nodes : 0;
         s.num_tile_entries = c.entry_count;
         s.error_flags = c.error_flags;
         s.gpu_scene_bytes = static_cast<int64_t>(geometry_stage_resources_.SceneBytes());

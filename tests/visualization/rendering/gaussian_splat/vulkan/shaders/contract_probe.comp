@@ -72,7 +72,7 @@ void WriteStageStructs() {
     view_out.reference_m10 = 342.0;
     view_out.reference_m14 = 343.0;
     view_out.depth_order = 344u;
-    view_out.reserved1 = 345u;
+    view_out.lod_budget = 345u;
     view_out.reserved2 = 346u;
     view_out.reserved3 = 347u;
 

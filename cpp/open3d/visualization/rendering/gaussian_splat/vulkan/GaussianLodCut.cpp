@@ -1,0 +1,107 @@
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/GaussianLodCut.h"
+
+#include <algorithm>
+
+#include "open3d/core/Exception.h"
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/Commands.h"
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/ComputePipeline.h"
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/EmbeddedShaders.h"
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/VulkanContext.h"
+
+namespace open3d {
+namespace visualization {
+namespace rendering {
+namespace vulkan {
+
+namespace {
+
+using namespace shader;
+
+uint32_t DivCeil(uint64_t a, uint64_t b) { return static_cast<uint32_t>((a + b - 1) / b); }
+
+void ComputeToCompute(VkCommandBuffer cmd) {
+    RecordMemoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                        VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT | VK_ACCESS_2_SHADER_STORAGE_READ_BIT,
+                        VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                        VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
+}
+
+}  // namespace
+
+GaussianLodCut::GaussianLodCut(const VulkanContext& context) : context_(context) {
+    set_layout_ = CreateStorageBufferPushLayout(context, kLodNumBindings);
+    pipeline_layout_ =
+        CreatePipelineLayout(context, set_layout_.Get(), sizeof(GaussianLodPushConstants));
+    const char* names[] = {"gaussian_lod_cut (buckets)", "gaussian_lod_cut (threshold)",
+                           "gaussian_lod_cut (mask)"};
+    const uint32_t modes[] = {kLodPassBuckets, kLodPassThreshold, kLodPassMask};
+    for (size_t i = 0; i < passes_.size(); ++i) {
+        const VkSpecializationMapEntry entry{kSpecLodPass, 0, sizeof(uint32_t)};
+        const VkSpecializationInfo info{1, &entry, sizeof(uint32_t), &modes[i]};
+        passes_[i] = CreateComputePipeline(context, pipeline_layout_.Get(), spirv::kGaussianLodCut,
+                                           names[i], &info);
+    }
+}
+
+VkDeviceSize GaussianLodCut::BucketsBytes(uint32_t num_inner) {
+    return VkDeviceSize(std::max(num_inner, 4u)) * 4;
+}
+
+VkDeviceSize GaussianLodCut::HistogramBytes() { return VkDeviceSize(kLodBuckets) * 4; }
+
+VkDeviceSize GaussianLodCut::VisibilityBytes(uint32_t num_nodes) {
+    return VkDeviceSize(std::max(DivCeil(num_nodes, 32), 4u)) * 4;
+}
+
+void GaussianLodCut::PushBindings(VkCommandBuffer cmd, const LodCutBuffers& buffers) const {
+    const std::array<const BufferRange*, kLodNumBindings> ranges{
+        &buffers.view_params, &buffers.positions, &buffers.nodes,     &buffers.buckets,
+        &buffers.histogram,   &buffers.counters,  &buffers.visibility};
+    static_assert(kLodViewBinding == 0 && kLodPositionsBinding == 1 && kLodNodesBinding == 2 &&
+                      kLodBucketsBinding == 3 && kLodHistogramBinding == 4 &&
+                      kLodCountersBinding == 5 && kLodVisibilityBinding == 6,
+                  "ranges above are listed in binding order");
+    std::array<VkDescriptorBufferInfo, kLodNumBindings> infos{};
+    std::array<VkWriteDescriptorSet, kLodNumBindings> writes{};
+    for (uint32_t i = 0; i < kLodNumBindings; ++i) {
+        const BufferRange& range = *ranges[i];
+        if (range.buffer == VK_NULL_HANDLE) {
+            core::ThrowError("GaussianLodCut: binding {} has no buffer", i);
+        }
+        infos[i] = {range.buffer, range.offset, range.size};
+        writes[i].sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET;
+        writes[i].dstBinding = i;
+        writes[i].descriptorCount = 1;
+        writes[i].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+        writes[i].pBufferInfo = &infos[i];
+    }
+    context_.GetCmdPushDescriptorSet()(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_layout_.Get(),
+                                       0, kLodNumBindings, writes.data());
+}
+
+void GaussianLodCut::Record(VkCommandBuffer cmd, const LodCutBuffers& buffers) const {
+    const uint32_t nodes = buffers.num_leaves + buffers.num_inner;
+    vkCmdFillBuffer(cmd, buffers.histogram.buffer, buffers.histogram.offset, HistogramBytes(), 0u);
+    RecordMemoryBarrier(cmd, VK_PIPELINE_STAGE_2_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                        VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                        VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
+    PushBindings(cmd, buffers);
+    const GaussianLodPushConstants push{buffers.num_leaves, buffers.num_inner, 0u, 0u};
+    vkCmdPushConstants(cmd, pipeline_layout_.Get(), VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(push),
+                       &push);
+    // A hierarchy of one splat has no inner node: the buckets pass does nothing, the
+    // histogram stays zero and the threshold pass opens everything (the one leaf).
+    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, passes_[kLodPassBuckets].Get());
+    vkCmdDispatch(cmd, std::max(DivCeil(buffers.num_inner, kLodWorkgroupSize), 1u), 1, 1);
+    ComputeToCompute(cmd);
+    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, passes_[kLodPassThreshold].Get());
+    vkCmdDispatch(cmd, 1, 1, 1);
+    ComputeToCompute(cmd);
+    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, passes_[kLodPassMask].Get());
+    vkCmdDispatch(cmd, std::max(DivCeil(DivCeil(nodes, 32), kLodWorkgroupSize), 1u), 1, 1);
+}
+
+}  // namespace vulkan
+}  // namespace rendering
+}  // namespace visualization
+}  // namespace open3d

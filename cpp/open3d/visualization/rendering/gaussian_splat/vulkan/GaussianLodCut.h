@@ -1,0 +1,66 @@
+// The level-of-detail cut on the GPU as a recorder (docs/lod.md "The cut on the GPU"): for a
+// scene whose splats are a hierarchy's nodes (GaussianSplatLodPacking.h), three dispatches of
+// gaussian_lod_cut.comp turn the view and its budget (GaussianViewParams::lod_budget) into
+// the visibility mask the projection reads. Run by GaussianGeometryStage::Record before the
+// projection; its counters land in GaussianGeometryStageCounters (lod_cut_nodes,
+// lod_threshold).
+#pragma once
+
+#include <vulkan/vulkan.h>
+
+#include <array>
+#include <cstdint>
+
+#include "GaussianSplatLodContract.h"
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/Buffer.h"
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/VulkanHandle.h"
+
+namespace open3d {
+namespace visualization {
+namespace rendering {
+namespace vulkan {
+
+class VulkanContext;
+
+/// What the cut reads and writes. Per view: buckets, histogram and the mask (frames in
+/// flight must not share them); per scene: the nodes and positions.
+struct LodCutBuffers {
+    BufferRange view_params;  ///< shader::GaussianViewParams, already written
+    BufferRange positions;    ///< vec4 [nodes]
+    BufferRange nodes;        ///< shader::GaussianLodNode [nodes]
+    BufferRange buckets;      ///< uint32 [inner]
+    BufferRange histogram;    ///< uint32 [kLodBuckets]
+    BufferRange counters;     ///< shader::GaussianGeometryStageCounters, already zeroed
+    BufferRange visibility;   ///< uint32 [ceil(nodes / 32)], written
+    uint32_t num_leaves = 0;
+    uint32_t num_inner = 0;
+};
+
+class GaussianLodCut {
+public:
+    explicit GaussianLodCut(const VulkanContext& context);
+
+    /// Bytes of the per-view buffers for a hierarchy of `num_inner` inner nodes and
+    /// `num_nodes` nodes in all.
+    static VkDeviceSize BucketsBytes(uint32_t num_inner);
+    static VkDeviceSize HistogramBytes();
+    static VkDeviceSize VisibilityBytes(uint32_t num_nodes);
+
+    /// Records the cut: clears the histogram, then the three passes with compute barriers
+    /// between them. The caller orders the view parameters' and counters' writes before it
+    /// and the mask's compute write before the projection reads it.
+    void Record(VkCommandBuffer cmd, const LodCutBuffers& buffers) const;
+
+private:
+    void PushBindings(VkCommandBuffer cmd, const LodCutBuffers& buffers) const;
+
+    const VulkanContext& context_;
+    UniqueDescriptorSetLayout set_layout_;
+    UniquePipelineLayout pipeline_layout_;
+    std::array<UniquePipeline, 3> passes_;  // kLodPassBuckets, kLodPassThreshold, kLodPassMask
+};
+
+}  // namespace vulkan
+}  // namespace rendering
+}  // namespace visualization
+}  // namespace open3d

@@ -1,0 +1,168 @@
+#version 460
+// The level-of-detail cut on the GPU (docs/lod.md "The cut on the GPU"), three passes picked
+// by kSpecLodPass, mirrored on the CPU by cpu/LodCut.cpp:
+// - buckets: per inner node, the size bucket of its effective size, the smallest projected
+//   size on its path to the root (so a node opens only where all its ancestors do), and a
+//   histogram of what opening it adds to the cut (children - 1) per bucket;
+// - threshold: one workgroup finds the lowest bucket t such that opening every node above it
+//   keeps the cut within view.lod_budget nodes (1 + the sum of the histogram above t);
+// - mask: per 32 nodes, the cut as visibility bits: a node whose parent opens and which does
+//   not open itself. The projection then draws exactly those nodes.
+#extension GL_GOOGLE_include_directive : require
+#include "GaussianSplatLodContract.h"
+
+layout(local_size_x = kLodWorkgroupSize) in;
+layout(constant_id = kSpecLodPass) const uint kPass = kLodPassBuckets;
+
+layout(push_constant) uniform PushBlock {
+    GaussianLodPushConstants pc;
+};
+layout(std430, set = 0, binding = kLodViewBinding) readonly buffer ViewBlock {
+    GaussianViewParams view;
+};
+layout(std430, set = 0, binding = kLodPositionsBinding) readonly buffer PositionsBlock {
+    vec4 positions[];
+};
+layout(std430, set = 0, binding = kLodNodesBinding) readonly buffer NodesBlock {
+    GaussianLodNode nodes[];
+};
+layout(std430, set = 0, binding = kLodBucketsBinding) buffer BucketsBlock {
+    uint buckets[];
+};
+layout(std430, set = 0, binding = kLodHistogramBinding) buffer HistogramBlock {
+    uint histogram[];
+};
+layout(std430, set = 0, binding = kLodCountersBinding) buffer CountersBlock {
+    GaussianGeometryStageCounters counters;
+};
+layout(std430, set = 0, binding = kLodVisibilityBinding) writeonly buffer VisibilityBlock {
+    uint visibility[];
+};
+
+const uint kBucketsPerInvocation = kLodBuckets / kLodWorkgroupSize;
+shared uint s_histogram[kLodBuckets];
+shared uint s_suffix[kLodWorkgroupSize];
+shared uint s_threshold;
+
+// Whether the sphere of `radius` about camera-space `c` lies wholly outside one side plane
+// x = m z of an image axis spanning [lo, hi] in x / z, widened by 15% of the span and 2 px
+// (the projection's 1.3x guard band and the footprint's dilation reach that far).
+bool OutsideAxis(float x, float z, float lo, float hi, float focal, float radius) {
+    float margin = 0.15 * (hi - lo) + 2.0 / focal;
+    lo -= margin;
+    hi += margin;
+    return (x - lo * z) / sqrt(1.0 + lo * lo) < -radius ||
+           (hi * z - x) / sqrt(1.0 + hi * hi) < -radius;
+}
+
+// Size bucket of a node (kLodBuckets - 1 largest); 0 when it lies wholly behind the camera or
+// outside the frustum.
+uint SizeBucket(uint node) {
+    vec3 p = positions[node].xyz;
+    float radius = nodes[node].radius;
+    vec3 c_lo = vec3(view.center_low_x, view.center_low_y, view.center_low_z);
+    vec3 rel = vec3(CameraRelative(p.x, view.center_high.x, c_lo.x),
+                    CameraRelative(p.y, view.center_high.y, c_lo.y),
+                    CameraRelative(p.z, view.center_high.z, c_lo.z));
+    vec3 c = vec3(dot(view.rotation_row0, rel), dot(view.rotation_row1, rel),
+                  dot(view.rotation_row2, rel));
+    if (c.z + radius <= 0.0) return 0u;
+    if (OutsideAxis(c.x, c.z, (-0.5 - view.cx) / view.fx,
+                    (float(view.width) - 0.5 - view.cx) / view.fx, view.fx, radius) ||
+        OutsideAxis(c.y, c.z, (-0.5 - view.cy) / view.fy,
+                    (float(view.height) - 0.5 - view.cy) / view.fy, view.fy, radius)) {
+        return 0u;
+    }
+    // A node nearer than its own size counts as up to 1000x its size in pixels.
+    float size = max(view.fx, view.fy) * radius / max(c.z, 1e-3 * radius + 1e-30);
+    float b = floor((log2(size) + kLodLog2Offset) * float(kLodBucketsPerOctave));
+    if (!(b >= 0.0)) return 1u;  // below 2^-32 px (or NaN): the smallest in view
+    return uint(min(b, float(kLodBuckets - 2u))) + 1u;
+}
+
+bool Opens(uint inner, uint threshold) {
+    return threshold == kLodOpenAll || buckets[inner] > threshold;
+}
+
+void main() {
+    uint id = gl_GlobalInvocationID.x;
+    uint lane = gl_LocalInvocationID.x;
+    if (kPass == kLodPassBuckets) {
+        for (uint b = lane; b < kLodBuckets; b += kLodWorkgroupSize) s_histogram[b] = 0u;
+        barrier();
+        if (id < pc.num_inner) {
+            uint node = pc.num_leaves + id;
+            uint bucket = SizeBucket(node);
+            for (uint up = nodes[node].parent; up != kLodNoParent && bucket > 0u;
+                 up = nodes[up].parent) {
+                bucket = min(bucket, SizeBucket(up));
+            }
+            buckets[id] = bucket;
+            atomicAdd(s_histogram[bucket], nodes[node].children - 1u);
+        }
+        barrier();
+        for (uint b = lane; b < kLodBuckets; b += kLodWorkgroupSize) {
+            if (s_histogram[b] != 0u) atomicAdd(histogram[b], s_histogram[b]);
+        }
+    } else if (kPass == kLodPassThreshold) {
+        // Lane i owns buckets [16 i, 16 i + 16); the cut when opening above t has
+        // 1 + sum(histogram[b], b > t) nodes, falling as t rises.
+        uint first = lane * kBucketsPerInvocation;
+        uint own = 0u;
+        for (uint k = 0u; k < kBucketsPerInvocation; ++k) own += histogram[first + k];
+        s_suffix[lane] = own;
+        if (lane == 0u) s_threshold = kLodBuckets;
+        barrier();
+        if (lane == 0u) {  // suffix sums: s_suffix[i] = sum over lanes > i
+            uint above = 0u;
+            for (uint i = kLodWorkgroupSize; i-- > 0u;) {
+                uint mine = s_suffix[i];
+                s_suffix[i] = above;
+                above += mine;
+            }
+        }
+        barrier();
+        uint budget = max(view.lod_budget, 1u);
+        uint above = s_suffix[lane];  // sum over buckets past this lane's
+        uint best = kLodBuckets;
+        for (uint k = kBucketsPerInvocation; k-- > 0u;) {
+            uint t = first + k;
+            if (above >= budget) break;  // 1 + above > budget from here down
+            best = t;
+            above += histogram[t];
+        }
+        if (best != kLodBuckets) atomicMin(s_threshold, best);
+        barrier();
+        if (lane == 0u) {
+            // Everything fits when 1 + the sum over all buckets does: then even the nodes
+            // outside the view open and the cut is the leaves.
+            uint all = s_suffix[0];
+            for (uint k = 0u; k < kBucketsPerInvocation; ++k) all += histogram[k];
+            if (all < budget) {
+                counters.lod_threshold = kLodOpenAll;
+                counters.lod_cut_nodes = 1u + all;
+            } else {
+                uint t = s_threshold;
+                uint cut = 1u;
+                for (uint b = t + 1u; b < kLodBuckets; ++b) cut += histogram[b];
+                counters.lod_threshold = t;
+                counters.lod_cut_nodes = cut;
+            }
+        }
+    } else {
+        uint total_nodes = pc.num_leaves + pc.num_inner;
+        if (id * 32u >= total_nodes) return;
+        uint threshold = counters.lod_threshold;
+        uint word = 0u;
+        for (uint j = 0u; j < 32u; ++j) {
+            uint node = id * 32u + j;
+            if (node >= total_nodes) break;
+            uint parent = nodes[node].parent;
+            bool parent_opens =
+                parent == kLodNoParent || Opens(parent - pc.num_leaves, threshold);
+            bool opens = node >= pc.num_leaves && Opens(node - pc.num_leaves, threshold);
+            if (parent_opens && !opens) word |= 1u << j;
+        }
+        visibility[id] = word;
+    }
+}
