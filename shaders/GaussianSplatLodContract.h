@@ -33,15 +33,17 @@ OPEN3D_SHADER_CONST uint kLodNoParent = 0xFFFFFFFFu;
 
 // Passes of gaussian_lod_cut.comp (specialisation constant kSpecLodPass).
 OPEN3D_SHADER_CONST uint kSpecLodPass = 0u;
-OPEN3D_SHADER_CONST uint kLodPassBuckets = 0u;    // per inner node: effective size bucket
-OPEN3D_SHADER_CONST uint kLodPassThreshold = 1u;  // one workgroup: the bucket to open above
-OPEN3D_SHADER_CONST uint kLodPassMask = 2u;       // per 32 nodes: the cut as visibility bits
+OPEN3D_SHADER_CONST uint kLodPassSizes = 0u;      // per inner node: own size bucket
+OPEN3D_SHADER_CONST uint kLodPassBuckets = 1u;    // per inner node: effective bucket, histogram
+OPEN3D_SHADER_CONST uint kLodPassThreshold = 2u;  // one workgroup: the bucket to open above
+OPEN3D_SHADER_CONST uint kLodPassMask = 3u;       // per node: the cut as visibility bits
+OPEN3D_SHADER_CONST uint kLodNumPasses = 4u;
 
 // Descriptor set 0 of the cut's pipelines (one push-descriptor layout).
 OPEN3D_SHADER_CONST uint kLodViewBinding = 0u;        // GaussianViewParams
 OPEN3D_SHADER_CONST uint kLodPositionsBinding = 1u;   // vec4[nodes]: xyz, sigmoid(opacity)
 OPEN3D_SHADER_CONST uint kLodNodesBinding = 2u;       // GaussianLodNode[nodes]
-OPEN3D_SHADER_CONST uint kLodBucketsBinding = 3u;     // uint[inner]: effective size bucket
+OPEN3D_SHADER_CONST uint kLodBucketsBinding = 3u;     // uint[2 inner]: effective, own bucket
 OPEN3D_SHADER_CONST uint kLodHistogramBinding = 4u;   // uint[kLodBuckets]
 OPEN3D_SHADER_CONST uint kLodCountersBinding = 5u;    // GaussianGeometryStageCounters
 OPEN3D_SHADER_CONST uint kLodVisibilityBinding = 6u;  // uint[ceil(nodes / 32)]: the cut
@@ -67,6 +69,7 @@ static_assert(sizeof(GaussianLodNode) == 16);
 static_assert(offsetof(GaussianLodNode, parent) == 4);
 static_assert(offsetof(GaussianLodNode, children) == 8);
 static_assert(sizeof(GaussianLodPushConstants) == 16);
+static_assert(kLodWorkgroupSize % 32 == 0, "the mask pass writes whole words");
 static_assert(offsetof(GaussianLodPushConstants, num_inner) == 4);
 }  // namespace shader
 }  // namespace rendering

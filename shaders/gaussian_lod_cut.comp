@@ -1,13 +1,14 @@
 #version 460
-// The level-of-detail cut on the GPU (docs/lod.md "The cut on the GPU"), three passes picked
+// The level-of-detail cut on the GPU (docs/lod.md "The cut on the GPU"), four passes picked
 // by kSpecLodPass, mirrored on the CPU by cpu/LodCut.cpp:
-// - buckets: per inner node, the size bucket of its effective size, the smallest projected
-//   size on its path to the root (so a node opens only where all its ancestors do), and a
-//   histogram of what opening it adds to the cut (children - 1) per bucket;
+// - sizes: per inner node, the size bucket of its own projected size;
+// - buckets: per inner node, its effective bucket, the smallest on its path to the root (so
+//   a node opens only where all its ancestors do), and a histogram of what opening it adds
+//   to the cut (children - 1) per bucket;
 // - threshold: one workgroup finds the lowest bucket t such that opening every node above it
 //   keeps the cut within view.lod_budget nodes (1 + the sum of the histogram above t);
-// - mask: per 32 nodes, the cut as visibility bits: a node whose parent opens and which does
-//   not open itself. The projection then draws exactly those nodes.
+// - mask: per node, whether it is in the cut (its parent opens, it does not), gathered into
+//   the visibility words the projection reads.
 #extension GL_GOOGLE_include_directive : require
 #include "GaussianSplatLodContract.h"
 
@@ -26,6 +27,7 @@ layout(std430, set = 0, binding = kLodPositionsBinding) readonly buffer Position
 layout(std430, set = 0, binding = kLodNodesBinding) readonly buffer NodesBlock {
     GaussianLodNode nodes[];
 };
+// [0, inner): each inner node's effective bucket; [inner, 2 inner): its own.
 layout(std430, set = 0, binding = kLodBucketsBinding) buffer BucketsBlock {
     uint buckets[];
 };
@@ -43,6 +45,7 @@ const uint kBucketsPerInvocation = kLodBuckets / kLodWorkgroupSize;
 shared uint s_histogram[kLodBuckets];
 shared uint s_suffix[kLodWorkgroupSize];
 shared uint s_threshold;
+shared uint s_words[kLodWorkgroupSize / 32u];
 
 // Whether the sphere of `radius` about camera-space `c` lies wholly outside one side plane
 // x = m z of an image axis spanning [lo, hi] in x / z, widened by 15% of the span and 2 px
@@ -87,15 +90,17 @@ bool Opens(uint inner, uint threshold) {
 void main() {
     uint id = gl_GlobalInvocationID.x;
     uint lane = gl_LocalInvocationID.x;
-    if (kPass == kLodPassBuckets) {
+    if (kPass == kLodPassSizes) {
+        if (id < pc.num_inner) buckets[pc.num_inner + id] = SizeBucket(pc.num_leaves + id);
+    } else if (kPass == kLodPassBuckets) {
         for (uint b = lane; b < kLodBuckets; b += kLodWorkgroupSize) s_histogram[b] = 0u;
         barrier();
         if (id < pc.num_inner) {
             uint node = pc.num_leaves + id;
-            uint bucket = SizeBucket(node);
+            uint bucket = buckets[pc.num_inner + id];
             for (uint up = nodes[node].parent; up != kLodNoParent && bucket > 0u;
                  up = nodes[up].parent) {
-                bucket = min(bucket, SizeBucket(up));
+                bucket = min(bucket, buckets[pc.num_inner + up - pc.num_leaves]);
             }
             buckets[id] = bucket;
             atomicAdd(s_histogram[bucket], nodes[node].children - 1u);
@@ -150,19 +155,23 @@ void main() {
             }
         }
     } else {
+        // One invocation per node; the workgroup's 256 bits gather in shared memory and go
+        // out as 8 whole words (the workgroup starts on a word boundary).
         uint total_nodes = pc.num_leaves + pc.num_inner;
-        if (id * 32u >= total_nodes) return;
-        uint threshold = counters.lod_threshold;
-        uint word = 0u;
-        for (uint j = 0u; j < 32u; ++j) {
-            uint node = id * 32u + j;
-            if (node >= total_nodes) break;
-            uint parent = nodes[node].parent;
+        if (lane < kLodWorkgroupSize / 32u) s_words[lane] = 0u;
+        barrier();
+        if (id < total_nodes) {
+            uint threshold = counters.lod_threshold;
+            uint parent = nodes[id].parent;
             bool parent_opens =
                 parent == kLodNoParent || Opens(parent - pc.num_leaves, threshold);
-            bool opens = node >= pc.num_leaves && Opens(node - pc.num_leaves, threshold);
-            if (parent_opens && !opens) word |= 1u << j;
+            bool opens = id >= pc.num_leaves && Opens(id - pc.num_leaves, threshold);
+            if (parent_opens && !opens) atomicOr(s_words[lane / 32u], 1u << (lane % 32u));
         }
-        visibility[id] = word;
+        barrier();
+        uint word = gl_WorkGroupID.x * (kLodWorkgroupSize / 32u) + lane;
+        if (lane < kLodWorkgroupSize / 32u && word * 32u < total_nodes) {
+            visibility[word] = s_words[lane];
+        }
     }
 }

@@ -22,7 +22,7 @@ std::vector<int64_t> ParseBudgets(const std::string& text);
 std::string BudgetLabel(int64_t budget);
 
 /// A view's cut: the cloud of its nodes, how many, and the CPU time the cut and the
-/// extraction took (the GPU cut is not built: docs/lod.md).
+/// extraction took: the rows of backends without the GPU cut (docs/lod.md).
 struct LodCut {
     t::geometry::PointCloud cloud;
     int64_t nodes = 0;

@@ -1,7 +1,8 @@
 // A level-of-detail hierarchy over a Gaussian splat cloud (docs/lod.md): an octree over the
 // splats' positions whose inner nodes are Gaussians merged from their children by moment
 // matching, and the cut that picks, for one view, the nodes to draw under a splat budget.
-// CPU only: the GPU cut is not built yet; the file is t/io/SplatHierarchyIO.h.
+// The file is t/io/SplatHierarchyIO.h; the cut the Vulkan renderer chooses per frame on the
+// GPU is a threshold cut of its own (visualization/.../cpu/LodCut.h mirrors it).
 #pragma once
 
 #include <Eigen/Core>

@@ -32,19 +32,19 @@ GaussianLodCut::GaussianLodCut(const VulkanContext& context) : context_(context)
     set_layout_ = CreateStorageBufferPushLayout(context, kLodNumBindings);
     pipeline_layout_ =
         CreatePipelineLayout(context, set_layout_.Get(), sizeof(GaussianLodPushConstants));
-    const char* names[] = {"gaussian_lod_cut (buckets)", "gaussian_lod_cut (threshold)",
-                           "gaussian_lod_cut (mask)"};
-    const uint32_t modes[] = {kLodPassBuckets, kLodPassThreshold, kLodPassMask};
-    for (size_t i = 0; i < passes_.size(); ++i) {
+    const char* names[kLodNumPasses] = {
+        "gaussian_lod_cut (sizes)", "gaussian_lod_cut (buckets)", "gaussian_lod_cut (threshold)",
+        "gaussian_lod_cut (mask)"};
+    for (uint32_t pass = 0; pass < kLodNumPasses; ++pass) {
         const VkSpecializationMapEntry entry{kSpecLodPass, 0, sizeof(uint32_t)};
-        const VkSpecializationInfo info{1, &entry, sizeof(uint32_t), &modes[i]};
-        passes_[i] = CreateComputePipeline(context, pipeline_layout_.Get(), spirv::kGaussianLodCut,
-                                           names[i], &info);
+        const VkSpecializationInfo info{1, &entry, sizeof(uint32_t), &pass};
+        passes_[pass] = CreateComputePipeline(context, pipeline_layout_.Get(),
+                                              spirv::kGaussianLodCut, names[pass], &info);
     }
 }
 
 VkDeviceSize GaussianLodCut::BucketsBytes(uint32_t num_inner) {
-    return VkDeviceSize(std::max(num_inner, 4u)) * 4;
+    return VkDeviceSize(std::max(num_inner, 2u)) * 2 * 4;  // effective, then own
 }
 
 VkDeviceSize GaussianLodCut::HistogramBytes() { return VkDeviceSize(kLodBuckets) * 4; }
@@ -89,16 +89,16 @@ void GaussianLodCut::Record(VkCommandBuffer cmd, const LodCutBuffers& buffers) c
     const GaussianLodPushConstants push{buffers.num_leaves, buffers.num_inner, 0u, 0u};
     vkCmdPushConstants(cmd, pipeline_layout_.Get(), VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(push),
                        &push);
-    // A hierarchy of one splat has no inner node: the buckets pass does nothing, the
-    // histogram stays zero and the threshold pass opens everything (the one leaf).
-    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, passes_[kLodPassBuckets].Get());
-    vkCmdDispatch(cmd, std::max(DivCeil(buffers.num_inner, kLodWorkgroupSize), 1u), 1, 1);
-    ComputeToCompute(cmd);
-    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, passes_[kLodPassThreshold].Get());
-    vkCmdDispatch(cmd, 1, 1, 1);
-    ComputeToCompute(cmd);
-    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, passes_[kLodPassMask].Get());
-    vkCmdDispatch(cmd, std::max(DivCeil(DivCeil(nodes, 32), kLodWorkgroupSize), 1u), 1, 1);
+    // A hierarchy of one splat has no inner node: the sizes and buckets passes do nothing,
+    // the histogram stays zero and the threshold pass opens everything (the one leaf).
+    const uint32_t inner_groups = std::max(DivCeil(buffers.num_inner, kLodWorkgroupSize), 1u);
+    const uint32_t groups[kLodNumPasses] = {inner_groups, inner_groups, 1u,
+                                            std::max(DivCeil(nodes, kLodWorkgroupSize), 1u)};
+    for (uint32_t pass = 0; pass < kLodNumPasses; ++pass) {
+        if (pass > 0) ComputeToCompute(cmd);
+        vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, passes_[pass].Get());
+        vkCmdDispatch(cmd, groups[pass], 1, 1);
+    }
 }
 
 }  // namespace vulkan

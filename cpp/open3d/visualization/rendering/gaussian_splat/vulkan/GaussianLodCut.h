@@ -1,5 +1,5 @@
 // The level-of-detail cut on the GPU as a recorder (docs/lod.md "The cut on the GPU"): for a
-// scene whose splats are a hierarchy's nodes (GaussianSplatLodPacking.h), three dispatches of
+// scene whose splats are a hierarchy's nodes (GaussianSplatLodPacking.h), four dispatches of
 // gaussian_lod_cut.comp turn the view and its budget (GaussianViewParams::lod_budget) into
 // the visibility mask the projection reads. Run by GaussianGeometryStage::Record before the
 // projection; its counters land in GaussianGeometryStageCounters (lod_cut_nodes,
@@ -28,7 +28,7 @@ struct LodCutBuffers {
     BufferRange view_params;  ///< shader::GaussianViewParams, already written
     BufferRange positions;    ///< vec4 [nodes]
     BufferRange nodes;        ///< shader::GaussianLodNode [nodes]
-    BufferRange buckets;      ///< uint32 [inner]
+    BufferRange buckets;      ///< uint32 [2 inner]: effective, then own buckets
     BufferRange histogram;    ///< uint32 [kLodBuckets]
     BufferRange counters;     ///< shader::GaussianGeometryStageCounters, already zeroed
     BufferRange visibility;   ///< uint32 [ceil(nodes / 32)], written
@@ -46,7 +46,7 @@ public:
     static VkDeviceSize HistogramBytes();
     static VkDeviceSize VisibilityBytes(uint32_t num_nodes);
 
-    /// Records the cut: clears the histogram, then the three passes with compute barriers
+    /// Records the cut: clears the histogram, then the four passes with compute barriers
     /// between them. The caller orders the view parameters' and counters' writes before it
     /// and the mask's compute write before the projection reads it.
     void Record(VkCommandBuffer cmd, const LodCutBuffers& buffers) const;
@@ -57,7 +57,7 @@ private:
     const VulkanContext& context_;
     UniqueDescriptorSetLayout set_layout_;
     UniquePipelineLayout pipeline_layout_;
-    std::array<UniquePipeline, 3> passes_;  // kLodPassBuckets, kLodPassThreshold, kLodPassMask
+    std::array<UniquePipeline, shader::kLodNumPasses> passes_;  // by kLodPass* value
 };
 
 }  // namespace vulkan
