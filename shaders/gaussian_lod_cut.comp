@@ -10,6 +10,7 @@
 // - mask: per node, whether it is in the cut (its parent opens, it does not), gathered into
 //   the visibility words the projection reads.
 #extension GL_GOOGLE_include_directive : require
+#extension GL_EXT_control_flow_attributes : require
 #include "GaussianSplatLodContract.h"
 
 layout(local_size_x = kLodWorkgroupSize) in;
@@ -110,49 +111,49 @@ void main() {
             if (s_histogram[b] != 0u) atomicAdd(histogram[b], s_histogram[b]);
         }
     } else if (kPass == kLodPassThreshold) {
-        // Lane i owns buckets [16 i, 16 i + 16); the cut when opening above t has
-        // 1 + sum(histogram[b], b > t) nodes, falling as t rises.
+        // Lane i owns buckets [16 i, 16 i + 16), read once; the cut when opening above t has
+        // 1 + S(t) nodes, S(t) = sum(histogram[b], b > t), falling as t rises. No lane walks
+        // the histogram alone: on the H200 a serial loop over its 4096 global words cost
+        // more than the rest of the cut.
         uint first = lane * kBucketsPerInvocation;
+        uint counts[kBucketsPerInvocation];
         uint own = 0u;
-        for (uint k = 0u; k < kBucketsPerInvocation; ++k) own += histogram[first + k];
+        [[unroll]] for (uint k = 0u; k < kBucketsPerInvocation; ++k) {
+            counts[k] = histogram[first + k];
+            own += counts[k];
+        }
+        // Inclusive suffix sums over the lanes (Hillis-Steele), then exclusive: past lane i.
         s_suffix[lane] = own;
         if (lane == 0u) s_threshold = kLodBuckets;
         barrier();
-        if (lane == 0u) {  // suffix sums: s_suffix[i] = sum over lanes > i
-            uint above = 0u;
-            for (uint i = kLodWorkgroupSize; i-- > 0u;) {
-                uint mine = s_suffix[i];
-                s_suffix[i] = above;
-                above += mine;
-            }
+        for (uint step = 1u; step < kLodWorkgroupSize; step <<= 1u) {
+            uint add = lane + step < kLodWorkgroupSize ? s_suffix[lane + step] : 0u;
+            barrier();
+            s_suffix[lane] += add;
+            barrier();
         }
-        barrier();
+        uint total = s_suffix[0];
         uint budget = max(view.lod_budget, 1u);
-        uint above = s_suffix[lane];  // sum over buckets past this lane's
-        uint best = kLodBuckets;
+        uint above = s_suffix[lane] - own;  // S of this lane's last bucket
+        uint best = kLodBuckets, best_above = 0u;
         for (uint k = kBucketsPerInvocation; k-- > 0u;) {
-            uint t = first + k;
-            if (above >= budget) break;  // 1 + above > budget from here down
-            best = t;
-            above += histogram[t];
+            if (above >= budget) break;  // 1 + S(t) > budget from here down
+            best = first + k;
+            best_above = above;
+            above += counts[k];
         }
         if (best != kLodBuckets) atomicMin(s_threshold, best);
         barrier();
-        if (lane == 0u) {
-            // Everything fits when 1 + the sum over all buckets does: then even the nodes
-            // outside the view open and the cut is the leaves.
-            uint all = s_suffix[0];
-            for (uint k = 0u; k < kBucketsPerInvocation; ++k) all += histogram[k];
-            if (all < budget) {
+        // Everything fits when 1 + the sum over all buckets does: then even the nodes outside
+        // the view open and the cut is the leaves.
+        if (total < budget) {
+            if (lane == 0u) {
                 counters.lod_threshold = kLodOpenAll;
-                counters.lod_cut_nodes = 1u + all;
-            } else {
-                uint t = s_threshold;
-                uint cut = 1u;
-                for (uint b = t + 1u; b < kLodBuckets; ++b) cut += histogram[b];
-                counters.lod_threshold = t;
-                counters.lod_cut_nodes = cut;
+                counters.lod_cut_nodes = 1u + total;
             }
+        } else if (best == s_threshold) {
+            counters.lod_threshold = best;
+            counters.lod_cut_nodes = 1u + best_above;
         }
     } else {
         // One invocation per node; the workgroup's 256 bits gather in shared memory and go

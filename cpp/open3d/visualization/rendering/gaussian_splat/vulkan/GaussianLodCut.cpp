@@ -32,9 +32,8 @@ GaussianLodCut::GaussianLodCut(const VulkanContext& context) : context_(context)
     set_layout_ = CreateStorageBufferPushLayout(context, kLodNumBindings);
     pipeline_layout_ =
         CreatePipelineLayout(context, set_layout_.Get(), sizeof(GaussianLodPushConstants));
-    const char* names[kLodNumPasses] = {
-        "gaussian_lod_cut (sizes)", "gaussian_lod_cut (buckets)", "gaussian_lod_cut (threshold)",
-        "gaussian_lod_cut (mask)"};
+    const char* names[kLodNumPasses] = {"gaussian_lod_cut (sizes)", "gaussian_lod_cut (buckets)",
+                                        "gaussian_lod_cut (threshold)", "gaussian_lod_cut (mask)"};
     for (uint32_t pass = 0; pass < kLodNumPasses; ++pass) {
         const VkSpecializationMapEntry entry{kSpecLodPass, 0, sizeof(uint32_t)};
         const VkSpecializationInfo info{1, &entry, sizeof(uint32_t), &pass};
