@@ -97,6 +97,15 @@ void GaussianSplatVulkanBackend::SetScene(const t::geometry::PointCloud& cloud) 
 void GaussianSplatVulkanBackend::SetSceneHierarchy(const t::geometry::PointCloud& source,
                                                    const t::geometry::SplatHierarchy& hierarchy) {
     source.ValidateGaussianSplat();
+    // The depth sort keeps a slot per node (the hidden ones dropped in its first pass):
+    // refused before the nodes are gathered and uploaded.
+    if (hierarchy.NumNodes() > int64_t(RadixSort::kMaxCount)) {
+        core::ThrowError(
+            "Vulkan backend: a hierarchy of {} nodes ({} splats + {} inner) exceeds the {} "
+            "slots the depth sort takes (the GPU cut draws from every node)",
+            hierarchy.NumNodes(), hierarchy.num_leaves, hierarchy.NumInner(),
+            RadixSort::kMaxCount);
+    }
     const PackedLodNodes lod = PackLodNodes(hierarchy);
     t::geometry::PointCloud nodes = HierarchyNodeCloud(hierarchy, source);
     if (geometry_.in_flight) Wait(*context_, geometry_stage_fence_.Get());
