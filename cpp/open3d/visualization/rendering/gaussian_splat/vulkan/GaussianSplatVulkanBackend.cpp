@@ -103,8 +103,7 @@ void GaussianSplatVulkanBackend::SetSceneHierarchy(const t::geometry::PointCloud
         core::ThrowError(
             "Vulkan backend: a hierarchy of {} nodes ({} splats + {} inner) exceeds the {} "
             "slots the depth sort takes (the GPU cut draws from every node)",
-            hierarchy.NumNodes(), hierarchy.num_leaves, hierarchy.NumInner(),
-            RadixSort::kMaxCount);
+            hierarchy.NumNodes(), hierarchy.num_leaves, hierarchy.NumInner(), RadixSort::kMaxCount);
     }
     const PackedLodNodes lod = PackLodNodes(hierarchy);
     t::geometry::PointCloud nodes = HierarchyNodeCloud(hierarchy, source);
