@@ -24,9 +24,16 @@ run() {  # name, seed files... (FUZZ_MAX_LEN: longest input, default 64 KiB; FUZ
   mkdir -p "$corpus"
   for f in "$@"; do [ -f "$f" ] && cp -n "$f" "$corpus/" || true; done
   echo "fuzz: $name for ${seconds}s"
+  local log="$build_dir/fuzz-logs/$name.log" status=0
+  mkdir -p "$build_dir/fuzz-logs"
   "$build_dir/bin/$name" "$corpus" -max_total_time="$seconds" -rss_limit_mb=2048 \
     -max_len="${FUZZ_MAX_LEN:-65536}" -len_control="${FUZZ_LEN_CONTROL:-100}" \
-    -artifact_prefix="$artifacts/$name-" -print_final_stats=1 2>&1 | tail -n 12
+    -artifact_prefix="$artifacts/$name-" -print_final_stats=1 >"$log" 2>&1 || status=$?
+  # The harness's own reason (a disagreement, a sanitizer report) comes before libFuzzer's
+  # stack and statistics: printed first, so a CI log that keeps only the end still has it.
+  grep -m 5 -E 'renderers disagree|ERROR: |runtime error' "$log" || true
+  tail -n 12 "$log"
+  return "$status"
 }
 run fuzz_ply_reader "$data/pc_short/pc_short.ply" "$data/train3/train_3points.ply" "$root"/tests/fuzz/seeds/*.ply
 run fuzz_splat_reader "$data/train3/one_splat.splat"
@@ -42,5 +49,5 @@ run fuzz_splat_hierarchy_reader "$root"/tests/fuzz/seeds/*.lod
 # The harness reads at most ~130 bytes (six splats and a camera) and runs at ~5 inputs/s on
 # lavapipe under ASan (~570 MB resident): without -len_control=0, libFuzzer's slowly growing
 # length limit kept a 20 s run at 4-byte inputs (one splat, all else zero).
-FUZZ_MAX_LEN=256 FUZZ_LEN_CONTROL=0 run fuzz_render_agreement
+FUZZ_MAX_LEN=256 FUZZ_LEN_CONTROL=0 run fuzz_render_agreement "$root"/tests/fuzz/seeds/render_*.bin
 

@@ -219,13 +219,19 @@ bool Project(uint i, out float depth, out uint entries) {
     float py = fy * v.y / v.z + view.cy;
 
     // Jacobian at the guard-band clamped position (keeps off-screen footprints bounded).
-    float tx = clamp(v.x / v.z, -view.guard_x, view.guard_x) * v.z;
-    float ty = clamp(v.y / v.z, -view.guard_y, view.guard_y) * v.z;
+    float x_over_z = clamp(v.x / v.z, -view.guard_x, view.guard_x);
+    float y_over_z = clamp(v.y / v.z, -view.guard_y, view.guard_y);
+    float tx = x_over_z * v.z, ty = y_over_z * v.z;
     float z2 = v.z * v.z;
+    // J's z column, -f tx / z^2 as the original computes it; past z ~ 1.8e19 z^2 overflows
+    // float32 and that quotient drops to 0 while the term, times a splat as large as its
+    // distance, is of pixel size: there -f (x / z) / z, the same value without the overflow.
+    float jx = isinf(z2) ? -fx * x_over_z / v.z : -fx * tx / z2;
+    float jy = isinf(z2) ? -fy * y_over_z / v.z : -fy * ty / z2;
     // Rows of J (2x3) times W (the world-to-camera rotation): T = J W.
     vec3 w0 = view.rotation_row0, w1 = view.rotation_row1, w2 = view.rotation_row2;
-    vec3 t0 = (fx / v.z) * w0 + (-fx * tx / z2) * w2;
-    vec3 t1 = (fy / v.z) * w1 + (-fy * ty / z2) * w2;
+    vec3 t0 = (fx / v.z) * w0 + jx * w2;
+    vec3 t1 = (fy / v.z) * w1 + jy * w2;
     vec3 scale = vec3(ShapeValue(i, 0u), ShapeValue(i, 1u), ShapeValue(i, 2u));
     vec4 rot = vec4(ShapeValue(i, 3u), ShapeValue(i, 4u), ShapeValue(i, 5u), ShapeValue(i, 6u));
     // cov2D = T M (T M)^T: rows u0 = M^T t0, u1 = M^T t1, and det(cov2D) = |u0 x u1|^2
