@@ -2,7 +2,8 @@
 // GaussianSplatLodPacking.cpp, shaders/gaussian_lod_cut.comp, the CPU mirror cpu/LodCut.cpp):
 // the per-node record, the size buckets, the bindings and push constants. A stage of its
 // own because only scenes drawn through a hierarchy run it, before the projection, and its
-// output is the projection's visibility mask (docs/lod.md "The cut on the GPU").
+// output is the list of the cut's nodes the projection reads, one per list slot, in node
+// order (docs/lod.md "The cut on the GPU").
 // GLSL and C++ as GaussianSplatCommon.h says; C++ gets static_asserts on every offset.
 #ifndef OPEN3D_SHADERS_GAUSSIAN_SPLAT_LOD_CONTRACT_H
 #define OPEN3D_SHADERS_GAUSSIAN_SPLAT_LOD_CONTRACT_H
@@ -36,8 +37,10 @@ OPEN3D_SHADER_CONST uint kSpecLodPass = 0u;
 OPEN3D_SHADER_CONST uint kLodPassSizes = 0u;      // per inner node: own size bucket
 OPEN3D_SHADER_CONST uint kLodPassBuckets = 1u;    // per inner node: effective bucket, histogram
 OPEN3D_SHADER_CONST uint kLodPassThreshold = 2u;  // one workgroup: the bucket to open above
-OPEN3D_SHADER_CONST uint kLodPassMask = 3u;       // per node: the cut as visibility bits
-OPEN3D_SHADER_CONST uint kLodNumPasses = 4u;
+OPEN3D_SHADER_CONST uint kLodPassMask = 3u;       // per node: the cut as bits, group counts
+OPEN3D_SHADER_CONST uint kLodPassOffsets = 4u;    // one workgroup: group counts -> offsets
+OPEN3D_SHADER_CONST uint kLodPassList = 5u;       // per node: the cut's nodes as a list
+OPEN3D_SHADER_CONST uint kLodNumPasses = 6u;
 
 // Descriptor set 0 of the cut's pipelines (one push-descriptor layout).
 OPEN3D_SHADER_CONST uint kLodViewBinding = 0u;        // GaussianViewParams
@@ -47,7 +50,11 @@ OPEN3D_SHADER_CONST uint kLodBucketsBinding = 3u;     // uint[2 inner]: effectiv
 OPEN3D_SHADER_CONST uint kLodHistogramBinding = 4u;   // uint[kLodBuckets]
 OPEN3D_SHADER_CONST uint kLodCountersBinding = 5u;    // GaussianGeometryStageCounters
 OPEN3D_SHADER_CONST uint kLodVisibilityBinding = 6u;  // uint[ceil(nodes / 32)]: the cut
-OPEN3D_SHADER_CONST uint kLodNumBindings = 7u;
+// uint[ceil(nodes / kLodWorkgroupSize)]: the cut's nodes per workgroup of the mask pass,
+// then (the offsets pass) their exclusive prefix sums.
+OPEN3D_SHADER_CONST uint kLodGroupCountsBinding = 7u;
+OPEN3D_SHADER_CONST uint kLodListBinding = 8u;  // uint[LodListSlots]: node of each list slot
+OPEN3D_SHADER_CONST uint kLodNumBindings = 9u;
 
 // One node of the hierarchy (16 bytes, std430), in node order: leaves 0..N-1 (the scene's
 // splats), then the inner nodes N..N+K-1, children before parents, the root last.
@@ -61,8 +68,18 @@ struct GaussianLodNode {
 struct GaussianLodPushConstants {
     uint num_leaves;
     uint num_inner;
-    uint reserved0, reserved1;
+    uint list_slots;  // LodListSlots of the view's budget
+    uint reserved0;
 };
+
+// Slots of the cut's node list, known before the cut is: the cut never exceeds the budget
+// (at least 1, the root) nor the leaves (every node open). The projection, the depth sort
+// and the scan run over these slots, not over every node (`lod_budget` as packed:
+// kLodOpenAll keeps every leaf).
+OPEN3D_SHADER_FUNC uint LodListSlots(uint num_leaves, uint lod_budget) {
+    uint budget = lod_budget > 1u ? lod_budget : 1u;
+    return num_leaves < budget ? num_leaves : budget;
+}
 
 #ifdef __cplusplus
 static_assert(sizeof(GaussianLodNode) == 16);
@@ -71,6 +88,7 @@ static_assert(offsetof(GaussianLodNode, children) == 8);
 static_assert(sizeof(GaussianLodPushConstants) == 16);
 static_assert(kLodWorkgroupSize % 32 == 0, "the mask pass writes whole words");
 static_assert(offsetof(GaussianLodPushConstants, num_inner) == 4);
+static_assert(offsetof(GaussianLodPushConstants, list_slots) == 8);
 }  // namespace shader
 }  // namespace rendering
 }  // namespace visualization

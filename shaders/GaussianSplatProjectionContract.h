@@ -39,6 +39,10 @@ OPEN3D_SHADER_CONST uint kSpecPrecision = 2u;  // kPrecisionExact / kPrecisionCo
 // one stable depth sort of all N slots orders ties by splat index; 0 (packed key): visible
 // splats are appended in subgroup order.
 OPEN3D_SHADER_CONST uint kSpecIndexedList = 3u;
+// 1 (a level-of-detail hierarchy's nodes): the visibility binding holds the cut's list of
+// nodes (GaussianSplatLodContract.h) and slot i projects node list[i] when i is below
+// GaussianGeometryStageCounters::lod_cut_nodes; 0: slot i projects splat i if its bit is set.
+OPEN3D_SHADER_CONST uint kSpecCutList = 4u;
 
 // Descriptor set 0 of every geometry stage projection pipeline (one push-descriptor layout; each
 // shader declares only the bindings it uses).
@@ -46,8 +50,8 @@ OPEN3D_SHADER_CONST uint kGeometryStageViewBinding = 0u;       // GaussianViewPa
 OPEN3D_SHADER_CONST uint kGeometryStagePositionsBinding = 1u;  // vec4[N]: xyz, sigmoid(opacity)
 OPEN3D_SHADER_CONST uint kGeometryStageShapeBinding = 2u;      // uint[N * shape words]
 OPEN3D_SHADER_CONST uint kGeometryStageShBinding = 3u;  // uint[N * sh words]; unread at degree 0
-OPEN3D_SHADER_CONST uint kGeometryStageVisibilityBinding =
-    4u;  // uint[ceil(N / 32)], bit i = splat i
+// uint[ceil(N / 32)], bit i = splat i; with kSpecCutList, uint[N]: the cut's nodes.
+OPEN3D_SHADER_CONST uint kGeometryStageVisibilityBinding = 4u;
 OPEN3D_SHADER_CONST uint kGeometryStageProjectedBinding = 5u;     // GaussianProjectedSplat[N]
 OPEN3D_SHADER_CONST uint kGeometryStageCountersBinding = 6u;      // GaussianGeometryStageCounters
 OPEN3D_SHADER_CONST uint kGeometryStageDepthKeysBinding = 7u;     // uint[N]: visible depth keys

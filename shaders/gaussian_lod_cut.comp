@@ -1,6 +1,6 @@
 #version 460
 // The level-of-detail cut on the GPU (docs/lod.md "The cut on the GPU"), four passes picked
-// by kSpecLodPass, mirrored on the CPU by cpu/LodCut.cpp:
+// by kSpecLodPass, mirrored on the CPU by cpu/LodCut.cpp, then two that compact it:
 // - sizes: per inner node, the size bucket of its own projected size;
 // - buckets: per inner node, its effective bucket, the smallest on its path to the root (so
 //   a node opens only where all its ancestors do), and a histogram of what opening it adds
@@ -8,7 +8,11 @@
 // - threshold: one workgroup finds the lowest bucket t such that opening every node above it
 //   keeps the cut within view.lod_budget nodes (1 + the sum of the histogram above t);
 // - mask: per node, whether it is in the cut (its parent opens, it does not), gathered into
-//   the visibility words the projection reads.
+//   visibility words, and how many of each workgroup's nodes are;
+// - offsets: one workgroup turns those counts into exclusive prefix sums;
+// - list: each node of the cut writes its id at its rank, so the list is in node order (the
+//   projection's slot order, on which the depth sort's ties depend, is the node order, as
+//   when every node had its own slot).
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_control_flow_attributes : require
 #include "GaussianSplatLodContract.h"
@@ -38,8 +42,14 @@ layout(std430, set = 0, binding = kLodHistogramBinding) buffer HistogramBlock {
 layout(std430, set = 0, binding = kLodCountersBinding) buffer CountersBlock {
     GaussianGeometryStageCounters counters;
 };
-layout(std430, set = 0, binding = kLodVisibilityBinding) writeonly buffer VisibilityBlock {
+layout(std430, set = 0, binding = kLodVisibilityBinding) buffer VisibilityBlock {
     uint visibility[];
+};
+layout(std430, set = 0, binding = kLodGroupCountsBinding) buffer GroupCountsBlock {
+    uint group_counts[];
+};
+layout(std430, set = 0, binding = kLodListBinding) writeonly buffer ListBlock {
+    uint list[];
 };
 
 const uint kBucketsPerInvocation = kLodBuckets / kLodWorkgroupSize;
@@ -47,6 +57,7 @@ shared uint s_histogram[kLodBuckets];
 shared uint s_suffix[kLodWorkgroupSize];
 shared uint s_threshold;
 shared uint s_words[kLodWorkgroupSize / 32u];
+const uint kWordsPerGroup = kLodWorkgroupSize / 32u;
 
 // Whether the sphere of `radius` about camera-space `c` lies wholly outside one side plane
 // x = m z of an image axis spanning [lo, hi] in x / z, widened by 15% of the span and 2 px
@@ -155,11 +166,11 @@ void main() {
             counters.lod_threshold = best;
             counters.lod_cut_nodes = 1u + best_above;
         }
-    } else {
+    } else if (kPass == kLodPassMask) {
         // One invocation per node; the workgroup's 256 bits gather in shared memory and go
         // out as 8 whole words (the workgroup starts on a word boundary).
         uint total_nodes = pc.num_leaves + pc.num_inner;
-        if (lane < kLodWorkgroupSize / 32u) s_words[lane] = 0u;
+        if (lane < kWordsPerGroup) s_words[lane] = 0u;
         barrier();
         if (id < total_nodes) {
             uint threshold = counters.lod_threshold;
@@ -170,9 +181,51 @@ void main() {
             if (parent_opens && !opens) atomicOr(s_words[lane / 32u], 1u << (lane % 32u));
         }
         barrier();
-        uint word = gl_WorkGroupID.x * (kLodWorkgroupSize / 32u) + lane;
-        if (lane < kLodWorkgroupSize / 32u && word * 32u < total_nodes) {
-            visibility[word] = s_words[lane];
+        uint word = gl_WorkGroupID.x * kWordsPerGroup + lane;
+        if (lane < kWordsPerGroup && word * 32u < total_nodes) visibility[word] = s_words[lane];
+        if (lane == 0u) {
+            uint count = 0u;
+            [[unroll]] for (uint k = 0u; k < kWordsPerGroup; ++k) count += bitCount(s_words[k]);
+            group_counts[gl_WorkGroupID.x] = count;
+        }
+    } else if (kPass == kLodPassOffsets) {
+        // Lane i sums a run of consecutive groups, the lanes' sums are scanned in shared
+        // memory, then each lane writes its run's exclusive offsets. Groups of 256 nodes keep
+        // the run short: 9.2M nodes, 141 groups a lane; 134M nodes, 2,048.
+        uint groups = (pc.num_leaves + pc.num_inner + kLodWorkgroupSize - 1u) / kLodWorkgroupSize;
+        uint run = (groups + kLodWorkgroupSize - 1u) / kLodWorkgroupSize;
+        uint first = min(lane * run, groups), last = min(first + run, groups);
+        uint own = 0u;
+        for (uint g = first; g < last; ++g) own += group_counts[g];
+        s_suffix[lane] = own;  // inclusive prefix sums below (Hillis-Steele)
+        barrier();
+        for (uint step = 1u; step < kLodWorkgroupSize; step <<= 1u) {
+            uint add = lane >= step ? s_suffix[lane - step] : 0u;
+            barrier();
+            s_suffix[lane] += add;
+            barrier();
+        }
+        uint offset = s_suffix[lane] - own;
+        for (uint g = first; g < last; ++g) {
+            uint count = group_counts[g];
+            group_counts[g] = offset;
+            offset += count;
+        }
+    } else {
+        // The list: a node of the cut goes to its group's offset plus the cut's nodes before
+        // it in the group (the words before its own, then its own word's lower bits). Slots
+        // past the budget cannot be reached: the cut fits it (LodListSlots).
+        uint total_nodes = pc.num_leaves + pc.num_inner;
+        if (lane < kWordsPerGroup) {
+            uint word = gl_WorkGroupID.x * kWordsPerGroup + lane;
+            s_words[lane] = word * 32u < total_nodes ? visibility[word] : 0u;
+        }
+        barrier();
+        uint w = lane / 32u, bit = lane % 32u;
+        if (id < total_nodes && (s_words[w] & (1u << bit)) != 0u) {
+            uint rank = group_counts[gl_WorkGroupID.x] + bitCount(s_words[w] & ((1u << bit) - 1u));
+            for (uint k = 0u; k < w; ++k) rank += bitCount(s_words[k]);
+            if (rank < pc.list_slots) list[rank] = id;
         }
     }
 }

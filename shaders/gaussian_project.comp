@@ -20,6 +20,7 @@ layout(constant_id = kSpecShDegree) const uint kShDegree = 3u;
 layout(constant_id = kSpecAntialias) const uint kAntialias = 0u;
 layout(constant_id = kSpecPrecision) const uint kPrecision = kPrecisionExact;
 layout(constant_id = kSpecIndexedList) const uint kIndexedList = 1u;
+layout(constant_id = kSpecCutList) const uint kCutList = 0u;
 
 layout(std430, set = 0, binding = kGeometryStageViewBinding) readonly buffer ViewBlock {
     GaussianViewParams view;
@@ -41,6 +42,7 @@ layout(std430, set = 0, binding = kGeometryStageShBinding) readonly buffer ShBlo
 layout(std430, set = 0, binding = kGeometryStageShapeBinding) readonly buffer ShapeBlock2 {
     uvec2 shape2[];
 };
+// Bits by splat, or with kCutList the level-of-detail cut's nodes by slot.
 layout(std430, set = 0, binding = kGeometryStageVisibilityBinding) readonly buffer VisibilityBlock {
     uint visibility[];
 };
@@ -190,10 +192,10 @@ uint TileBound(float v, uint tiles) {
     return uint(min(t, float(tiles)));
 }
 
-// Returns true (and writes the record) when splat i is visible.
-bool Project(uint i, out float depth, out uint entries) {
+// Returns true (and writes the record of slot `slot`) when splat i is visible.
+bool Project(uint i, uint slot, out float depth, out uint entries) {
     depth = 0.0;
-    if ((visibility[i >> 5u] & (1u << (i & 31u))) == 0u) return false;
+    if (kCutList == 0u && (visibility[i >> 5u] & (1u << (i & 31u))) == 0u) return false;
     vec4 position_opacity = positions[i];
     vec3 p = position_opacity.xyz;
     // Camera-relative (p - c_hi) - c_lo: precise 1e5 from the origin too (GaussianSplatShared.h).
@@ -293,8 +295,8 @@ bool Project(uint i, out float depth, out uint entries) {
     out_splat.rect_max = rect_max.x | (rect_max.y << 16u);
     out_splat.num_entries = num_tiles;
     out_splat.radius = radius;
-    projected[i] = PackProjectedSplat(out_splat);
-    tile_counts[i] = num_tiles;
+    projected[slot] = PackProjectedSplat(out_splat);
+    tile_counts[slot] = num_tiles;
     depth = order_depth;
     entries = num_tiles;
     return true;
@@ -304,7 +306,11 @@ void main() {
     uint i = gl_GlobalInvocationID.x;
     float depth = 0.0;
     uint entries = 0u;
-    bool visible = i < view.num_splats && Project(i, depth, entries);
+    // Slot i holds splat i, or the cut's node list[i] (its slots past the cut's size are
+    // empty: as hidden splats, they sort last).
+    bool in_list = i < view.num_splats && (kCutList == 0u || i < counters.lod_cut_nodes);
+    uint splat = kCutList != 0u && in_list ? visibility[i] : i;
+    bool visible = in_list && Project(splat, i, depth, entries);
     uint value = PackListValue(i, entries, view.num_splats);
 
     // One atomicAdd per subgroup reserves the slots of all its visible splats.

@@ -221,6 +221,12 @@ GeometryStageChoices ChooseGeometryStage(const camera::PinholeCamera& camera,
     return choices;
 }
 
+uint32_t PackedLodBudget(const RenderConfig& config) {
+    return config.lod_budget == 0
+               ? shader::kLodOpenAll
+               : static_cast<uint32_t>(std::min<uint64_t>(config.lod_budget, shader::kLodOpenAll));
+}
+
 PackedView PackGaussianView(const camera::PinholeCamera& camera, const RenderConfig& config,
                             const ViewPackingInputs& inputs) {
     camera.Validate();
@@ -280,10 +286,7 @@ PackedView PackGaussianView(const camera::PinholeCamera& camera, const RenderCon
     p.depth_order = config.depth_order == DepthOrder::kReference
                         ? shader::kDepthOrderReference
                         : shader::kDepthOrderCameraRelative;
-    p.lod_budget =
-        config.lod_budget == 0
-            ? shader::kLodOpenAll
-            : static_cast<uint32_t>(std::min<uint64_t>(config.lod_budget, shader::kLodOpenAll));
+    p.lod_budget = PackedLodBudget(config);
     return {p, choices};
 }
 

@@ -136,6 +136,10 @@ ReferenceDepthRow GetReferenceDepthRow(const camera::PinholeCamera& camera);
 /// True when `config` selects the packed 32-bit key, false for exact order.
 bool UsesPackedSortKey(const RenderConfig& config);
 
+/// RenderConfig::lod_budget as GaussianViewParams::lod_budget holds it: 0 (no cap) becomes
+/// shader::kLodOpenAll, larger counts saturate there.
+uint32_t PackedLodBudget(const RenderConfig& config);
+
 /// IEEE half from float, round to nearest even (overflow to inf, NaN kept).
 uint16_t FloatToHalf(float value);
 /// Float from IEEE half (exact).

@@ -32,8 +32,8 @@ struct Scene {
     std::vector<camera::CameraView> views;
 };
 
-bool LoadPlaybot(Scene& scene) {
-    const std::string path = DataPath("playbot/playbot_31k.ply");
+bool LoadPlaybot(Scene& scene, const std::string& file = "playbot_31k.ply") {
+    const std::string path = DataPath("playbot/" + file);
     if (!FileExists(path)) return false;
     t::io::ReadPointCloud(path, scene.cloud);
     scene.hierarchy = t::geometry::BuildSplatHierarchy(scene.cloud);
@@ -102,6 +102,48 @@ TEST_F(LodCut, GpuCutIsTheMirrorsCutWithinTheBudget) {
         }
     }
     EXPECT_GE(coarser_than_exact, 12);  // the budgets below N really cut
+}
+
+TEST_F(LodCut, CompactionAcrossManyGroupsPerLane) {
+    // The cut's list is compacted in groups of 256 nodes whose offsets one workgroup of 256
+    // lanes scans, each lane a run of consecutive groups: playbot_31k's ~46k nodes give one
+    // group a lane, playbot_125k's ~187k nodes give runs of 3 and lanes with none. Every
+    // leaf must land in its own slot in node order (the source image bit for bit), and a
+    // cut must hold the mirror's nodes.
+    Scene scene;
+    if (!LoadPlaybot(scene, "playbot_125k.ply")) {
+        OPEN3D_SKIP_OR_FAIL_WHEN_UNAVAILABLE("playbot_125k.ply is absent");
+    }
+    const int64_t n = scene.cloud.NumPoints();
+    ASSERT_GT(n + scene.hierarchy.NumInner(), 2 * 256 * 256);
+    auto through_hierarchy = MakeBackend();
+    through_hierarchy->SetSceneHierarchy(scene.cloud, scene.hierarchy);
+    const camera::PinholeCamera cam = scene.views.at(2).camera.Resized(80, 64);
+    const RenderOutput all = through_hierarchy->Render(cam, {});
+    {
+        auto plain = MakeBackend();
+        plain->SetScene(scene.cloud);
+        const RenderOutput exact = plain->Render(cam, {});
+        EXPECT_EQ(all.stats.lod_cut_nodes, n);
+        EXPECT_EQ(all.stats.num_visible, exact.stats.num_visible);
+        EXPECT_EQ(t::geometry::ComputeMaxAbsError(all.color, exact.color), 0.0);
+    }
+    for (const uint64_t budget : {uint64_t(3000), uint64_t(40000)}) {
+        RenderConfig config;
+        config.lod_budget = budget;
+        const cpu::LodCutResult mirror = cpu::CutLikeGpu(scene.hierarchy, cam, budget);
+        const RenderOutput gpu = through_hierarchy->Render(cam, config);
+        SCOPED_TRACE("budget " + std::to_string(budget));
+        EXPECT_EQ(gpu.stats.lod_cut_nodes, int64_t(mirror.nodes.size()));
+        const t::geometry::PointCloud nodes =
+            t::geometry::ExtractSplatNodes(scene.hierarchy, scene.cloud, mirror.nodes);
+        const RenderOutput ref = cpu::RenderReference(nodes, cam, {});
+        // As in GpuCutIsTheMirrorsCutWithinTheBudget: one node in the wrong slot, or one
+        // missing, would fall far below.
+        EXPECT_GE(
+            t::geometry::ComputeImageErrorMetrics(gpu.color, ref.color, 1.0, 1.0 / 255.0).psnr_db,
+            80.0);
+    }
 }
 
 TEST_F(LodCut, ASceneOfOneSplatAndAPlainSceneAfterwards) {

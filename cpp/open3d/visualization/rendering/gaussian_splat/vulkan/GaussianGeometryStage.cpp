@@ -101,20 +101,22 @@ GeometryStageStorageRequirements GaussianGeometryStage::GetStorageRequirements(
 }
 
 VkPipeline GaussianGeometryStage::GetProjectPipeline(uint32_t sh_degree, bool antialias,
-                                                     SplatPrecision precision, bool indexed_list) {
+                                                     SplatPrecision precision, bool indexed_list,
+                                                     bool cut_list) {
     const uint32_t precision_value =
         precision == SplatPrecision::kExact ? kPrecisionExact : kPrecisionCompact;
-    const uint32_t key =
-        sh_degree | (antialias ? 4u : 0u) | (precision_value << 3) | (indexed_list ? 16u : 0u);
+    const uint32_t key = sh_degree | (antialias ? 4u : 0u) | (precision_value << 3) |
+                         (indexed_list ? 16u : 0u) | (cut_list ? 32u : 0u);
     auto it = project_.find(key);
     if (it != project_.end()) return it->second.Get();
-    const std::array<uint32_t, 4> values{sh_degree, antialias ? 1u : 0u, precision_value,
-                                         indexed_list ? 1u : 0u};
-    const std::array<VkSpecializationMapEntry, 4> entries{{{kSpecShDegree, 0, 4},
+    const std::array<uint32_t, 5> values{sh_degree, antialias ? 1u : 0u, precision_value,
+                                         indexed_list ? 1u : 0u, cut_list ? 1u : 0u};
+    const std::array<VkSpecializationMapEntry, 5> entries{{{kSpecShDegree, 0, 4},
                                                            {kSpecAntialias, 4, 4},
                                                            {kSpecPrecision, 8, 4},
-                                                           {kSpecIndexedList, 12, 4}}};
-    const VkSpecializationInfo info{4, entries.data(), sizeof(values), values.data()};
+                                                           {kSpecIndexedList, 12, 4},
+                                                           {kSpecCutList, 16, 4}}};
+    const VkSpecializationInfo info{5, entries.data(), sizeof(values), values.data()};
     UniquePipeline pipeline = CreateComputePipeline(
         context_, pipeline_layout_.Get(), spirv::kGaussianProject, "gaussian_project", &info);
     return project_.emplace(key, std::move(pipeline)).first->second.Get();
@@ -170,19 +172,24 @@ void GaussianGeometryStage::Record(VkCommandBuffer cmd, const GeometryStageScene
                                    const GpuTimestamps* timestamps,
                                    const BufferRange* params_source) {
     if (timestamps) timestamps->RecordBegin(cmd, TimedPass::kProject);
-    // A hierarchy's nodes are drawn through the view's cut, not the scene's mask.
+    // A hierarchy's nodes are drawn through the view's cut: the projection reads the list of
+    // its nodes at the visibility binding, and every pass after the cut runs over the list's
+    // slots (LodListSlots of the budget), not the nodes.
     GeometryStageSceneBuffers scene = in_scene;
-    if (scene.lod) scene.visibility = buffers.lod_visibility;
-    const uint32_t n = scene.num_splats;
+    if (scene.lod) scene.visibility = buffers.lod_list;
+    // (The parameters may come from params_source: the host's choices carry the slot count.)
     const GaussianViewParams& params = view.params;
     const GeometryStageChoices& choices = view.choices;
+    const uint32_t n = choices.num_splats;
     const uint32_t capacity = choices.entry_capacity_allocated;
     const bool packed_key = choices.packed_key;
-    if (choices.num_splats != n || choices.entry_capacity > capacity) {
+    const bool slots_fit = scene.lod ? n >= 1 && n <= scene.lod_leaves : n == scene.num_splats;
+    if (!slots_fit || choices.entry_capacity > capacity) {
         core::ThrowError(
             "GaussianGeometryStage: view parameters for {} splats / capacity {} do not "
-            "match the scene ({} splats)",
-            choices.num_splats, choices.entry_capacity, n);
+            "match the scene ({} splats{})",
+            n, choices.entry_capacity, scene.lod ? scene.lod_leaves : scene.num_splats,
+            scene.lod ? ", the most a cut of its hierarchy holds" : "");
     }
     const GeometryStageStorageRequirements need = GetStorageRequirements(n, capacity);
     const VkPipelineLayout layout = pipeline_layout_.Get();
@@ -228,7 +235,7 @@ void GaussianGeometryStage::Record(VkCommandBuffer cmd, const GeometryStageScene
         VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT |
             VK_ACCESS_2_INDIRECT_COMMAND_READ_BIT);
 
-    // 0. Level of detail: the view's cut of the hierarchy becomes the projection's mask.
+    // 0. Level of detail: the view's cut of the hierarchy becomes the projection's list.
     if (scene.lod) {
         LodCutBuffers cut;
         cut.view_params = buffers.view_params;
@@ -238,11 +245,14 @@ void GaussianGeometryStage::Record(VkCommandBuffer cmd, const GeometryStageScene
         cut.histogram = buffers.lod_histogram;
         cut.counters = buffers.counters;
         cut.visibility = buffers.lod_visibility;
+        cut.group_counts = buffers.lod_group_counts;
+        cut.list = buffers.lod_list;
         cut.num_leaves = scene.lod_leaves;
         cut.num_inner = scene.lod_inner;
-        if (cut.num_leaves + cut.num_inner != n) {
+        cut.list_slots = n;
+        if (cut.num_leaves + cut.num_inner != scene.num_splats) {
             core::ThrowError("GaussianGeometryStage: a hierarchy of {} + {} nodes for {} splats",
-                             cut.num_leaves, cut.num_inner, n);
+                             cut.num_leaves, cut.num_inner, scene.num_splats);
         }
         lod_cut_.Record(cmd, cut);
         ComputeBarrier(cmd);
@@ -250,9 +260,9 @@ void GaussianGeometryStage::Record(VkCommandBuffer cmd, const GeometryStageScene
 
     // 1. Project: visible splats -> (depth key, splat index) list, visible_count.
     PushBindings(cmd, scene, buffers);
-    vkCmdBindPipeline(
-        cmd, VK_PIPELINE_BIND_POINT_COMPUTE,
-        GetProjectPipeline(choices.sh_degree, choices.antialias, scene.precision, !packed_key));
+    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE,
+                      GetProjectPipeline(choices.sh_degree, choices.antialias, scene.precision,
+                                         !packed_key, scene.lod));
     if (n > 0) vkCmdDispatch(cmd, DivCeil(n, kProjectWorkgroupSize), 1, 1);
     ComputeBarrier(cmd);
 

@@ -63,7 +63,8 @@ struct GeometryStageSceneBuffers {
     BufferRange visibility;  ///< uint32 [ceil(N / 32)]; unread for a hierarchy (lod)
     uint32_t num_splats = 0;
     /// The splats are the nodes of a level-of-detail hierarchy (GaussianSplatLodPacking.h):
-    /// the cut (GaussianLodCut) writes the view's mask into GeometryStageViewBuffers.
+    /// the cut (GaussianLodCut) writes the view's list of nodes into GeometryStageViewBuffers,
+    /// and the stage runs over shader::LodListSlots list slots, not N.
     bool lod = false;
     BufferRange lod_nodes;  ///< shader::GaussianLodNode [N]
     uint32_t lod_leaves = 0, lod_inner = 0;
@@ -86,8 +87,9 @@ struct GeometryStageViewBuffers {
     RadixSortScratch sort_scratch;
     BufferRange tile_counts;  ///< scratch: each visible splat's tile count, by splat index
     /// A hierarchy's cut (GaussianLodCut; unused otherwise): effective size buckets, their
-    /// histogram, and the cut as the visibility mask the projection reads.
-    BufferRange lod_buckets, lod_histogram, lod_visibility;
+    /// histogram, the cut as bits, their counts per group, and the list of the cut's nodes
+    /// the projection reads.
+    BufferRange lod_buckets, lod_histogram, lod_visibility, lod_group_counts, lod_list;
 };
 
 class GaussianGeometryStage {
@@ -103,8 +105,9 @@ public:
 
     /// Records geometry stage for one view: writes view.params into buffers.view_params, zeroes the
     /// counters (and, from N, the scan and emit sizes and the depth sort's parameters), for a
-    /// hierarchy's nodes (scene.lod) chooses the cut into buffers.lod_visibility, then
-    /// project (slot i = splat i) -> one stable sort of all
+    /// hierarchy's nodes (scene.lod) chooses the cut into buffers.lod_list (then N below is
+    /// its slot count, view.choices.num_splats), then
+    /// project (slot i = splat i, or the list's node i) -> one stable sort of all
     /// N slots by depth (culled splats last, ties by index) -> scan tile counts of the N slots
     /// -> dispatch args (entries that fit; the tile sort's parameters, so no sort runs its setup
     /// pass) -> emit entries -> stable sort by tile (view.choices.tile_bits bits). Every size after
@@ -133,8 +136,9 @@ public:
                 const BufferRange* params_source = nullptr);
 
 private:
+    /// `cut_list`: slot i projects the node the cut's list holds (shader::kSpecCutList).
     VkPipeline GetProjectPipeline(uint32_t sh_degree, bool antialias, SplatPrecision precision,
-                                  bool indexed_list);
+                                  bool indexed_list, bool cut_list);
     void PushBindings(VkCommandBuffer cmd, const GeometryStageSceneBuffers& scene,
                       const GeometryStageViewBuffers& buffers) const;
 

@@ -112,10 +112,14 @@ void GeometryStageViewResources::Allocate(const VulkanContext& context, uint32_t
     lod_buckets = Buffer();
     lod_histogram = Buffer();
     lod_visibility = Buffer();
+    lod_group_counts = Buffer();
+    lod_list = Buffer();
     if (lod_inner) {
         lod_buckets = make(GaussianLodCut::BucketsBytes(*lod_inner), need.usage);
         lod_histogram = make(GaussianLodCut::HistogramBytes(), need.usage);
         lod_visibility = make(GaussianLodCut::VisibilityBytes(n), need.usage);
+        lod_group_counts = make(GaussianLodCut::GroupCountsBytes(n), need.usage);
+        lod_list = make(GaussianLodCut::ListBytes(n - *lod_inner), need.usage);
     }
     lod_inner_ = lod_inner;
     num_splats_ = n;
@@ -160,6 +164,8 @@ GeometryStageViewBuffers GeometryStageViewResources::Buffers() const {
         view.lod_buckets = lod_buckets.Range();
         view.lod_histogram = lod_histogram.Range();
         view.lod_visibility = lod_visibility.Range();
+        view.lod_group_counts = lod_group_counts.Range();
+        view.lod_list = lod_list.Range();
     }
     return view;
 }
@@ -173,7 +179,9 @@ PackedView GeometryStageResources::ViewParams(const camera::PinholeCamera& camer
                                               const RenderConfig& config,
                                               uint32_t entry_capacity) const {
     ViewPackingInputs inputs;
-    inputs.num_splats = layout_.num_splats;
+    // A hierarchy's frame runs over the slots of its cut's list, not over every node.
+    inputs.num_splats =
+        HasLod() ? shader::LodListSlots(lod_leaves_, PackedLodBudget(config)) : layout_.num_splats;
     inputs.packed_sh_degree = layout_.sh_degree;
     inputs.precision = layout_.precision;
     inputs.sh_words_per_splat = layout_.sh_words_per_splat;

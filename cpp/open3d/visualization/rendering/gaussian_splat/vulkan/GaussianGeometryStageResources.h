@@ -43,7 +43,8 @@ public:
 
     Buffer view_params, projected, counters, depth_keys, splat_indices, tile_counts, scan;
     Buffer entry_keys, entry_values, keys_alt, values_alt, histogram, sort_params;
-    Buffer lod_buckets, lod_histogram, lod_visibility;  ///< empty without a hierarchy
+    /// Empty without a hierarchy.
+    Buffer lod_buckets, lod_histogram, lod_visibility, lod_group_counts, lod_list;
 
 private:
     std::optional<uint32_t> lod_inner_;

@@ -32,8 +32,9 @@ GaussianLodCut::GaussianLodCut(const VulkanContext& context) : context_(context)
     set_layout_ = CreateStorageBufferPushLayout(context, kLodNumBindings);
     pipeline_layout_ =
         CreatePipelineLayout(context, set_layout_.Get(), sizeof(GaussianLodPushConstants));
-    const char* names[kLodNumPasses] = {"gaussian_lod_cut (sizes)", "gaussian_lod_cut (buckets)",
-                                        "gaussian_lod_cut (threshold)", "gaussian_lod_cut (mask)"};
+    const char* names[kLodNumPasses] = {
+        "gaussian_lod_cut (sizes)", "gaussian_lod_cut (buckets)", "gaussian_lod_cut (threshold)",
+        "gaussian_lod_cut (mask)",  "gaussian_lod_cut (offsets)", "gaussian_lod_cut (list)"};
     for (uint32_t pass = 0; pass < kLodNumPasses; ++pass) {
         const VkSpecializationMapEntry entry{kSpecLodPass, 0, sizeof(uint32_t)};
         const VkSpecializationInfo info{1, &entry, sizeof(uint32_t), &pass};
@@ -52,13 +53,23 @@ VkDeviceSize GaussianLodCut::VisibilityBytes(uint32_t num_nodes) {
     return VkDeviceSize(std::max(DivCeil(num_nodes, 32), 4u)) * 4;
 }
 
+VkDeviceSize GaussianLodCut::GroupCountsBytes(uint32_t num_nodes) {
+    return VkDeviceSize(std::max(DivCeil(num_nodes, kLodWorkgroupSize), 1u)) * 4;
+}
+
+VkDeviceSize GaussianLodCut::ListBytes(uint32_t num_leaves) {
+    return VkDeviceSize(std::max(num_leaves, 1u)) * 4;
+}
+
 void GaussianLodCut::PushBindings(VkCommandBuffer cmd, const LodCutBuffers& buffers) const {
     const std::array<const BufferRange*, kLodNumBindings> ranges{
-        &buffers.view_params, &buffers.positions, &buffers.nodes,     &buffers.buckets,
-        &buffers.histogram,   &buffers.counters,  &buffers.visibility};
+        &buffers.view_params, &buffers.positions,    &buffers.nodes,
+        &buffers.buckets,     &buffers.histogram,    &buffers.counters,
+        &buffers.visibility,  &buffers.group_counts, &buffers.list};
     static_assert(kLodViewBinding == 0 && kLodPositionsBinding == 1 && kLodNodesBinding == 2 &&
                       kLodBucketsBinding == 3 && kLodHistogramBinding == 4 &&
-                      kLodCountersBinding == 5 && kLodVisibilityBinding == 6,
+                      kLodCountersBinding == 5 && kLodVisibilityBinding == 6 &&
+                      kLodGroupCountsBinding == 7 && kLodListBinding == 8,
                   "ranges above are listed in binding order");
     std::array<VkDescriptorBufferInfo, kLodNumBindings> infos{};
     std::array<VkWriteDescriptorSet, kLodNumBindings> writes{};
@@ -85,14 +96,16 @@ void GaussianLodCut::Record(VkCommandBuffer cmd, const LodCutBuffers& buffers) c
                         VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
                         VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
     PushBindings(cmd, buffers);
-    const GaussianLodPushConstants push{buffers.num_leaves, buffers.num_inner, 0u, 0u};
+    const GaussianLodPushConstants push{buffers.num_leaves, buffers.num_inner, buffers.list_slots,
+                                        0u};
     vkCmdPushConstants(cmd, pipeline_layout_.Get(), VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(push),
                        &push);
     // A hierarchy of one splat has no inner node: the sizes and buckets passes do nothing,
     // the histogram stays zero and the threshold pass opens everything (the one leaf).
     const uint32_t inner_groups = std::max(DivCeil(buffers.num_inner, kLodWorkgroupSize), 1u);
+    const uint32_t node_groups = std::max(DivCeil(nodes, kLodWorkgroupSize), 1u);
     const uint32_t groups[kLodNumPasses] = {inner_groups, inner_groups, 1u,
-                                            std::max(DivCeil(nodes, kLodWorkgroupSize), 1u)};
+                                            node_groups,  1u,           node_groups};
     for (uint32_t pass = 0; pass < kLodNumPasses; ++pass) {
         if (pass > 0) ComputeToCompute(cmd);
         vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, passes_[pass].Get());

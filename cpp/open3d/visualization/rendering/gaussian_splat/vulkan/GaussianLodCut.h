@@ -1,9 +1,9 @@
 // The level-of-detail cut on the GPU as a recorder (docs/lod.md "The cut on the GPU"): for a
-// scene whose splats are a hierarchy's nodes (GaussianSplatLodPacking.h), four dispatches of
+// scene whose splats are a hierarchy's nodes (GaussianSplatLodPacking.h), six dispatches of
 // gaussian_lod_cut.comp turn the view and its budget (GaussianViewParams::lod_budget) into
-// the visibility mask the projection reads. Run by GaussianGeometryStage::Record before the
-// projection; its counters land in GaussianGeometryStageCounters (lod_cut_nodes,
-// lod_threshold).
+// the list of the cut's nodes, in node order, that the projection reads slot by slot. Run by
+// GaussianGeometryStage::Record before the projection; its counters land in
+// GaussianGeometryStageCounters (lod_cut_nodes, lod_threshold).
 #pragma once
 
 #include <vulkan/vulkan.h>
@@ -22,18 +22,21 @@ namespace vulkan {
 
 class VulkanContext;
 
-/// What the cut reads and writes. Per view: buckets, histogram and the mask (frames in
-/// flight must not share them); per scene: the nodes and positions.
+/// What the cut reads and writes. Per view: buckets, histogram, mask, group counts and the
+/// list (frames in flight must not share them); per scene: the nodes and positions.
 struct LodCutBuffers {
-    BufferRange view_params;  ///< shader::GaussianViewParams, already written
-    BufferRange positions;    ///< vec4 [nodes]
-    BufferRange nodes;        ///< shader::GaussianLodNode [nodes]
-    BufferRange buckets;      ///< uint32 [2 inner]: effective, then own buckets
-    BufferRange histogram;    ///< uint32 [kLodBuckets]
-    BufferRange counters;     ///< shader::GaussianGeometryStageCounters, already zeroed
-    BufferRange visibility;   ///< uint32 [ceil(nodes / 32)], written
+    BufferRange view_params;   ///< shader::GaussianViewParams, already written
+    BufferRange positions;     ///< vec4 [nodes]
+    BufferRange nodes;         ///< shader::GaussianLodNode [nodes]
+    BufferRange buckets;       ///< uint32 [2 inner]: effective, then own buckets
+    BufferRange histogram;     ///< uint32 [kLodBuckets]
+    BufferRange counters;      ///< shader::GaussianGeometryStageCounters, already zeroed
+    BufferRange visibility;    ///< uint32 [ceil(nodes / 32)]: the cut as bits
+    BufferRange group_counts;  ///< uint32 [GroupCountsBytes / 4]
+    BufferRange list;          ///< uint32 [list_slots], written: the cut's nodes
     uint32_t num_leaves = 0;
     uint32_t num_inner = 0;
+    uint32_t list_slots = 0;  ///< shader::LodListSlots of the view's budget
 };
 
 class GaussianLodCut {
@@ -45,10 +48,13 @@ public:
     static VkDeviceSize BucketsBytes(uint32_t num_inner);
     static VkDeviceSize HistogramBytes();
     static VkDeviceSize VisibilityBytes(uint32_t num_nodes);
+    static VkDeviceSize GroupCountsBytes(uint32_t num_nodes);
+    /// The list for any budget: at most a slot per leaf.
+    static VkDeviceSize ListBytes(uint32_t num_leaves);
 
-    /// Records the cut: clears the histogram, then the four passes with compute barriers
+    /// Records the cut: clears the histogram, then the six passes with compute barriers
     /// between them. The caller orders the view parameters' and counters' writes before it
-    /// and the mask's compute write before the projection reads it.
+    /// and the list's compute write before the projection reads it.
     void Record(VkCommandBuffer cmd, const LodCutBuffers& buffers) const;
 
 private:
