@@ -34,13 +34,14 @@ OPEN3D_SHADER_CONST uint kLodNoParent = 0xFFFFFFFFu;
 
 // Passes of gaussian_lod_cut.comp (specialisation constant kSpecLodPass).
 OPEN3D_SHADER_CONST uint kSpecLodPass = 0u;
-OPEN3D_SHADER_CONST uint kLodPassSizes = 0u;      // per inner node: own size bucket
-OPEN3D_SHADER_CONST uint kLodPassBuckets = 1u;    // per inner node: effective bucket, histogram
-OPEN3D_SHADER_CONST uint kLodPassThreshold = 2u;  // one workgroup: the bucket to open above
-OPEN3D_SHADER_CONST uint kLodPassMask = 3u;       // per node: the cut as bits, group counts
-OPEN3D_SHADER_CONST uint kLodPassOffsets = 4u;    // one workgroup: group counts -> offsets
-OPEN3D_SHADER_CONST uint kLodPassList = 5u;       // per node: the cut's nodes as a list
-OPEN3D_SHADER_CONST uint kLodNumPasses = 6u;
+OPEN3D_SHADER_CONST uint kLodPassSizes = 0u;         // per inner node: own size bucket
+OPEN3D_SHADER_CONST uint kLodPassBuckets = 1u;       // per inner node: effective bucket, histogram
+OPEN3D_SHADER_CONST uint kLodPassThreshold = 2u;     // one workgroup: the bucket to open above
+OPEN3D_SHADER_CONST uint kLodPassMask = 3u;          // per node: the cut as bits, group counts
+OPEN3D_SHADER_CONST uint kLodPassOffsets = 4u;       // per 256 groups: offsets in the block, total
+OPEN3D_SHADER_CONST uint kLodPassBlockOffsets = 5u;  // one workgroup: block totals -> offsets
+OPEN3D_SHADER_CONST uint kLodPassList = 6u;          // per node: the cut's nodes as a list
+OPEN3D_SHADER_CONST uint kLodNumPasses = 7u;
 
 // Descriptor set 0 of the cut's pipelines (one push-descriptor layout).
 OPEN3D_SHADER_CONST uint kLodViewBinding = 0u;        // GaussianViewParams
@@ -50,8 +51,10 @@ OPEN3D_SHADER_CONST uint kLodBucketsBinding = 3u;     // uint[2 inner]: effectiv
 OPEN3D_SHADER_CONST uint kLodHistogramBinding = 4u;   // uint[kLodBuckets]
 OPEN3D_SHADER_CONST uint kLodCountersBinding = 5u;    // GaussianGeometryStageCounters
 OPEN3D_SHADER_CONST uint kLodVisibilityBinding = 6u;  // uint[ceil(nodes / 32)]: the cut
-// uint[ceil(nodes / kLodWorkgroupSize)]: the cut's nodes per workgroup of the mask pass,
-// then (the offsets pass) their exclusive prefix sums.
+// uint[LodCountWords(nodes)]: the cut's nodes per group (a workgroup of the mask pass,
+// kLodWorkgroupSize nodes), then their exclusive prefix sums within blocks of
+// kLodWorkgroupSize groups; from LodBlockBase(nodes) on, the blocks' totals, then their
+// exclusive prefix sums.
 OPEN3D_SHADER_CONST uint kLodGroupCountsBinding = 7u;
 OPEN3D_SHADER_CONST uint kLodListBinding = 8u;  // uint[LodListSlots]: node of each list slot
 OPEN3D_SHADER_CONST uint kLodNumBindings = 9u;
@@ -79,6 +82,19 @@ struct GaussianLodPushConstants {
 OPEN3D_SHADER_FUNC uint LodListSlots(uint num_leaves, uint lod_budget) {
     uint budget = lod_budget > 1u ? lod_budget : 1u;
     return num_leaves < budget ? num_leaves : budget;
+}
+
+OPEN3D_SHADER_FUNC uint LodGroups(uint num_nodes) {
+    return (num_nodes + kLodWorkgroupSize - 1u) / kLodWorkgroupSize;
+}
+OPEN3D_SHADER_FUNC uint LodBlocks(uint num_nodes) {
+    return (LodGroups(num_nodes) + kLodWorkgroupSize - 1u) / kLodWorkgroupSize;
+}
+OPEN3D_SHADER_FUNC uint LodBlockBase(uint num_nodes) {
+    return LodBlocks(num_nodes) * kLodWorkgroupSize;
+}
+OPEN3D_SHADER_FUNC uint LodCountWords(uint num_nodes) {
+    return LodBlockBase(num_nodes) + LodBlocks(num_nodes);
 }
 
 #ifdef __cplusplus

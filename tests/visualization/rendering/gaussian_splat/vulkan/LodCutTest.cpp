@@ -104,12 +104,12 @@ TEST_F(LodCut, GpuCutIsTheMirrorsCutWithinTheBudget) {
     EXPECT_GE(coarser_than_exact, 12);  // the budgets below N really cut
 }
 
-TEST_F(LodCut, CompactionAcrossManyGroupsPerLane) {
-    // The cut's list is compacted in groups of 256 nodes whose offsets one workgroup of 256
-    // lanes scans, each lane a run of consecutive groups: playbot_31k's ~46k nodes give one
-    // group a lane, playbot_125k's ~187k nodes give runs of 3 and lanes with none. Every
-    // leaf must land in its own slot in node order (the source image bit for bit), and a
-    // cut must hold the mirror's nodes.
+TEST_F(LodCut, CompactionAcrossBlocksOfGroups) {
+    // The cut's list is compacted in groups of 256 nodes whose offsets are scanned within
+    // blocks of 256 groups, then across the blocks: playbot_31k's ~46k nodes make one block,
+    // playbot_125k's ~187k nodes three (the last partial). Every leaf must land in its own
+    // slot in node order (the source image bit for bit), and a cut must hold the mirror's
+    // nodes.
     Scene scene;
     if (!LoadPlaybot(scene, "playbot_125k.ply")) {
         OPEN3D_SKIP_OR_FAIL_WHEN_UNAVAILABLE("playbot_125k.ply is absent");

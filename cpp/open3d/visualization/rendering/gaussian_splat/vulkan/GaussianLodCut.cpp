@@ -33,8 +33,10 @@ GaussianLodCut::GaussianLodCut(const VulkanContext& context) : context_(context)
     pipeline_layout_ =
         CreatePipelineLayout(context, set_layout_.Get(), sizeof(GaussianLodPushConstants));
     const char* names[kLodNumPasses] = {
-        "gaussian_lod_cut (sizes)", "gaussian_lod_cut (buckets)", "gaussian_lod_cut (threshold)",
-        "gaussian_lod_cut (mask)",  "gaussian_lod_cut (offsets)", "gaussian_lod_cut (list)"};
+        "gaussian_lod_cut (sizes)",     "gaussian_lod_cut (buckets)",
+        "gaussian_lod_cut (threshold)", "gaussian_lod_cut (mask)",
+        "gaussian_lod_cut (offsets)",   "gaussian_lod_cut (block offsets)",
+        "gaussian_lod_cut (list)"};
     for (uint32_t pass = 0; pass < kLodNumPasses; ++pass) {
         const VkSpecializationMapEntry entry{kSpecLodPass, 0, sizeof(uint32_t)};
         const VkSpecializationInfo info{1, &entry, sizeof(uint32_t), &pass};
@@ -54,7 +56,7 @@ VkDeviceSize GaussianLodCut::VisibilityBytes(uint32_t num_nodes) {
 }
 
 VkDeviceSize GaussianLodCut::GroupCountsBytes(uint32_t num_nodes) {
-    return VkDeviceSize(std::max(DivCeil(num_nodes, kLodWorkgroupSize), 1u)) * 4;
+    return VkDeviceSize(std::max(LodCountWords(num_nodes), 1u)) * 4;
 }
 
 VkDeviceSize GaussianLodCut::ListBytes(uint32_t num_leaves) {
@@ -104,8 +106,9 @@ void GaussianLodCut::Record(VkCommandBuffer cmd, const LodCutBuffers& buffers) c
     // the histogram stays zero and the threshold pass opens everything (the one leaf).
     const uint32_t inner_groups = std::max(DivCeil(buffers.num_inner, kLodWorkgroupSize), 1u);
     const uint32_t node_groups = std::max(DivCeil(nodes, kLodWorkgroupSize), 1u);
-    const uint32_t groups[kLodNumPasses] = {inner_groups, inner_groups, 1u,
-                                            node_groups,  1u,           node_groups};
+    const uint32_t blocks = std::max(LodBlocks(nodes), 1u);
+    const uint32_t groups[kLodNumPasses] = {inner_groups, inner_groups, 1u,         node_groups,
+                                            blocks,       1u,           node_groups};
     for (uint32_t pass = 0; pass < kLodNumPasses; ++pass) {
         if (pass > 0) ComputeToCompute(cmd);
         vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, passes_[pass].Get());

@@ -1,5 +1,5 @@
 // The level-of-detail cut on the GPU as a recorder (docs/lod.md "The cut on the GPU"): for a
-// scene whose splats are a hierarchy's nodes (GaussianSplatLodPacking.h), six dispatches of
+// scene whose splats are a hierarchy's nodes (GaussianSplatLodPacking.h), seven dispatches of
 // gaussian_lod_cut.comp turn the view and its budget (GaussianViewParams::lod_budget) into
 // the list of the cut's nodes, in node order, that the projection reads slot by slot. Run by
 // GaussianGeometryStage::Record before the projection; its counters land in
@@ -52,7 +52,7 @@ public:
     /// The list for any budget: at most a slot per leaf.
     static VkDeviceSize ListBytes(uint32_t num_leaves);
 
-    /// Records the cut: clears the histogram, then the six passes with compute barriers
+    /// Records the cut: clears the histogram, then the seven passes with compute barriers
     /// between them. The caller orders the view parameters' and counters' writes before it
     /// and the list's compute write before the projection reads it.
     void Record(VkCommandBuffer cmd, const LodCutBuffers& buffers) const;
