@@ -1,6 +1,7 @@
 // Views and scenes that do not fit in device memory are refused before anything is
 // allocated, with the numbers and a size that fits; that size then renders
-// (OPEN3D_DEVICE_MEMORY_LIMIT stands in for a small device).
+// (OPEN3D_DEVICE_MEMORY_LIMIT stands in for a small device); a buffer past one storage
+// binding's range is refused too.
 #include <gtest/gtest.h>
 
 #include <cstdio>
@@ -9,6 +10,7 @@
 #include "TestUtility.h"
 #include "open3d/core/Exception.h"
 #include "open3d/visualization/rendering/gaussian_splat/DefaultScene.h"
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/GaussianGeometryStageResources.h"
 #include "visualization/rendering/gaussian_splat/vulkan/VulkanTestFixture.h"
 
 namespace open3d {
@@ -65,6 +67,26 @@ TEST_F(VulkanMemoryCheck, ASceneThatDoesNotFitIsRefused) {
         EXPECT_NE(std::string(e.what()).find("OPEN3D_DEVICE_MEMORY_LIMIT"), std::string::npos)
             << e.what();
     }
+}
+
+TEST_F(VulkanMemoryCheck, ABufferPastOneStorageBindingIsRefused) {
+    // Per-view buffers are bound whole: projected records of one slot past the device's
+    // maxStorageBufferRange (lavapipe 128 MiB: 2.1M slots; the H200 4 GiB: 67M) are refused
+    // before that buffer is made; a driver without validation reads zeros past the range.
+    const uint64_t limit = Context().GetDeviceInfo().max_storage_buffer_range;
+    const uint64_t record = sizeof(visualization::rendering::shader::GaussianProjectedSplat);
+    const uint32_t slots = static_cast<uint32_t>(limit / record + 1);
+    ASSERT_LE(slots, rendering::vulkan::RadixSort::kMaxCount);
+    rendering::vulkan::GeometryStageViewResources view;
+    try {
+        view.Allocate(Context(), slots, 16);
+        FAIL() << "per-view buffers for " << slots << " slots were made";
+    } catch (const core::Open3DError& e) {
+        EXPECT_NE(std::string(e.what()).find("maxStorageBufferRange"), std::string::npos)
+            << e.what();
+    }
+    view.Allocate(Context(), static_cast<uint32_t>(limit / record), 16);  // just fits
+    EXPECT_TRUE(view);
 }
 
 }  // namespace

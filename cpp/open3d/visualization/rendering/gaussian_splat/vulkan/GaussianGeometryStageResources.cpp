@@ -1,6 +1,7 @@
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/GaussianGeometryStageResources.h"
 
 #include <algorithm>
+#include <cstdint>
 #include <cstring>
 
 #include "open3d/core/Exception.h"
@@ -15,6 +16,26 @@ namespace {
 
 constexpr VkBufferUsageFlags kTransfer =
     VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
+
+}  // namespace
+
+namespace {
+
+// Every scene and per-view buffer here is bound whole as one storage binding. A range past
+// the device's maxStorageBufferRange is invalid usage that only the validation layer
+// reports; without it the H200's driver read zeros past the limit (a 5.9 GB shape buffer of
+// 147M hierarchy nodes: garbage footprints, 134M tile entries for 2M visible splats).
+void RequireStorageBinding(const VulkanContext& context, const char* what, VkDeviceSize bytes,
+                           uint64_t count) {
+    const uint64_t limit = context.GetDeviceInfo().max_storage_buffer_range;
+    if (bytes > limit) {
+        core::ThrowError(
+            "Vulkan backend: the {} for {} splats take {} bytes, more than one storage binding "
+            "of this device holds ({} bytes, maxStorageBufferRange); fewer splats, compact "
+            "storage or a lower SH degree fit",
+            what, count, bytes, limit);
+    }
+}
 
 }  // namespace
 
@@ -35,6 +56,18 @@ Buffer UploadStorageBuffer(const VulkanContext& context, const CommandPool& pool
 
 void GeometryStageResources::UploadScene(const VulkanContext& context, const CommandPool& pool,
                                          const PackedGaussianSplats& packed) {
+    // The shaders index the shape and SH words with 32-bit unsigned integers.
+    const size_t words = std::max(packed.shape.size(), packed.sh.size());
+    if (words > size_t(UINT32_MAX)) {
+        core::ThrowError(
+            "{} splats need {} words of shape or SH data, more than the shaders' 32-bit "
+            "indices reach ({}): compact storage or a lower SH degree halves it or more",
+            packed.num_splats, words, UINT32_MAX);
+    }
+    const uint64_t n = packed.num_splats;
+    RequireStorageBinding(context, "positions", packed.positions.size() * sizeof(float), n);
+    RequireStorageBinding(context, "shape words", packed.shape.size() * 4, n);
+    RequireStorageBinding(context, "SH words", packed.sh.size() * 4, n);
     positions = UploadStorageBuffer(context, pool, packed.positions.data(),
                                     packed.positions.size() * sizeof(float));
     shape = UploadStorageBuffer(context, pool, packed.shape.data(), packed.shape.size() * 4);
@@ -61,6 +94,8 @@ void GeometryStageResources::UploadLod(const VulkanContext& context, const Comma
         core::ThrowError("a hierarchy of {} + {} nodes for a scene of {} splats", lod.num_leaves,
                          lod.num_inner, layout_.num_splats);
     }
+    RequireStorageBinding(context, "hierarchy nodes",
+                          lod.nodes.size() * sizeof(shader::GaussianLodNode), lod.nodes.size());
     lod_nodes = UploadStorageBuffer(context, pool, lod.nodes.data(),
                                     lod.nodes.size() * sizeof(shader::GaussianLodNode));
     lod_leaves_ = lod.num_leaves;
@@ -90,9 +125,16 @@ void GeometryStageResources::AllocateView(const VulkanContext& context, uint32_t
 void GeometryStageViewResources::Allocate(const VulkanContext& context, uint32_t n,
                                           uint32_t entry_capacity,
                                           std::optional<uint32_t> lod_inner) {
+    // A hierarchy's frame runs over its cut's list, at most a slot per leaf (LodListSlots):
+    // the buffers after the cut are sized for the leaves, not the nodes.
+    if (lod_inner && *lod_inner >= n) {
+        core::ThrowError("GeometryStageViewResources: {} inner nodes of {} nodes", *lod_inner, n);
+    }
+    const uint32_t slots = lod_inner ? n - *lod_inner : n;
     const GeometryStageStorageRequirements need =
-        GaussianGeometryStage::GetStorageRequirements(n, entry_capacity);
+        GaussianGeometryStage::GetStorageRequirements(slots, entry_capacity);
     const auto make = [&](VkDeviceSize bytes, VkBufferUsageFlags usage) {
+        RequireStorageBinding(context, "per-view buffers", bytes, slots);
         return Buffer(context, std::max<VkDeviceSize>(bytes, 16), usage | kTransfer,
                       MemoryUsage::kDevice);
     };
@@ -119,7 +161,7 @@ void GeometryStageViewResources::Allocate(const VulkanContext& context, uint32_t
         lod_histogram = make(GaussianLodCut::HistogramBytes(), need.usage);
         lod_visibility = make(GaussianLodCut::VisibilityBytes(n), need.usage);
         lod_group_counts = make(GaussianLodCut::GroupCountsBytes(n), need.usage);
-        lod_list = make(GaussianLodCut::ListBytes(n - *lod_inner), need.usage);
+        lod_list = make(GaussianLodCut::ListBytes(slots), need.usage);
     }
     lod_inner_ = lod_inner;
     num_splats_ = n;

@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstddef>
+#include <cstdint>
 #include <cstring>
 #include <utility>
 #include <vector>
@@ -97,13 +98,15 @@ void GaussianSplatVulkanBackend::SetScene(const t::geometry::PointCloud& cloud) 
 void GaussianSplatVulkanBackend::SetSceneHierarchy(const t::geometry::PointCloud& source,
                                                    const t::geometry::SplatHierarchy& hierarchy) {
     source.ValidateGaussianSplat();
-    // The depth sort keeps a slot per node (the hidden ones dropped in its first pass):
-    // refused before the nodes are gathered and uploaded.
-    if (hierarchy.NumNodes() > int64_t(RadixSort::kMaxCount)) {
+    // Every pass after the cut runs over its list, at most a slot per leaf; the cut's own
+    // passes index nodes with 32-bit integers. Refused before the nodes are gathered.
+    if (hierarchy.num_leaves > int64_t(RadixSort::kMaxCount) ||
+        hierarchy.NumNodes() > int64_t(INT32_MAX)) {
         core::ThrowError(
             "Vulkan backend: a hierarchy of {} nodes ({} splats + {} inner) exceeds the {} "
-            "slots the depth sort takes (the GPU cut draws from every node)",
-            hierarchy.NumNodes(), hierarchy.num_leaves, hierarchy.NumInner(), RadixSort::kMaxCount);
+            "splats the depth sort takes or the {} nodes the cut indexes",
+            hierarchy.NumNodes(), hierarchy.num_leaves, hierarchy.NumInner(), RadixSort::kMaxCount,
+            INT32_MAX);
     }
     const PackedLodNodes lod = PackLodNodes(hierarchy);
     t::geometry::PointCloud nodes = HierarchyNodeCloud(hierarchy, source);
