@@ -98,6 +98,9 @@ struct RenderStats {
     double gpu_merge_ms = 0.0;      ///< depth merge (offscreen depth readback only)
     /// Parts of gpu_sort_ms: depth sort, scan + entry emission, tile sort.
     double gpu_depth_sort_ms = 0.0, gpu_scan_emit_ms = 0.0, gpu_tile_sort_ms = 0.0;
+    /// Part of gpu_project_ms: the level-of-detail cut chosen on the GPU (0 without a
+    /// hierarchy).
+    double gpu_lod_cut_ms = 0.0;
     /// Host time of the frame in the Vulkan backend: recording commands (0 when a recording
     /// was submitted again), submitting, waiting for the GPU's fence, copying the images out.
     /// A batch reports its totals divided by its views. docs/perf/ has the breakdown.

@@ -158,12 +158,17 @@ TEST_F(LodCut, ASceneOfOneSplatAndAPlainSceneAfterwards) {
     const camera::PinholeCamera cam = scene.views.at(0).camera.Resized(64, 64);
     RenderConfig config;
     config.lod_budget = 1;
-    EXPECT_EQ(backend->Render(cam, config).stats.lod_cut_nodes, 1);
+    const RenderOutput cut = backend->Render(cam, config);
+    EXPECT_EQ(cut.stats.lod_cut_nodes, 1);
+    // The cut's passes are timed as a part of the projection (lavapipe has timestamps).
+    EXPECT_GT(cut.stats.gpu_lod_cut_ms, 0.0);
+    EXPECT_LT(cut.stats.gpu_lod_cut_ms, cut.stats.gpu_project_ms);
     // A visibility mask belongs to plain scenes; SetScene makes one again.
     EXPECT_THROW(backend->SetVisibility({1u}), core::Open3DError);
     backend->SetScene(scene.cloud);
     const RenderOutput plain = backend->Render(cam, {});
     EXPECT_EQ(plain.stats.lod_cut_nodes, 0);
+    EXPECT_EQ(plain.stats.gpu_lod_cut_ms, 0.0);
     const RenderOutput ref = cpu::RenderReference(scene.cloud, cam, {});
     EXPECT_GE(
         t::geometry::ComputeImageErrorMetrics(plain.color, ref.color, 1.0, 1.0 / 255.0).psnr_db,

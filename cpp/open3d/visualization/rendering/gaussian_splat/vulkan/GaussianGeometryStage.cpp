@@ -254,8 +254,10 @@ void GaussianGeometryStage::Record(VkCommandBuffer cmd, const GeometryStageScene
             core::ThrowError("GaussianGeometryStage: a hierarchy of {} + {} nodes for {} splats",
                              cut.num_leaves, cut.num_inner, scene.num_splats);
         }
+        if (timestamps) timestamps->RecordBegin(cmd, TimedPass::kLodCut);
         lod_cut_.Record(cmd, cut);
         ComputeBarrier(cmd);
+        if (timestamps) timestamps->RecordEnd(cmd, TimedPass::kLodCut);
     }
 
     // 1. Project: visible splats -> (depth key, splat index) list, visible_count.

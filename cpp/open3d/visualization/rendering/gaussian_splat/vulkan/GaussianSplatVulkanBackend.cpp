@@ -461,6 +461,7 @@ void GaussianSplatVulkanBackend::WaitForGeometry() {
     t.gpu_depth_sort_ms = at(TimedPass::kDepthSort);
     t.gpu_scan_emit_ms = at(TimedPass::kScanEmit);
     t.gpu_tile_sort_ms = at(TimedPass::kTileSort);
+    t.gpu_lod_cut_ms = geometry_stage_resources_.HasLod() ? at(TimedPass::kLodCut) : 0.0;
 }
 
 RenderStats GaussianSplatVulkanBackend::RenderComposite(CompositeSink& sink) {

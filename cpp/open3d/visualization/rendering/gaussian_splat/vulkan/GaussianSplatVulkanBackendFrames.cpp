@@ -736,6 +736,7 @@ std::vector<RenderOutput> GaussianSplatVulkanBackend::WaitBatch(uint64_t ticket)
         s.gpu_depth_sort_ms = at(TimedPass::kDepthSort);
         s.gpu_scan_emit_ms = at(TimedPass::kScanEmit);
         s.gpu_tile_sort_ms = at(TimedPass::kTileSort);
+        s.gpu_lod_cut_ms = geometry_stage_resources_.HasLod() ? at(TimedPass::kLodCut) : 0.0;
         s.gpu_composite_ms = at(TimedPass::kComposite);
     }
     const double readback_ms = core::MillisecondsSince(readback_start);

@@ -29,6 +29,7 @@ enum class TimedPass : uint32_t {
     kDepthSort,  ///< the depth sort of the visible list
     kScanEmit,   ///< tile-count scan, capacity check and entry emission
     kTileSort,   ///< the stable sort of the entries by tile
+    kLodCut,     ///< part of kProject: a hierarchy's cut (GaussianLodCut), before the projection
     kCount
 };
 
