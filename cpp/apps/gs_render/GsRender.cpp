@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <optional>
 #include <string>
 #include <vector>
@@ -16,11 +17,15 @@
 #include "open3d/core/ParallelFor.h"
 #include "open3d/core/Timer.h"
 #include "open3d/t/geometry/PointCloudStatistics.h"
+#include "open3d/t/geometry/SplatHierarchy.h"
 #include "open3d/t/io/ImageIO.h"
 #include "open3d/t/io/OutputFiles.h"
 #include "open3d/t/io/PointCloudIO.h"
+#include "open3d/t/io/SplatHierarchyIO.h"
 #include "open3d/visualization/rendering/gaussian_splat/DefaultScene.h"
 #include "open3d/visualization/rendering/gaussian_splat/GaussianSplatBackend.h"
+#include "open3d/visualization/rendering/gaussian_splat/cpu/LodCut.h"
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/GaussianSplatVulkanBackend.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/VulkanBackendRegistry.h"
 
 namespace {
@@ -53,6 +58,8 @@ struct Options {
     bool sphere = false;
     std::optional<double> sphere_radius;
     int frames = 1;
+    uint64_t lod_budget = 0;  // 0: no level of detail
+    std::string lod;          // hierarchy file; default <input>.lod, else built here
 };
 
 Eigen::Vector3d ToVec(const std::vector<double>& v) { return Eigen::Vector3d(v[0], v[1], v[2]); }
@@ -208,8 +215,47 @@ camera::PinholeCamera ChooseCamera(const Options& opt, const t::geometry::PointC
     return cam;
 }
 
+// The hierarchy for --lod-budget: --lod, else <input>.lod beside the scene (what gs-convert
+// --lod writes), else built from the scene now (and not kept).
+t::geometry::SplatHierarchy LoadOrBuildHierarchy(const Options& opt,
+                                                 const t::geometry::PointCloud& cloud) {
+    const auto start = std::chrono::steady_clock::now();
+    std::string path = opt.lod;
+    if (path.empty() && !opt.input.empty() && std::filesystem::exists(opt.input + ".lod")) {
+        path = opt.input + ".lod";
+    }
+    if (!path.empty()) {
+        t::geometry::SplatHierarchy hierarchy = t::io::ReadSplatHierarchy(path);
+        if (hierarchy.num_leaves != cloud.NumPoints()) {
+            core::ThrowError("--lod '{}': a hierarchy of {} leaves for a scene of {} splats", path,
+                             hierarchy.num_leaves, cloud.NumPoints());
+        }
+        std::printf("level of detail: hierarchy of %lld nodes read from %s in %.1f ms\n",
+                    static_cast<long long>(hierarchy.NumNodes()), path.c_str(),
+                    core::MillisecondsSince(start));
+        return hierarchy;
+    }
+    std::printf(
+        "level of detail: building the hierarchy of %lld splats (gs-convert --lod "
+        "writes it beside the scene once)...\n",
+        static_cast<long long>(cloud.NumPoints()));
+    std::fflush(stdout);
+    t::geometry::SplatHierarchy hierarchy = t::geometry::BuildSplatHierarchy(cloud);
+    std::printf("level of detail: hierarchy of %lld nodes built in %.1f ms\n",
+                static_cast<long long>(hierarchy.NumNodes()), core::MillisecondsSince(start));
+    return hierarchy;
+}
+
 int Run(const Options& opt) {
     CheckOutputs(opt);
+    if (!opt.lod.empty() && opt.lod_budget == 0) {
+        core::ThrowError("--lod '{}' is read for --lod-budget: give a budget too", opt.lod);
+    }
+    if (opt.lod_budget > 0 && (opt.filament || opt.sphere)) {
+        core::ThrowError(
+            "--lod-budget draws through the splat backend alone, not --filament or "
+            "--sphere");
+    }
     rendering::vulkan::RegisterVulkanBackend();
     const auto start = std::chrono::steady_clock::now();
     t::geometry::PointCloud cloud;
@@ -270,7 +316,23 @@ int Run(const Options& opt) {
         std::printf("total time %.1f ms\n", core::MillisecondsSince(start));
         return 0;
     }
-    backend->SetScene(cloud);
+    int64_t lod_nodes = 0;
+    if (opt.lod_budget > 0) {
+        const t::geometry::SplatHierarchy hierarchy = LoadOrBuildHierarchy(opt, cloud);
+        config.lod_budget = opt.lod_budget;
+        auto* vulkan = dynamic_cast<rendering::vulkan::GaussianSplatVulkanBackend*>(backend.get());
+        if (vulkan != nullptr) {
+            vulkan->SetSceneHierarchy(cloud, hierarchy);  // the cut is chosen on the GPU
+        } else {
+            // The CPU reference draws the cut the GPU would choose (its mirror), as a scene.
+            const std::vector<int64_t> nodes =
+                rendering::cpu::CutLikeGpu(hierarchy, cam, opt.lod_budget).nodes;
+            lod_nodes = static_cast<int64_t>(nodes.size());
+            backend->SetScene(t::geometry::ExtractSplatNodes(hierarchy, cloud, nodes));
+        }
+    } else {
+        backend->SetScene(cloud);
+    }
     const auto render_start = std::chrono::steady_clock::now();
     backend->RenderGeometryStage(cam, config);
     rendering::RenderOutput out;
@@ -291,6 +353,13 @@ int Run(const Options& opt) {
         static_cast<long long>(s.num_visible), static_cast<long long>(s.num_tile_entries),
         s.error_flags ? ", ENTRIES DROPPED: raise the capacity limits" : "");
 
+    if (opt.lod_budget > 0) {
+        if (s.lod_cut_nodes > 0) lod_nodes = s.lod_cut_nodes;
+        std::printf("level of detail: cut of %lld nodes (budget %llu) of %lld splats\n",
+                    static_cast<long long>(lod_nodes),
+                    static_cast<unsigned long long>(opt.lod_budget),
+                    static_cast<long long>(cloud.NumPoints()));
+    }
     const auto& depth = opt.depth_kind == "median" ? out.depth_median : out.depth_expected;
     WriteOutputs(opt, out.color.SelectChannels(0, 3), opt.depth_output.empty() ? nullptr : &depth,
                  opt.depth_kind + " depth", opt.float_output.empty() ? nullptr : &out.color);
@@ -370,6 +439,14 @@ int main(int argc, char** argv) {
         ->check(CLI::Range(1.0, 179.0));
     app.add_option("--orbit-angle", opt.orbit_angle,
                    "Rotate the eye about --up through --center by this many degrees");
+    app.add_option("--lod-budget", opt.lod_budget,
+                   "Draw the scene's level-of-detail cut of at most this many splats (docs/lod.md; "
+                   "0: the whole scene)")
+        ->capture_default_str();
+    app.add_option("--lod", opt.lod,
+                   "Hierarchy file for --lod-budget (default: <input>.lod as gs-convert --lod "
+                   "writes it, else the hierarchy is built from the scene first)")
+        ->check(CLI::ExistingFile);
     app.add_flag("--filament", opt.filament,
                  "Render through Filament (the Open3DScene offscreen path) instead of the "
                  "backend alone");
