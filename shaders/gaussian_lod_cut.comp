@@ -96,6 +96,20 @@ uint SizeBucket(uint node) {
     return uint(min(b, float(kLodBuckets - 2u))) + 1u;
 }
 
+// The sum of `own` over lanes 0..lane of the workgroup (Hillis-Steele in s_suffix); every
+// lane must call it.
+uint InclusivePrefixSum(uint lane, uint own) {
+    s_suffix[lane] = own;
+    barrier();
+    for (uint step = 1u; step < kLodWorkgroupSize; step <<= 1u) {
+        uint add = lane >= step ? s_suffix[lane - step] : 0u;
+        barrier();
+        s_suffix[lane] += add;
+        barrier();
+    }
+    return s_suffix[lane];
+}
+
 bool Opens(uint inner, uint threshold) {
     return threshold == kLodOpenAll || buckets[inner] > threshold;
 }
@@ -196,18 +210,11 @@ void main() {
         // 143k groups of the grid 14x14's 36.7M nodes on an H200.)
         uint groups = LodGroups(pc.num_leaves + pc.num_inner);
         uint own = id < groups ? group_counts[id] : 0u;
-        s_suffix[lane] = own;  // inclusive prefix sums below (Hillis-Steele)
-        barrier();
-        for (uint step = 1u; step < kLodWorkgroupSize; step <<= 1u) {
-            uint add = lane >= step ? s_suffix[lane - step] : 0u;
-            barrier();
-            s_suffix[lane] += add;
-            barrier();
-        }
-        if (id < groups) group_counts[id] = s_suffix[lane] - own;
+        uint inclusive = InclusivePrefixSum(lane, own);
+        if (id < groups) group_counts[id] = inclusive - own;
         if (lane == kLodWorkgroupSize - 1u) {
             group_counts[LodBlockBase(pc.num_leaves + pc.num_inner) + gl_WorkGroupID.x] =
-                s_suffix[lane];
+                inclusive;
         }
     } else if (kPass == kLodPassBlockOffsets) {
         // Lane i sums a run of consecutive block totals, the lanes' sums are scanned in
@@ -219,15 +226,7 @@ void main() {
         uint first = min(lane * run, blocks), last = min(first + run, blocks);
         uint own = 0u;
         for (uint b = first; b < last; ++b) own += group_counts[base + b];
-        s_suffix[lane] = own;
-        barrier();
-        for (uint step = 1u; step < kLodWorkgroupSize; step <<= 1u) {
-            uint add = lane >= step ? s_suffix[lane - step] : 0u;
-            barrier();
-            s_suffix[lane] += add;
-            barrier();
-        }
-        uint offset = s_suffix[lane] - own;
+        uint offset = InclusivePrefixSum(lane, own) - own;
         for (uint b = first; b < last; ++b) {
             uint count = group_counts[base + b];
             group_counts[base + b] = offset;

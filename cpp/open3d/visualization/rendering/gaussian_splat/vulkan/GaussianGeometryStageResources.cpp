@@ -56,14 +56,8 @@ Buffer UploadStorageBuffer(const VulkanContext& context, const CommandPool& pool
 
 void GeometryStageResources::UploadScene(const VulkanContext& context, const CommandPool& pool,
                                          const PackedGaussianSplats& packed) {
-    // The shaders index the shape and SH words with 32-bit unsigned integers.
-    const size_t words = std::max(packed.shape.size(), packed.sh.size());
-    if (words > size_t(UINT32_MAX)) {
-        core::ThrowError(
-            "{} splats need {} words of shape or SH data, more than the shaders' 32-bit "
-            "indices reach ({}): compact storage or a lower SH degree halves it or more",
-            packed.num_splats, words, UINT32_MAX);
-    }
+    // A binding holds at most 4 GiB (maxStorageBufferRange is 32-bit), so the shaders'
+    // 32-bit word indices reach every word of a buffer these checks let through.
     const uint64_t n = packed.num_splats;
     RequireStorageBinding(context, "positions", packed.positions.size() * sizeof(float), n);
     RequireStorageBinding(context, "shape words", packed.shape.size() * 4, n);
