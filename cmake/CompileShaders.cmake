@@ -55,7 +55,7 @@ function(open3d_add_compute_shaders target)
       COMMENT "Compiling compute shader ${stem}.comp to SPIR-V"
       VERBATIM)
     add_custom_command(OUTPUT ${msl}
-      COMMAND ${SPIRV_CROSS} --msl --msl-version 20100 --msl-fixed-subgroup-size 32
+      COMMAND ${SPIRV_CROSS} --msl --msl-version 20200 --msl-fixed-subgroup-size 32
               --output ${msl} ${spv}
       DEPENDS ${spv}
       COMMENT "Translating ${stem}.spv to MSL"

@@ -91,19 +91,19 @@ OPEN3D_SHADER_FUNC uint CompositeBlockMask(float cx, float cy, float a, float b,
     return mask;
 }
 
-// Descriptor set 0 of the composite (push descriptors).
-OPEN3D_SHADER_CONST uint kCompositeProjectedBinding = 0u;     // GaussianProjectedSplat[N]
-OPEN3D_SHADER_CONST uint kCompositeEntryKeysBinding = 1u;     // uint[capacity]: tile, ascending
-OPEN3D_SHADER_CONST uint kCompositeEntryValuesBinding = 2u;   // uint[capacity]: splat index
-OPEN3D_SHADER_CONST uint kCompositeCountBinding = 3u;         // uint[]: entry count at count_index
-OPEN3D_SHADER_CONST uint kCompositeStateBinding = 4u;         // GaussianCompositeState
-OPEN3D_SHADER_CONST uint kCompositeColorBinding = 5u;         // image2D rgba32f / rgba16f
-OPEN3D_SHADER_CONST uint kCompositeDepthBinding = 6u;         // image2D r32f: expected view z
-OPEN3D_SHADER_CONST uint kCompositeAlphaBinding = 7u;         // image2D r32f: 1 - T
-OPEN3D_SHADER_CONST uint kCompositeMedianDepthBinding = 8u;   // image2D r32f: median view z
-OPEN3D_SHADER_CONST uint kCompositeSceneDepthBinding = 9u;    // texture2D, reversed-Z
-OPEN3D_SHADER_CONST uint kCompositeColorBufferBinding = 10u;  // vec4[W * H] (kSpecColorBuffer)
-OPEN3D_SHADER_CONST uint kCompositeNumBindings = 11u;
+// Descriptor set 0 of the composite (push descriptors). The projected records are read
+// through their device address (GaussianCompositePushConstants::projected_lo / _hi).
+OPEN3D_SHADER_CONST uint kCompositeEntryKeysBinding = 0u;    // uint[capacity]: tile, ascending
+OPEN3D_SHADER_CONST uint kCompositeEntryValuesBinding = 1u;  // uint[capacity]: splat index
+OPEN3D_SHADER_CONST uint kCompositeCountBinding = 2u;        // uint[]: entry count at count_index
+OPEN3D_SHADER_CONST uint kCompositeStateBinding = 3u;        // GaussianCompositeState
+OPEN3D_SHADER_CONST uint kCompositeColorBinding = 4u;        // image2D rgba32f / rgba16f
+OPEN3D_SHADER_CONST uint kCompositeDepthBinding = 5u;        // image2D r32f: expected view z
+OPEN3D_SHADER_CONST uint kCompositeAlphaBinding = 6u;        // image2D r32f: 1 - T
+OPEN3D_SHADER_CONST uint kCompositeMedianDepthBinding = 7u;  // image2D r32f: median view z
+OPEN3D_SHADER_CONST uint kCompositeSceneDepthBinding = 8u;   // texture2D, reversed-Z
+OPEN3D_SHADER_CONST uint kCompositeColorBufferBinding = 9u;  // vec4[W * H] (kSpecColorBuffer)
+OPEN3D_SHADER_CONST uint kCompositeNumBindings = 10u;
 
 // Descriptor set 0 of the depth merge (push descriptors).
 OPEN3D_SHADER_CONST uint kDepthMergeSplatDepthBinding = 0u;  // image2D r32f: splat view z
@@ -131,6 +131,9 @@ struct GaussianCompositePushConstants {
     uint reserved0;
     vec3 background;   // out.rgb = C + T * background
     float scene_near;  // near of the reversed-Z scene depth (view z = near / d)
+    // Device address of the GaussianProjectedSplat records (low, high words).
+    uint projected_lo, projected_hi;
+    uint reserved1, reserved2;
 };
 
 // Push constants of the depth merge.
@@ -156,7 +159,7 @@ static_assert(kCompositeBlocks * kCompositeBlockWidth * kCompositeBlockHeight ==
 static_assert(sizeof(GaussianCompositeState) == 16);
 static_assert(offsetof(GaussianCompositeState, next_tile) == 0);
 
-static_assert(sizeof(GaussianCompositePushConstants) == 48);
+static_assert(sizeof(GaussianCompositePushConstants) == 64);
 static_assert(offsetof(GaussianCompositePushConstants, width) == 0);
 static_assert(offsetof(GaussianCompositePushConstants, height) == 4);
 static_assert(offsetof(GaussianCompositePushConstants, tiles_x) == 8);
@@ -166,6 +169,7 @@ static_assert(offsetof(GaussianCompositePushConstants, entry_capacity) == 20);
 static_assert(offsetof(GaussianCompositePushConstants, scene_depth_flip_y) == 24);
 static_assert(offsetof(GaussianCompositePushConstants, background) == 32);
 static_assert(offsetof(GaussianCompositePushConstants, scene_near) == 44);
+static_assert(offsetof(GaussianCompositePushConstants, projected_lo) == 48);
 
 static_assert(sizeof(GaussianDepthMergePushConstants) == 32);
 static_assert(offsetof(GaussianDepthMergePushConstants, width) == 0);

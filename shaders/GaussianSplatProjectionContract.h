@@ -45,23 +45,35 @@ OPEN3D_SHADER_CONST uint kSpecIndexedList = 3u;
 OPEN3D_SHADER_CONST uint kSpecCutList = 4u;
 
 // Descriptor set 0 of every geometry stage projection pipeline (one push-descriptor layout; each
-// shader declares only the bindings it uses).
+// shader declares only the bindings it uses). The shape and SH words and the projected records
+// are not bound: they are read through device addresses (GaussianGeometryAddresses).
 OPEN3D_SHADER_CONST uint kGeometryStageViewBinding = 0u;       // GaussianViewParams
 OPEN3D_SHADER_CONST uint kGeometryStagePositionsBinding = 1u;  // vec4[N]: xyz, sigmoid(opacity)
-OPEN3D_SHADER_CONST uint kGeometryStageShapeBinding = 2u;      // uint[N * shape words]
-OPEN3D_SHADER_CONST uint kGeometryStageShBinding = 3u;  // uint[N * sh words]; unread at degree 0
 // uint[ceil(N / 32)], bit i = splat i; with kSpecCutList, uint[N]: the cut's nodes.
-OPEN3D_SHADER_CONST uint kGeometryStageVisibilityBinding = 4u;
-OPEN3D_SHADER_CONST uint kGeometryStageProjectedBinding = 5u;     // GaussianProjectedSplat[N]
-OPEN3D_SHADER_CONST uint kGeometryStageCountersBinding = 6u;      // GaussianGeometryStageCounters
-OPEN3D_SHADER_CONST uint kGeometryStageDepthKeysBinding = 7u;     // uint[N]: visible depth keys
-OPEN3D_SHADER_CONST uint kGeometryStageSplatIndexBinding = 8u;    // uint[N]: visible splat indices
-OPEN3D_SHADER_CONST uint kGeometryStageScanBinding = 9u;          // uint[scan words]: all levels
-OPEN3D_SHADER_CONST uint kGeometryStageEntryKeysBinding = 10u;    // uint[capacity]: tile index
-OPEN3D_SHADER_CONST uint kGeometryStageEntryValuesBinding = 11u;  // uint[capacity]: splat index
-OPEN3D_SHADER_CONST uint kGeometryStageSortParamsBinding = 12u;  // RadixSortParams of the next sort
-OPEN3D_SHADER_CONST uint kGeometryStageTileCountsBinding = 13u;  // uint[N]: tiles of splat i
-OPEN3D_SHADER_CONST uint kGeometryStageNumBindings = 14u;
+OPEN3D_SHADER_CONST uint kGeometryStageVisibilityBinding = 2u;
+OPEN3D_SHADER_CONST uint kGeometryStageCountersBinding = 3u;      // GaussianGeometryStageCounters
+OPEN3D_SHADER_CONST uint kGeometryStageDepthKeysBinding = 4u;     // uint[N]: visible depth keys
+OPEN3D_SHADER_CONST uint kGeometryStageSplatIndexBinding = 5u;    // uint[N]: visible splat indices
+OPEN3D_SHADER_CONST uint kGeometryStageScanBinding = 6u;          // uint[scan words]: all levels
+OPEN3D_SHADER_CONST uint kGeometryStageEntryKeysBinding = 7u;     // uint[capacity]: tile index
+OPEN3D_SHADER_CONST uint kGeometryStageEntryValuesBinding = 8u;   // uint[capacity]: splat index
+OPEN3D_SHADER_CONST uint kGeometryStageSortParamsBinding = 9u;  // RadixSortParams of the next sort
+OPEN3D_SHADER_CONST uint kGeometryStageTileCountsBinding = 10u;  // uint[N]: tiles of splat i
+OPEN3D_SHADER_CONST uint kGeometryStageNumBindings = 11u;
+
+// The buffers a splat count can grow past the range one storage binding reaches
+// (maxStorageBufferRange: 4 GiB on NVIDIA, 128 MiB on lavapipe; 98M splats of degree 3 have
+// 9.4 GB of SH words), as device addresses split into low and high words: the projection
+// reads the shape and SH words and writes the projected records, the emit reads those. They
+// sit in the geometry stage's push constants at kGeometryAddressesPushOffset, after the
+// scan's and the dispatch-args pass's constants, and are pushed with the bindings.
+struct GaussianGeometryAddresses {
+    uint shape_lo, shape_hi;          // uint[N * shape words]
+    uint sh_lo, sh_hi;                // uint[N * sh words]; unread at degree 0
+    uint projected_lo, projected_hi;  // GaussianProjectedSplat[N]
+    uint reserved0, reserved1;
+};
+OPEN3D_SHADER_CONST uint kGeometryAddressesPushOffset = 32u;
 
 // Per-frame view parameters (a readonly std430 storage buffer), one named member per value;
 // each vec3 shares its 16 bytes with the scalar after it (GaussianSplatCommon.h).
@@ -118,6 +130,9 @@ struct GaussianProjectedSplat {
     uint num_entries;  // the rect's tiles that TileRowSpan keeps
     uint radius;       // pixels
 };
+
+// Bytes of one record as the shaders store it (GaussianProjectedWords).
+OPEN3D_SHADER_CONST uint kProjectedSplatBytes = 64u;
 
 // How the shaders store a GaussianProjectedSplat: the same 64 bytes as four 16-byte words,
 // so the projection writes it and the emit and composite passes read it with 128-bit
@@ -198,8 +213,11 @@ static_assert(offsetof(GaussianViewParams, reference_m14) == 172);
 static_assert(offsetof(GaussianViewParams, depth_order) == 176);
 static_assert(offsetof(GaussianViewParams, lod_budget) == 180);
 static_assert(offsetof(GaussianViewParams, reserved3) == 188);
+static_assert(sizeof(GaussianGeometryAddresses) == 32);
+static_assert(offsetof(GaussianGeometryAddresses, sh_lo) == 8);
+static_assert(offsetof(GaussianGeometryAddresses, projected_lo) == 16);
 
-static_assert(sizeof(GaussianProjectedSplat) == 64);
+static_assert(sizeof(GaussianProjectedSplat) == kProjectedSplatBytes);
 static_assert(offsetof(GaussianProjectedSplat, center_x) == 0);
 static_assert(offsetof(GaussianProjectedSplat, center_y) == 4);
 static_assert(offsetof(GaussianProjectedSplat, depth) == 8);

@@ -22,7 +22,10 @@
 #extension GL_EXT_control_flow_attributes : require
 #extension GL_KHR_shader_subgroup_basic : require
 #extension GL_KHR_shader_subgroup_arithmetic : require
+#extension GL_EXT_buffer_reference : require
+#extension GL_EXT_shader_explicit_arithmetic_types_int64 : require
 #include "GaussianSplatCompositeContract.h"
+#include "gaussian_device_address.glsl"
 
 layout(local_size_x = kCompositeWorkgroupSize) in;
 
@@ -41,9 +44,6 @@ layout(push_constant, std430) uniform PushConstantsBlock {
     GaussianCompositePushConstants pc;
 };
 
-layout(std430, set = 0, binding = kCompositeProjectedBinding) readonly buffer ProjectedBlock {
-    GaussianProjectedWords projected[];
-};
 layout(std430, set = 0, binding = kCompositeEntryValuesBinding) readonly buffer ValuesBlock {
     uint entry_values[];  // splat index, front to back inside a tile
 };
@@ -210,6 +210,7 @@ uint CompositeTile(uint tile, uvec2 range, uint next_index, uvec2 upcoming, uint
     bool inside = pixel.x < int(size.x) && pixel.y < int(size.y);
     uint begin = range.x;
     uint end = range.y;
+    uint64_t projected = DeviceAddress(pc.projected_lo, pc.projected_hi);
     if (local == 0u) s_done = 0u;
     PixelState p;
     p.position = vec2(pixel);
@@ -239,7 +240,7 @@ uint CompositeTile(uint tile, uvec2 range, uint next_index, uvec2 upcoming, uint
         uint entry = batch + slot;
         uint mask = 0u;
         if (entry < end) {
-            GaussianProjectedSplat splat = UnpackProjectedSplat(projected[next_index]);
+            GaussianProjectedSplat splat = LoadProjected(projected, next_index);
             if (entry + kCompositeBatchSize < end) {
                 next_index = entry_values[entry + kCompositeBatchSize];
             }

@@ -10,7 +10,10 @@
 // key, sorted on all 32 bits; kEmitUnpackKeys then turns the sorted keys back into tile
 // indices, so later stages read the same layout in both modes.
 #extension GL_GOOGLE_include_directive : require
+#extension GL_EXT_buffer_reference : require
+#extension GL_EXT_shader_explicit_arithmetic_types_int64 : require
 #include "GaussianSplatTileListContract.h"
+#include "gaussian_device_address.glsl"
 
 layout(local_size_x = kEmitWorkgroupSize) in;
 
@@ -19,8 +22,8 @@ layout(constant_id = kSpecEmitMode) const uint kEmitMode = kEmitTileKeys;
 layout(std430, set = 0, binding = kGeometryStageViewBinding) readonly buffer ViewBlock {
     GaussianViewParams view;
 };
-layout(std430, set = 0, binding = kGeometryStageProjectedBinding) readonly buffer ProjectedBlock {
-    GaussianProjectedWords projected[];
+layout(push_constant, std430) uniform AddressesBlock {
+    layout(offset = kGeometryAddressesPushOffset) GaussianGeometryAddresses addresses;
 };
 layout(std430, set = 0, binding = kGeometryStageCountersBinding) readonly buffer CountersBlock {
     GaussianGeometryStageCounters counters;
@@ -62,8 +65,9 @@ void main() {
     uint end = k + 1u < visible ? ScanOffset(k + 1u) : counters.requested_entries;
     if (end > view.entry_capacity || end == begin) return;
     uint splat = ListValueSplat(splat_indices[k], view.num_splats);
+    uint64_t projected = DeviceAddress(addresses.projected_lo, addresses.projected_hi);
     // Only the words of the members used are loaded: the rest of an unpacked record is dead.
-    GaussianProjectedSplat record = UnpackProjectedSplat(projected[splat]);
+    GaussianProjectedSplat record = LoadProjected(projected, splat);
     uint rect_min = record.rect_min, rect_max = record.rect_max;
     uint min_x = rect_min & 0xFFFFu, min_y = rect_min >> 16u;
     uint max_x = rect_max & 0xFFFFu, max_y = rect_max >> 16u;
@@ -84,7 +88,7 @@ void main() {
     float cull_t = 0.0;
     float det_q = 0.0;
     if (!whole_rect) {
-        GaussianProjectedSplat shape = UnpackProjectedSplat(projected[splat]);  // loaded here only
+        GaussianProjectedSplat shape = LoadProjected(projected, splat);  // loaded here only
         center = vec2(shape.center_x, shape.center_y);
         conic = shape.conic;
         cull_t = shape.cull_threshold;

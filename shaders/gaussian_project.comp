@@ -10,7 +10,10 @@
 #extension GL_KHR_shader_subgroup_arithmetic : require
 #extension GL_KHR_shader_subgroup_ballot : require
 #extension GL_EXT_control_flow_attributes : require
+#extension GL_EXT_buffer_reference : require
+#extension GL_EXT_shader_explicit_arithmetic_types_int64 : require
 #include "GaussianSplatTileListContract.h"
+#include "gaussian_device_address.glsl"
 
 layout(local_size_x = kProjectWorkgroupSize) in;
 
@@ -28,26 +31,24 @@ layout(std430, set = 0, binding = kGeometryStageViewBinding) readonly buffer Vie
 layout(std430, set = 0, binding = kGeometryStagePositionsBinding) readonly buffer PositionsBlock {
     vec4 positions[];  // xyz, sigmoid(opacity)
 };
-layout(std430, set = 0, binding = kGeometryStageShapeBinding) readonly buffer ShapeBlock {
-    uint shape[];
+// The shape and SH words through their device addresses, as uint, uvec2 and uvec4: a warp's
+// scalar loads at a 40- or 96-byte stride touch 32 sectors per instruction, so the aligned
+// layouts are read in wider loads.
+layout(push_constant, std430) uniform AddressesBlock {
+    layout(offset = kGeometryAddressesPushOffset) GaussianGeometryAddresses addresses;
 };
-layout(std430, set = 0, binding = kGeometryStageShBinding) readonly buffer ShBlock {
-    uint sh[];
+layout(buffer_reference, std430, buffer_reference_align = 4) readonly buffer Words {
+    uint words[];
 };
-// The same bindings read in wider loads where the layout is aligned for them: a warp's
-// scalar loads at a 40- or 96-byte stride touch 32 sectors per instruction.
-layout(std430, set = 0, binding = kGeometryStageShBinding) readonly buffer ShBlock4 {
-    uvec4 sh4[];
+layout(buffer_reference, std430, buffer_reference_align = 8) readonly buffer Words2 {
+    uvec2 words[];
 };
-layout(std430, set = 0, binding = kGeometryStageShapeBinding) readonly buffer ShapeBlock2 {
-    uvec2 shape2[];
+layout(buffer_reference, std430, buffer_reference_align = 16) readonly buffer Words4 {
+    uvec4 words[];
 };
 // Bits by splat, or with kCutList the level-of-detail cut's nodes by slot.
 layout(std430, set = 0, binding = kGeometryStageVisibilityBinding) readonly buffer VisibilityBlock {
     uint visibility[];
-};
-layout(std430, set = 0, binding = kGeometryStageProjectedBinding) writeonly buffer ProjectedBlock {
-    GaussianProjectedWords projected[];
 };
 layout(std430, set = 0, binding = kGeometryStageCountersBinding) buffer CountersBlock {
     GaussianGeometryStageCounters counters;
@@ -72,10 +73,18 @@ const float kSH_C3[7] = float[7](-0.5900435899266435, 2.890611442640554, -0.4570
                                  0.3731763325901154, -0.4570457994644658, 1.445305721320277,
                                  -0.5900435899266435);
 
-// Halves k and k + 1 of a compact record start at word `base`.
-float HalfAt(uint base, uint k, bool from_sh) {
-    uint word = from_sh ? sh[base + k / 2u] : shape[base + k / 2u];
-    vec2 pair = unpackHalf2x16(word);
+uint64_t ShapeRecord(uint i, uint words_per_splat) {
+    return RecordAddress(DeviceAddress(addresses.shape_lo, addresses.shape_hi), i,
+                         words_per_splat * 4u);
+}
+
+uint64_t ShRecord(uint i, uint words_per_splat) {
+    return RecordAddress(DeviceAddress(addresses.sh_lo, addresses.sh_hi), i, words_per_splat * 4u);
+}
+
+// Half k of the compact record at `record` (halves k and k + 1 share a word).
+float HalfAt(uint64_t record, uint k) {
+    vec2 pair = unpackHalf2x16(Words(record).words[k / 2u]);
     return (k & 1u) == 0u ? pair.x : pair.y;
 }
 
@@ -85,8 +94,9 @@ float g_shape[kShapeWordsExact];
 
 void LoadShape(uint i) {
     if (kPrecision == kPrecisionCompact) return;
+    Words2 record = Words2(ShapeRecord(i, kShapeWordsExact));
     [[unroll]] for (uint q = 0u; q < kShapeWordsExact / 2u; ++q) {
-        uvec2 w = shape2[i * (kShapeWordsExact / 2u) + q];
+        uvec2 w = record.words[q];
         g_shape[2u * q] = uintBitsToFloat(w.x);
         g_shape[2u * q + 1u] = uintBitsToFloat(w.y);
     }
@@ -94,16 +104,16 @@ void LoadShape(uint i) {
 
 // Shape value k (0-2 scale, 3-6 rotation wxyz, 7-9 f_dc) of splat i.
 float ShapeValue(uint i, uint k) {
-    if (kPrecision == kPrecisionCompact) return HalfAt(i * kShapeWordsCompact, k, false);
+    if (kPrecision == kPrecisionCompact) return HalfAt(ShapeRecord(i, kShapeWordsCompact), k);
     return g_shape[k];
 }
 
 // SH rest coefficient j (1-based basis index), channel c of splat i; layout [Nc, 3].
 float ShValue(uint i, uint j, uint c) {
     uint k = (j - 1u) * 3u + c;
-    uint base = i * view.sh_words_per_splat;
-    if (kPrecision == kPrecisionCompact) return HalfAt(base, k, true);
-    return uintBitsToFloat(sh[base + k]);
+    uint64_t record = ShRecord(i, view.sh_words_per_splat);
+    if (kPrecision == kPrecisionCompact) return HalfAt(record, k);
+    return uintBitsToFloat(Words(record).words[k]);
 }
 
 // M = R diag(s) (the 3D covariance is M M^T) for a (w, x, y, z) quaternion normalised at
@@ -164,8 +174,9 @@ vec3 ShColor(uint i, vec3 relative) {
         uint num_basis = (kShDegree + 1u) * (kShDegree + 1u);
         if (vec4_path) {
             float words[48];  // f_rest words of degree 3, rounded up to uvec4s
+            Words4 record = Words4(ShRecord(i, kShWords));
             [[unroll]] for (uint q = 0u; q < kShVec4s; ++q) {
-                uvec4 w = sh4[i * kShVec4s + q];
+                uvec4 w = record.words[q];
                 words[4u * q] = uintBitsToFloat(w.x);
                 words[4u * q + 1u] = uintBitsToFloat(w.y);
                 words[4u * q + 2u] = uintBitsToFloat(w.z);
@@ -295,7 +306,9 @@ bool Project(uint i, uint slot, out float depth, out uint entries) {
     out_splat.rect_max = rect_max.x | (rect_max.y << 16u);
     out_splat.num_entries = num_tiles;
     out_splat.radius = radius;
-    projected[slot] = PackProjectedSplat(out_splat);
+    ProjectedOut(RecordAddress(DeviceAddress(addresses.projected_lo, addresses.projected_hi), slot,
+                               kProjectedSplatBytes))
+        .words = PackProjectedSplat(out_splat);
     tile_counts[slot] = num_tiles;
     depth = order_depth;
     entries = num_tiles;

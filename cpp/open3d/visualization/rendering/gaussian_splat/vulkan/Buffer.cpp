@@ -63,6 +63,13 @@ Buffer::Buffer(const VulkanContext& context, VkDeviceSize size, VkBufferUsageFla
     }
     VkMemoryAllocateInfo allocate_info =
         MakeInfo<VkMemoryAllocateInfo>(VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO);
+    VkMemoryAllocateFlagsInfo flags_info =
+        MakeInfo<VkMemoryAllocateFlagsInfo>(VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_FLAGS_INFO);
+    const bool addressed = (usage & VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT) != 0;
+    if (addressed) {
+        flags_info.flags = VK_MEMORY_ALLOCATE_DEVICE_ADDRESS_BIT;
+        allocate_info.pNext = &flags_info;
+    }
     allocate_info.allocationSize = requirements.size;
     allocate_info.memoryTypeIndex =
         context.FindMemoryType(requirements.memoryTypeBits, required, preferred);
@@ -79,6 +86,12 @@ Buffer::Buffer(const VulkanContext& context, VkDeviceSize size, VkBufferUsageFla
     memory_ = UniqueDeviceMemory(device, device_memory);
     charge_ = std::move(charge);
     CheckVk(vkBindBufferMemory(device, buffer, device_memory, 0), "vkBindBufferMemory");
+    if (addressed) {
+        VkBufferDeviceAddressInfo address_info =
+            MakeInfo<VkBufferDeviceAddressInfo>(VK_STRUCTURE_TYPE_BUFFER_DEVICE_ADDRESS_INFO);
+        address_info.buffer = buffer;
+        address_ = vkGetBufferDeviceAddress(device, &address_info);
+    }
     if (memory != MemoryUsage::kDevice) {
         CheckVk(vkMapMemory(device, device_memory, 0, VK_WHOLE_SIZE, 0, &mapped_), "vkMapMemory");
     }
@@ -140,7 +153,8 @@ Buffer Buffer::ImportHost(const VulkanContext& context, void* data, VkDeviceSize
 
 BufferRange Buffer::Range(VkDeviceSize offset, VkDeviceSize size) const {
     assert(offset <= size_);
-    return BufferRange{buffer_.Get(), offset, size == VK_WHOLE_SIZE ? size_ - offset : size};
+    return BufferRange{buffer_.Get(), offset, size == VK_WHOLE_SIZE ? size_ - offset : size,
+                       address_ != 0 ? address_ + offset : 0};
 }
 
 }  // namespace vulkan

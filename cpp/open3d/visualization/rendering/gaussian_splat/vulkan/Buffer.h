@@ -23,6 +23,9 @@ struct BufferRange {
     VkBuffer buffer = VK_NULL_HANDLE;
     VkDeviceSize offset = 0;
     VkDeviceSize size = VK_WHOLE_SIZE;
+    /// Device address of byte `offset` for a buffer made with
+    /// VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT, else 0.
+    VkDeviceAddress address = 0;
 };
 
 enum class MemoryUsage {
@@ -38,7 +41,9 @@ class Buffer {
 public:
     Buffer() = default;
     /// Creates a buffer of `size` bytes (> 0) with `usage` and binds fresh memory to it.
-    /// Throws core::Open3DError when the allocation fails.
+    /// Throws core::Open3DError when the allocation fails. With
+    /// VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT in `usage` the memory is allocated for device
+    /// addresses and GetDeviceAddress() returns the buffer's.
     /// With `shared_with_transfer` the buffer is usable from the context's transfer queue
     /// too (concurrent sharing of the two families, when the context has that queue).
     Buffer(const VulkanContext& context, VkDeviceSize size, VkBufferUsageFlags usage,
@@ -49,12 +54,14 @@ public:
           memory_(std::move(other.memory_)),
           buffer_(std::move(other.buffer_)),
           size_(std::exchange(other.size_, 0)),
+          address_(std::exchange(other.address_, 0)),
           mapped_(std::exchange(other.mapped_, nullptr)) {}
     Buffer& operator=(Buffer&& other) noexcept {
         buffer_ = std::move(other.buffer_);  // buffer before memory, as in the destructor
         memory_ = std::move(other.memory_);
         charge_ = std::move(other.charge_);  // after the memory it accounts for is freed
         size_ = std::exchange(other.size_, 0);
+        address_ = std::exchange(other.address_, 0);
         mapped_ = std::exchange(other.mapped_, nullptr);
         return *this;
     }
@@ -70,6 +77,8 @@ public:
 
     VkBuffer Get() const { return buffer_.Get(); }
     VkDeviceSize GetSize() const { return size_; }
+    /// The buffer's device address; 0 unless made with VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT.
+    VkDeviceAddress GetDeviceAddress() const { return address_; }
     /// The whole buffer, or [offset, offset + size).
     BufferRange Range(VkDeviceSize offset = 0, VkDeviceSize size = VK_WHOLE_SIZE) const;
     /// Host pointer of a kHostUpload / kHostReadback buffer, nullptr for kDevice.
@@ -82,6 +91,7 @@ private:
     UniqueDeviceMemory memory_;
     UniqueBuffer buffer_;
     VkDeviceSize size_ = 0;
+    VkDeviceAddress address_ = 0;
     void* mapped_ = nullptr;  // unmapped implicitly by vkFreeMemory
 };
 

@@ -112,7 +112,6 @@ GaussianCompositeStage::GaussianCompositeStage(const VulkanContext& context) : c
     const VkDescriptorType kStorage = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
     const VkDescriptorType kSampled = VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE;
     std::vector<VkDescriptorType> composite(kCompositeNumBindings, kStorage);
-    composite[kCompositeProjectedBinding] = kBuffer;
     composite[kCompositeEntryKeysBinding] = kBuffer;
     composite[kCompositeEntryValuesBinding] = kBuffer;
     composite[kCompositeCountBinding] = kBuffer;
@@ -216,13 +215,18 @@ void GaussianCompositeStage::RecordComposite(VkCommandBuffer cmd,
     RequireView(targets.median_depth, "median_depth");
     const VkDeviceSize alignment = context_.GetDeviceInfo().min_storage_buffer_offset_alignment;
     for (const BufferRange* range :
-         {&inputs.projected, &inputs.entry_keys, &inputs.entry_values, &state}) {
+         {&inputs.entry_keys, &inputs.entry_values, &state}) {
         if (range->buffer == VK_NULL_HANDLE || range->offset % alignment != 0) {
             core::ThrowError(
                 "GaussianCompositeStage: every input buffer needs a buffer and an offset that is a "
                 "multiple of minStorageBufferOffsetAlignment {}",
                 alignment);
         }
+    }
+    if (inputs.projected.address == 0 || inputs.projected.address % 16 != 0) {
+        core::ThrowError(
+            "GaussianCompositeStage: the projected records need a buffer made for device "
+            "addresses (VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT) at a 16-byte aligned address");
     }
     if (inputs.entry_count.buffer == VK_NULL_HANDLE || inputs.entry_count.offset % 4 != 0) {
         core::ThrowError(
@@ -282,6 +286,8 @@ void GaussianCompositeStage::RecordComposite(VkCommandBuffer cmd,
     push.scene_depth_flip_y = params.scene_depth && params.scene_depth->flip_y ? 1u : 0u;
     push.background = {params.background[0], params.background[1], params.background[2]};
     push.scene_near = params.scene_depth ? params.scene_depth->near_plane : 0.f;
+    push.projected_lo = static_cast<uint32_t>(inputs.projected.address);
+    push.projected_hi = static_cast<uint32_t>(inputs.projected.address >> 32);
 
     const VkDeviceSize entry_bytes = VkDeviceSize(std::max(inputs.entry_capacity, 1u)) * 4;
     // Without a colour buffer the binding is never written (kSpecColorBuffer 0) but must hold
@@ -290,8 +296,7 @@ void GaussianCompositeStage::RecordComposite(VkCommandBuffer cmd,
         color_buffer ? VkDescriptorBufferInfo{targets.color_buffer.buffer,
                                               targets.color_buffer.offset, color_buffer_bytes}
                      : VkDescriptorBufferInfo{state.buffer, state.offset, state_bytes};
-    const std::array<VkDescriptorBufferInfo, 6> buffers{{
-        {inputs.projected.buffer, inputs.projected.offset, inputs.projected.size},
+    const std::array<VkDescriptorBufferInfo, 5> buffers{{
         {inputs.entry_keys.buffer, inputs.entry_keys.offset, entry_bytes},
         {inputs.entry_values.buffer, inputs.entry_values.offset, entry_bytes},
         {inputs.entry_count.buffer, count_offset, VK_WHOLE_SIZE},
@@ -306,17 +311,16 @@ void GaussianCompositeStage::RecordComposite(VkCommandBuffer cmd,
         SceneDepthDescriptor(cmd, params.scene_depth),
     }};
     const std::array<VkWriteDescriptorSet, kCompositeNumBindings> writes{{
-        BufferWrite(kCompositeProjectedBinding, &buffers[0]),
-        BufferWrite(kCompositeEntryKeysBinding, &buffers[1]),
-        BufferWrite(kCompositeEntryValuesBinding, &buffers[2]),
-        BufferWrite(kCompositeCountBinding, &buffers[3]),
-        BufferWrite(kCompositeStateBinding, &buffers[4]),
+        BufferWrite(kCompositeEntryKeysBinding, &buffers[0]),
+        BufferWrite(kCompositeEntryValuesBinding, &buffers[1]),
+        BufferWrite(kCompositeCountBinding, &buffers[2]),
+        BufferWrite(kCompositeStateBinding, &buffers[3]),
         ImageWrite(kCompositeColorBinding, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, &images[0]),
         ImageWrite(kCompositeDepthBinding, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, &images[1]),
         ImageWrite(kCompositeAlphaBinding, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, &images[2]),
         ImageWrite(kCompositeMedianDepthBinding, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, &images[3]),
         ImageWrite(kCompositeSceneDepthBinding, VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE, &images[4]),
-        BufferWrite(kCompositeColorBufferBinding, &buffers[5]),
+        BufferWrite(kCompositeColorBufferBinding, &buffers[4]),
     }};
     // Both pipelines share the layout: descriptors and push constants are set once.
     context_.GetCmdPushDescriptorSet()(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, composite_layout_.Get(),

@@ -52,7 +52,9 @@ struct CompositeStageStorageRequirements {
 
 /// Geometry stage's results that the composite reads (all written on the GPU).
 struct CompositeStageInputs {
-    BufferRange projected;     ///< shader::GaussianProjectedSplat [N], indexed by splat
+    /// shader::GaussianProjectedSplat [N], indexed by splat; read through its device address
+    /// (BufferRange::address), so it may be larger than one storage binding.
+    BufferRange projected;
     BufferRange entry_keys;    ///< uint32 [capacity]: tile index, ascending
     BufferRange entry_values;  ///< uint32 [capacity]: splat index, front to back per tile
     /// uint32 entry count (any 4-byte aligned offset), e.g.

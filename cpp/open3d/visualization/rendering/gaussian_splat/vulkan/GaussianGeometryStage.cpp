@@ -1,7 +1,9 @@
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/GaussianGeometryStage.h"
 
 #include <algorithm>
+#include <array>
 #include <bit>
+#include <utility>
 
 #include "open3d/core/Exception.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/Commands.h"
@@ -43,8 +45,10 @@ void ComputeBarrier(VkCommandBuffer cmd) {
 GaussianGeometryStage::GaussianGeometryStage(const VulkanContext& context)
     : context_(context), sort_(context), lod_cut_(context) {
     set_layout_ = CreateStorageBufferPushLayout(context, kGeometryStageNumBindings);
-    const uint32_t push_bytes = static_cast<uint32_t>(
-        std::max(sizeof(GaussianScanPushConstants), sizeof(GaussianDispatchArgsPushConstants)));
+    // The scan's or the dispatch-args pass's constants, then the device addresses.
+    static_assert(sizeof(GaussianScanPushConstants) <= kGeometryAddressesPushOffset &&
+                  sizeof(GaussianDispatchArgsPushConstants) <= kGeometryAddressesPushOffset);
+    const uint32_t push_bytes = kGeometryAddressesPushOffset + sizeof(GaussianGeometryAddresses);
     pipeline_layout_ = CreatePipelineLayout(context, set_layout_.Get(), push_bytes);
     const VkPipelineLayout layout = pipeline_layout_.Get();
 
@@ -128,10 +132,7 @@ void GaussianGeometryStage::PushBindings(VkCommandBuffer cmd,
     const std::array<const BufferRange*, kGeometryStageNumBindings> ranges{
         &buffers.view_params,
         &scene.positions,
-        &scene.shape,
-        &scene.sh,
         &scene.visibility,
-        &buffers.projected,
         &buffers.counters,
         &buffers.depth_keys,
         &buffers.splat_indices,
@@ -142,12 +143,11 @@ void GaussianGeometryStage::PushBindings(VkCommandBuffer cmd,
         &buffers.tile_counts};
     static_assert(
         kGeometryStageViewBinding == 0 && kGeometryStagePositionsBinding == 1 &&
-            kGeometryStageShapeBinding == 2 && kGeometryStageShBinding == 3 &&
-            kGeometryStageVisibilityBinding == 4 && kGeometryStageProjectedBinding == 5 &&
-            kGeometryStageCountersBinding == 6 && kGeometryStageDepthKeysBinding == 7 &&
-            kGeometryStageSplatIndexBinding == 8 && kGeometryStageScanBinding == 9 &&
-            kGeometryStageEntryKeysBinding == 10 && kGeometryStageEntryValuesBinding == 11 &&
-            kGeometryStageSortParamsBinding == 12 && kGeometryStageTileCountsBinding == 13,
+            kGeometryStageVisibilityBinding == 2 && kGeometryStageCountersBinding == 3 &&
+            kGeometryStageDepthKeysBinding == 4 && kGeometryStageSplatIndexBinding == 5 &&
+            kGeometryStageScanBinding == 6 && kGeometryStageEntryKeysBinding == 7 &&
+            kGeometryStageEntryValuesBinding == 8 && kGeometryStageSortParamsBinding == 9 &&
+            kGeometryStageTileCountsBinding == 10,
         "ranges above are listed in binding order");
     std::array<VkDescriptorBufferInfo, kGeometryStageNumBindings> infos{};
     std::array<VkWriteDescriptorSet, kGeometryStageNumBindings> writes{};
@@ -165,6 +165,26 @@ void GaussianGeometryStage::PushBindings(VkCommandBuffer cmd,
     }
     context_.GetCmdPushDescriptorSet()(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_layout_.Get(),
                                        0, kGeometryStageNumBindings, writes.data());
+    // The buffers a splat count can grow past one binding's range go by device address.
+    GaussianGeometryAddresses addresses{};
+    const std::array<std::pair<const BufferRange*, const char*>, 3> addressed{
+        {{&scene.shape, "shape words"}, {&scene.sh, "SH words"}, {&buffers.projected, "projected"}}};
+    for (const auto& [range, what] : addressed) {
+        if (range->address == 0 || range->address % 16 != 0) {
+            core::ThrowError(
+                "GaussianGeometryStage: the {} need a buffer made for device addresses "
+                "(VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT) at a 16-byte aligned address",
+                what);
+        }
+    }
+    addresses.shape_lo = static_cast<uint32_t>(scene.shape.address);
+    addresses.shape_hi = static_cast<uint32_t>(scene.shape.address >> 32);
+    addresses.sh_lo = static_cast<uint32_t>(scene.sh.address);
+    addresses.sh_hi = static_cast<uint32_t>(scene.sh.address >> 32);
+    addresses.projected_lo = static_cast<uint32_t>(buffers.projected.address);
+    addresses.projected_hi = static_cast<uint32_t>(buffers.projected.address >> 32);
+    vkCmdPushConstants(cmd, pipeline_layout_.Get(), VK_SHADER_STAGE_COMPUTE_BIT,
+                       kGeometryAddressesPushOffset, sizeof(addresses), &addresses);
 }
 
 void GaussianGeometryStage::Record(VkCommandBuffer cmd, const GeometryStageSceneBuffers& in_scene,

@@ -21,28 +21,31 @@ constexpr VkBufferUsageFlags kTransfer =
 
 namespace {
 
-// Every scene and per-view buffer here is bound whole as one storage binding. A range past
-// the device's maxStorageBufferRange is invalid usage that only the validation layer
-// reports; without it the H200's driver read zeros past the limit (a 5.9 GB shape buffer of
-// 147M hierarchy nodes: garbage footprints, 134M tile entries for 2M visible splats).
+// Every scene and per-view buffer here but the shape and SH words and the projected records
+// (read through device addresses) is bound whole as one storage binding. A range past the
+// device's maxStorageBufferRange is invalid usage that only the validation layer reports;
+// without it the H200's driver read zeros past the limit (a 5.9 GB shape buffer of 147M
+// hierarchy nodes, when it was bound: garbage footprints, 134M tile entries for 2M visible
+// splats).
 void RequireStorageBinding(const VulkanContext& context, const char* what, VkDeviceSize bytes,
                            uint64_t count) {
     const uint64_t limit = context.GetDeviceInfo().max_storage_buffer_range;
     if (bytes > limit) {
         core::ThrowError(
             "Vulkan backend: the {} for {} splats take {} bytes, more than one storage binding "
-            "of this device holds ({} bytes, maxStorageBufferRange); fewer splats, compact "
-            "storage or a lower SH degree fit",
+            "of this device holds ({} bytes, maxStorageBufferRange); fewer splats fit",
             what, count, bytes, limit);
     }
 }
 
+constexpr VkBufferUsageFlags kAddressed = VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT;
+
 }  // namespace
 
 Buffer UploadStorageBuffer(const VulkanContext& context, const CommandPool& pool, const void* data,
-                           VkDeviceSize bytes) {
+                           VkDeviceSize bytes, VkBufferUsageFlags extra_usage) {
     const VkDeviceSize size = std::max<VkDeviceSize>(bytes, 16);
-    Buffer device(context, size, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | kTransfer,
+    Buffer device(context, size, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | kTransfer | extra_usage,
                   MemoryUsage::kDevice);
     Buffer staging(context, size, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, MemoryUsage::kHostUpload);
     std::memset(staging.GetMapped(), 0, size);
@@ -56,16 +59,16 @@ Buffer UploadStorageBuffer(const VulkanContext& context, const CommandPool& pool
 
 void GeometryStageResources::UploadScene(const VulkanContext& context, const CommandPool& pool,
                                          const PackedGaussianSplats& packed) {
-    // A binding holds at most 4 GiB (maxStorageBufferRange is 32-bit), so the shaders'
-    // 32-bit word indices reach every word of a buffer these checks let through.
+    // The positions (16 bytes a splat) are bound: 268M splats on a 4 GiB binding. The shape
+    // and SH words (up to 136 bytes a splat) are read by device address and have no such
+    // limit.
     const uint64_t n = packed.num_splats;
     RequireStorageBinding(context, "positions", packed.positions.size() * sizeof(float), n);
-    RequireStorageBinding(context, "shape words", packed.shape.size() * 4, n);
-    RequireStorageBinding(context, "SH words", packed.sh.size() * 4, n);
     positions = UploadStorageBuffer(context, pool, packed.positions.data(),
                                     packed.positions.size() * sizeof(float));
-    shape = UploadStorageBuffer(context, pool, packed.shape.data(), packed.shape.size() * 4);
-    sh = UploadStorageBuffer(context, pool, packed.sh.data(), packed.sh.size() * 4);
+    shape = UploadStorageBuffer(context, pool, packed.shape.data(), packed.shape.size() * 4,
+                                kAddressed);
+    sh = UploadStorageBuffer(context, pool, packed.sh.data(), packed.sh.size() * 4, kAddressed);
     visibility =
         UploadStorageBuffer(context, pool, packed.visibility.data(), packed.visibility.size() * 4);
     scene_bytes_ = (packed.positions.size() + packed.shape.size() + packed.sh.size() +
@@ -128,12 +131,11 @@ void GeometryStageViewResources::Allocate(const VulkanContext& context, uint32_t
     const GeometryStageStorageRequirements need =
         GaussianGeometryStage::GetStorageRequirements(slots, entry_capacity);
     const auto make = [&](VkDeviceSize bytes, VkBufferUsageFlags usage) {
-        RequireStorageBinding(context, "per-view buffers", bytes, slots);
+        if (!(usage & kAddressed)) RequireStorageBinding(context, "per-view buffers", bytes, slots);
         return Buffer(context, std::max<VkDeviceSize>(bytes, 16), usage | kTransfer,
                       MemoryUsage::kDevice);
     };
     view_params = make(need.view_params_bytes, need.view_params_usage);
-    projected = make(need.projected_bytes, need.usage);
     counters = make(need.counters_bytes, need.counters_usage);
     depth_keys = make(need.depth_keys_bytes, need.usage);
     splat_indices = make(need.splat_indices_bytes, need.usage);
@@ -157,6 +159,8 @@ void GeometryStageViewResources::Allocate(const VulkanContext& context, uint32_t
         lod_group_counts = make(GaussianLodCut::GroupCountsBytes(n), need.usage);
         lod_list = make(GaussianLodCut::ListBytes(slots), need.usage);
     }
+    // The largest, and the one not bound: made after every bound buffer has passed its check.
+    projected = make(need.projected_bytes, need.usage | kAddressed);
     lod_inner_ = lod_inner;
     num_splats_ = n;
     entry_capacity_ = entry_capacity;

@@ -21,9 +21,10 @@ namespace rendering {
 namespace vulkan {
 
 /// A device-local storage buffer holding `bytes` of `data` (at least 16 bytes, zero-padded),
-/// copied through a staging buffer and waited for.
+/// copied through a staging buffer and waited for; `extra_usage` is added to the storage and
+/// transfer usages (VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT for what is read by address).
 Buffer UploadStorageBuffer(const VulkanContext& context, const CommandPool& pool, const void* data,
-                           VkDeviceSize bytes);
+                           VkDeviceSize bytes, VkBufferUsageFlags extra_usage = 0);
 
 /// One view's geometry-stage outputs and scratch, sized for a splat count and an entry
 /// capacity. The backend keeps one per frame slot, so frames in flight never share them.

@@ -111,6 +111,8 @@ struct DeviceQuery {
         MakeInfo<VkPhysicalDeviceIDProperties>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ID_PROPERTIES);
     VkPhysicalDeviceFeatures2 features =
         MakeInfo<VkPhysicalDeviceFeatures2>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2);
+    VkPhysicalDeviceVulkan12Features features12 = MakeInfo<VkPhysicalDeviceVulkan12Features>(
+        VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES);
     VkPhysicalDeviceVulkan13Features features13 = MakeInfo<VkPhysicalDeviceVulkan13Features>(
         VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES);
     std::vector<VkQueueFamilyProperties> queue_families;
@@ -122,7 +124,8 @@ struct DeviceQuery {
         size_control.pNext = &driver;
         driver.pNext = &ids;
         vkGetPhysicalDeviceProperties2(device, &properties);
-        features.pNext = &features13;
+        features.pNext = &features12;
+        features12.pNext = &features13;
         vkGetPhysicalDeviceFeatures2(device, &features);
         uint32_t count = 0;
         vkGetPhysicalDeviceQueueFamilyProperties(device, &count, nullptr);
@@ -176,6 +179,8 @@ struct DeviceQuery {
         }
         if (!features13.maintenance4) missing.push_back("the maintenance4 feature");
         if (!features13.synchronization2) missing.push_back("the synchronization2 feature");
+        if (!features12.bufferDeviceAddress) missing.push_back("the bufferDeviceAddress feature");
+        if (!features.features.shaderInt64) missing.push_back("the shaderInt64 feature");
         for (const char* extension : kRequiredDeviceExtensions) {
             if (!HasExtension(extension)) missing.push_back(extension);
         }
@@ -378,9 +383,17 @@ void VulkanContext::InitDevice(VkPhysicalDevice physical_device, uint32_t queue_
             VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES);
         features13.maintenance4 = VK_TRUE;
         features13.synchronization2 = VK_TRUE;
+        // bufferDeviceAddress and shaderInt64: the shape and SH words and the projected
+        // records are read through 64-bit device addresses, as they can outgrow the range
+        // one storage binding reaches (docs/vulkan.md "Buffers").
+        VkPhysicalDeviceVulkan12Features features12 = MakeInfo<VkPhysicalDeviceVulkan12Features>(
+            VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES);
+        features12.bufferDeviceAddress = VK_TRUE;
+        features12.pNext = &features13;
         VkPhysicalDeviceFeatures2 features =
             MakeInfo<VkPhysicalDeviceFeatures2>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2);
-        features.pNext = &features13;
+        features.features.shaderInt64 = VK_TRUE;
+        features.pNext = &features12;
         VkDeviceCreateInfo device_info =
             MakeInfo<VkDeviceCreateInfo>(VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO);
         device_info.pNext = &features;

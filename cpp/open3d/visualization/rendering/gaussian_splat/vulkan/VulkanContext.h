@@ -34,8 +34,9 @@ struct VulkanContextOptions {
 };
 
 /// Handles owned by a host application that the context uses without destroying them.
-/// The device must have been created with Vulkan 1.3, the features `maintenance4` and
-/// `synchronization2` enabled and the extension VK_KHR_push_descriptor.
+/// The device must have been created with Vulkan 1.3, the features `maintenance4`,
+/// `synchronization2`, `bufferDeviceAddress` and `shaderInt64` enabled and the extension
+/// VK_KHR_push_descriptor.
 struct BorrowedVulkanHandles {
     VkInstance instance = VK_NULL_HANDLE;
     VkPhysicalDevice physical_device = VK_NULL_HANDLE;

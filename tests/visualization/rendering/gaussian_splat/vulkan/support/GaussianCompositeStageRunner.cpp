@@ -73,8 +73,10 @@ CompositeStageReadback GaussianCompositeStageRunner::Run(const CompositeStageRun
     }
     const VkBufferUsageFlags storage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
     const uint32_t num_entries = static_cast<uint32_t>(in.entry_tiles.size());
-    Buffer projected = UploadBuffer(context_, in.projected.data(),
-                                    in.projected.size() * sizeof(in.projected[0]), storage);
+    // Read through its device address, as the geometry stage's records are.
+    Buffer projected =
+        UploadBuffer(context_, in.projected.data(), in.projected.size() * sizeof(in.projected[0]),
+                     storage | VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT);
     Buffer keys = UploadBuffer(context_, in.entry_tiles.data(), num_entries * 4ull, storage);
     Buffer values = UploadBuffer(context_, in.entry_splats.data(), num_entries * 4ull, storage);
     // The count at uint index 1, as a producer's counter block would hold it.
