@@ -117,7 +117,7 @@ TEST_F(VulkanMemoryCheck, ShWordsAndProjectedRecordsPastOneStorageBindingRender)
     const int64_t n = static_cast<int64_t>(n64);
     constexpr int kW = 64, kH = 48;
     std::vector<float> pos(n * 3), scale(n * 3, 0.05f), rot(n * 4, 0.f), opacity(n, 1.0f),
-            f_dc(n * 3), f_rest(n * 45);
+        f_dc(n * 3), f_rest(n * 45);
     int64_t in_view = 0;
     for (int64_t i = 0; i < n; ++i) {
         const bool shown = i % 1024 == 0 || i >= n - 2048;
@@ -129,7 +129,8 @@ TEST_F(VulkanMemoryCheck, ShWordsAndProjectedRecordsPastOneStorageBindingRender)
         in_view += shown;
         rot[i * 4] = 1.f;
         for (int c = 0; c < 3; ++c) f_dc[i * 3 + c] = 0.2f * float((i + c) % 5) - 0.4f;
-        for (int k = 0; k < 45; ++k) f_rest[i * 45 + k] = 0.05f * float((i * 7 + k * 3) % 11) - 0.25f;
+        for (int k = 0; k < 45; ++k)
+            f_rest[i * 45 + k] = 0.05f * float((i * 7 + k * 3) % 11) - 0.25f;
     }
     namespace gs = t::geometry::gs_attr;
     t::geometry::PointCloud cloud(core::Tensor::FromVector(pos, {n, 3}));
@@ -155,10 +156,11 @@ TEST_F(VulkanMemoryCheck, ShWordsAndProjectedRecordsPastOneStorageBindingRender)
     EXPECT_EQ(gpu.stats.num_visible, in_view);
     EXPECT_EQ(gpu.stats.num_tile_entries, ref.stats.num_tile_entries);
     const auto m = t::geometry::ComputeImageErrorMetrics(gpu.color, ref.color, 1.0, 0.0);
-    std::printf("[memory] %lld splats (SH %.1f MB, projected %.1f MB; binding range %.1f MB): "
-                "%lld visible, PSNR %.1f dB, max %.3g\n",
-                static_cast<long long>(n), n * sh_bytes / 1e6, n * 64 / 1e6, limit / 1e6,
-                static_cast<long long>(gpu.stats.num_visible), m.psnr_db, m.max_abs_error);
+    std::printf(
+        "[memory] %lld splats (SH %.1f MB, projected %.1f MB; binding range %.1f MB): "
+        "%lld visible, PSNR %.1f dB, max %.3g\n",
+        static_cast<long long>(n), n * sh_bytes / 1e6, n * 64 / 1e6, limit / 1e6,
+        static_cast<long long>(gpu.stats.num_visible), m.psnr_db, m.max_abs_error);
     // Measured on lavapipe: 141.5 dB, max 8.3e-7 (float32 rounding of the SH sums). Records
     // read at a wrapped index (index mod 10^6) gave 26.2 dB, max 0.47.
     EXPECT_GE(m.psnr_db, 120.0);

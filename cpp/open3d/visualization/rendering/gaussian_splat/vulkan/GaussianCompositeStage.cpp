@@ -214,8 +214,7 @@ void GaussianCompositeStage::RecordComposite(VkCommandBuffer cmd,
     RequireView(targets.alpha, "alpha");
     RequireView(targets.median_depth, "median_depth");
     const VkDeviceSize alignment = context_.GetDeviceInfo().min_storage_buffer_offset_alignment;
-    for (const BufferRange* range :
-         {&inputs.entry_keys, &inputs.entry_values, &state}) {
+    for (const BufferRange* range : {&inputs.entry_keys, &inputs.entry_values, &state}) {
         if (range->buffer == VK_NULL_HANDLE || range->offset % alignment != 0) {
             core::ThrowError(
                 "GaussianCompositeStage: every input buffer needs a buffer and an offset that is a "

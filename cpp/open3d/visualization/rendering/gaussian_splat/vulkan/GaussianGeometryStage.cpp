@@ -130,25 +130,19 @@ void GaussianGeometryStage::PushBindings(VkCommandBuffer cmd,
                                          const GeometryStageSceneBuffers& scene,
                                          const GeometryStageViewBuffers& buffers) const {
     const std::array<const BufferRange*, kGeometryStageNumBindings> ranges{
-        &buffers.view_params,
-        &scene.positions,
-        &scene.visibility,
-        &buffers.counters,
-        &buffers.depth_keys,
-        &buffers.splat_indices,
-        &buffers.scan,
-        &buffers.entry_keys,
-        &buffers.entry_values,
-        &buffers.sort_scratch.params,
+        &buffers.view_params,  &scene.positions,
+        &scene.visibility,     &buffers.counters,
+        &buffers.depth_keys,   &buffers.splat_indices,
+        &buffers.scan,         &buffers.entry_keys,
+        &buffers.entry_values, &buffers.sort_scratch.params,
         &buffers.tile_counts};
-    static_assert(
-        kGeometryStageViewBinding == 0 && kGeometryStagePositionsBinding == 1 &&
-            kGeometryStageVisibilityBinding == 2 && kGeometryStageCountersBinding == 3 &&
-            kGeometryStageDepthKeysBinding == 4 && kGeometryStageSplatIndexBinding == 5 &&
-            kGeometryStageScanBinding == 6 && kGeometryStageEntryKeysBinding == 7 &&
-            kGeometryStageEntryValuesBinding == 8 && kGeometryStageSortParamsBinding == 9 &&
-            kGeometryStageTileCountsBinding == 10,
-        "ranges above are listed in binding order");
+    static_assert(kGeometryStageViewBinding == 0 && kGeometryStagePositionsBinding == 1 &&
+                      kGeometryStageVisibilityBinding == 2 && kGeometryStageCountersBinding == 3 &&
+                      kGeometryStageDepthKeysBinding == 4 && kGeometryStageSplatIndexBinding == 5 &&
+                      kGeometryStageScanBinding == 6 && kGeometryStageEntryKeysBinding == 7 &&
+                      kGeometryStageEntryValuesBinding == 8 &&
+                      kGeometryStageSortParamsBinding == 9 && kGeometryStageTileCountsBinding == 10,
+                  "ranges above are listed in binding order");
     std::array<VkDescriptorBufferInfo, kGeometryStageNumBindings> infos{};
     std::array<VkWriteDescriptorSet, kGeometryStageNumBindings> writes{};
     for (uint32_t i = 0; i < kGeometryStageNumBindings; ++i) {
@@ -168,7 +162,9 @@ void GaussianGeometryStage::PushBindings(VkCommandBuffer cmd,
     // The buffers a splat count can grow past one binding's range go by device address.
     GaussianGeometryAddresses addresses{};
     const std::array<std::pair<const BufferRange*, const char*>, 3> addressed{
-        {{&scene.shape, "shape words"}, {&scene.sh, "SH words"}, {&buffers.projected, "projected"}}};
+        {{&scene.shape, "shape words"},
+         {&scene.sh, "SH words"},
+         {&buffers.projected, "projected"}}};
     for (const auto& [range, what] : addressed) {
         if (range->address == 0 || range->address % 16 != 0) {
             core::ThrowError(
