@@ -37,11 +37,12 @@ OPEN3D_SHADER_CONST uint kSpecLodPass = 0u;
 OPEN3D_SHADER_CONST uint kLodPassSizes = 0u;         // per inner node: own size bucket
 OPEN3D_SHADER_CONST uint kLodPassBuckets = 1u;       // per inner node: effective bucket, histogram
 OPEN3D_SHADER_CONST uint kLodPassThreshold = 2u;     // one workgroup: the bucket to open above
-OPEN3D_SHADER_CONST uint kLodPassMask = 3u;          // per node: the cut as bits, group counts
-OPEN3D_SHADER_CONST uint kLodPassOffsets = 4u;       // per 256 groups: offsets in the block, total
-OPEN3D_SHADER_CONST uint kLodPassBlockOffsets = 5u;  // one workgroup: block totals -> offsets
-OPEN3D_SHADER_CONST uint kLodPassList = 6u;          // per node: the cut's nodes as a list
-OPEN3D_SHADER_CONST uint kLodNumPasses = 7u;
+OPEN3D_SHADER_CONST uint kLodPassMask = 3u;          // per inner node: the cut as bits
+OPEN3D_SHADER_CONST uint kLodPassCounts = 4u;        // per group of 256 nodes: the cut's nodes
+OPEN3D_SHADER_CONST uint kLodPassOffsets = 5u;       // per 256 groups: offsets in the block, total
+OPEN3D_SHADER_CONST uint kLodPassBlockOffsets = 6u;  // one workgroup: block totals -> offsets
+OPEN3D_SHADER_CONST uint kLodPassList = 7u;          // per node: the cut's nodes as a list
+OPEN3D_SHADER_CONST uint kLodNumPasses = 8u;
 
 // Descriptor set 0 of the cut's pipelines (one push-descriptor layout).
 OPEN3D_SHADER_CONST uint kLodViewBinding = 0u;        // GaussianViewParams
@@ -51,13 +52,16 @@ OPEN3D_SHADER_CONST uint kLodBucketsBinding = 3u;     // uint[2 inner]: effectiv
 OPEN3D_SHADER_CONST uint kLodHistogramBinding = 4u;   // uint[kLodBuckets]
 OPEN3D_SHADER_CONST uint kLodCountersBinding = 5u;    // GaussianGeometryStageCounters
 OPEN3D_SHADER_CONST uint kLodVisibilityBinding = 6u;  // uint[ceil(nodes / 32)]: the cut
-// uint[LodCountWords(nodes)]: the cut's nodes per group (a workgroup of the mask pass,
-// kLodWorkgroupSize nodes), then their exclusive prefix sums within blocks of
+// uint[LodCountWords(nodes)]: the cut's nodes per group (kLodWorkgroupSize nodes, a
+// workgroup of the list pass), then their exclusive prefix sums within blocks of
 // kLodWorkgroupSize groups; from LodBlockBase(nodes) on, the blocks' totals, then their
 // exclusive prefix sums.
 OPEN3D_SHADER_CONST uint kLodGroupCountsBinding = 7u;
 OPEN3D_SHADER_CONST uint kLodListBinding = 8u;  // uint[LodListSlots]: node of each list slot
-OPEN3D_SHADER_CONST uint kLodNumBindings = 9u;
+// uint[nodes - 1]: every inner node's children, inner nodes in order
+// (GaussianLodNode::first_child).
+OPEN3D_SHADER_CONST uint kLodChildrenBinding = 9u;
+OPEN3D_SHADER_CONST uint kLodNumBindings = 10u;
 
 // One node of the hierarchy (16 bytes, std430), in node order: leaves 0..N-1 (the scene's
 // splats), then the inner nodes N..N+K-1, children before parents, the root last.
@@ -65,7 +69,9 @@ struct GaussianLodNode {
     float radius;   // 3 x the largest scale (inner nodes; 0 for leaves, never sized)
     uint parent;    // node id, kLodNoParent for the root
     uint children;  // 0 for a leaf, 2..8 for an inner node
-    uint reserved0;
+    // Index of the first of its children in the children binding (inner nodes; 0 for leaves):
+    // the mask pass marks an opening node's leaves from there.
+    uint first_child;
 };
 
 struct GaussianLodPushConstants {
@@ -101,8 +107,9 @@ OPEN3D_SHADER_FUNC uint LodCountWords(uint num_nodes) {
 static_assert(sizeof(GaussianLodNode) == 16);
 static_assert(offsetof(GaussianLodNode, parent) == 4);
 static_assert(offsetof(GaussianLodNode, children) == 8);
+static_assert(offsetof(GaussianLodNode, first_child) == 12);
 static_assert(sizeof(GaussianLodPushConstants) == 16);
-static_assert(kLodWorkgroupSize % 32 == 0, "the mask pass writes whole words");
+static_assert(kLodWorkgroupSize % 32 == 0, "the list pass reads whole words");
 static_assert(offsetof(GaussianLodPushConstants, num_inner) == 4);
 static_assert(offsetof(GaussianLodPushConstants, list_slots) == 8);
 }  // namespace shader

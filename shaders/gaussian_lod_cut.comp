@@ -7,8 +7,12 @@
 //   to the cut (children - 1) per bucket;
 // - threshold: one workgroup finds the lowest bucket t such that opening every node above it
 //   keeps the cut within view.lod_budget nodes (1 + the sum of the histogram above t);
-// - mask: per node, whether it is in the cut (its parent opens, it does not), gathered into
-//   visibility words, and how many of each workgroup's nodes are;
+// - mask: per inner node, whether it is in the cut (its parent opens, it does not), and when
+//   it opens, its leaves (each leaf's parent opens: it is in the cut), set as bits of the
+//   zeroed visibility words. One invocation per inner node: a leaf is reached only through
+//   its parent's list of children, so the leaves, two thirds of the nodes, are not visited
+//   and their parents' buckets are not gathered in the scene's order (see below);
+// - counts: per group of 256 nodes, how many of them are in the cut;
 // - offsets: per block of 256 groups, the counts' exclusive prefix sums and the block's total;
 // - block offsets: one workgroup turns the blocks' totals into exclusive prefix sums;
 // - list: each node of the cut writes its id at its rank, so the list is in node order (the
@@ -51,6 +55,9 @@ layout(std430, set = 0, binding = kLodGroupCountsBinding) buffer GroupCountsBloc
 };
 layout(std430, set = 0, binding = kLodListBinding) writeonly buffer ListBlock {
     uint list[];
+};
+layout(std430, set = 0, binding = kLodChildrenBinding) readonly buffer ChildrenBlock {
+    uint child_ids[];
 };
 
 const uint kBucketsPerInvocation = kLodBuckets / kLodWorkgroupSize;
@@ -182,26 +189,38 @@ void main() {
             counters.lod_cut_nodes = 1u + best_above;
         }
     } else if (kPass == kLodPassMask) {
-        // One invocation per node; the workgroup's 256 bits gather in shared memory and go
-        // out as 8 whole words (the workgroup starts on a word boundary).
-        uint total_nodes = pc.num_leaves + pc.num_inner;
-        if (lane < kWordsPerGroup) s_words[lane] = 0u;
-        barrier();
-        if (id < total_nodes) {
+        // One invocation per inner node (the visibility words were zeroed). The earlier pass,
+        // one invocation per node, looked up each leaf's parent bucket: leaves are in the
+        // scene's order, so those reads scattered over the inner nodes' buckets.
+        if (id < pc.num_inner) {
             uint threshold = counters.lod_threshold;
-            uint parent = nodes[id].parent;
-            bool parent_opens =
-                parent == kLodNoParent || Opens(parent - pc.num_leaves, threshold);
-            bool opens = id >= pc.num_leaves && Opens(id - pc.num_leaves, threshold);
-            if (parent_opens && !opens) atomicOr(s_words[lane / 32u], 1u << (lane % 32u));
+            uint node = pc.num_leaves + id;
+            GaussianLodNode record = nodes[node];
+            bool opens = Opens(id, threshold);
+            bool parent_opens = record.parent == kLodNoParent ||
+                                Opens(record.parent - pc.num_leaves, threshold);
+            if (parent_opens && !opens) atomicOr(visibility[node / 32u], 1u << (node % 32u));
+            if (opens) {
+                for (uint k = 0u; k < record.children; ++k) {
+                    uint child = child_ids[record.first_child + k];
+                    if (child < pc.num_leaves) {
+                        atomicOr(visibility[child / 32u], 1u << (child % 32u));
+                    }
+                }
+            }
+        } else if (pc.num_inner == 0u && id == 0u) {
+            atomicOr(visibility[0], 1u);  // a hierarchy of one leaf: the leaf is the cut
         }
-        barrier();
-        uint word = gl_WorkGroupID.x * kWordsPerGroup + lane;
-        if (lane < kWordsPerGroup && word * 32u < total_nodes) visibility[word] = s_words[lane];
-        if (lane == 0u) {
+    } else if (kPass == kLodPassCounts) {
+        // One invocation per group of kLodWorkgroupSize nodes: its words' bits.
+        uint total_nodes = pc.num_leaves + pc.num_inner;
+        if (id < LodGroups(total_nodes)) {
             uint count = 0u;
-            [[unroll]] for (uint k = 0u; k < kWordsPerGroup; ++k) count += bitCount(s_words[k]);
-            group_counts[gl_WorkGroupID.x] = count;
+            [[unroll]] for (uint k = 0u; k < kWordsPerGroup; ++k) {
+                uint word = id * kWordsPerGroup + k;
+                if (word * 32u < total_nodes) count += bitCount(visibility[word]);
+            }
+            group_counts[id] = count;
         }
     } else if (kPass == kLodPassOffsets) {
         // Workgroup b scans the counts of groups [256 b, 256 b + 256) in shared memory into

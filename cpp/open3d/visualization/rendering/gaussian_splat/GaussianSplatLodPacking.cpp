@@ -30,11 +30,15 @@ PackedLodNodes PackLodNodes(const t::geometry::SplatHierarchy& hierarchy) {
         const int64_t begin = hierarchy.child_offsets[size_t(k)];
         const int64_t end = hierarchy.child_offsets[size_t(k) + 1];
         node.children = static_cast<uint32_t>(end - begin);
+        node.first_child = static_cast<uint32_t>(begin);
         for (int64_t c = begin; c < end; ++c) {
             packed.nodes[size_t(hierarchy.children[size_t(c)])].parent =
                 static_cast<uint32_t>(hierarchy.num_leaves + k);
         }
     }
+    packed.children.resize(hierarchy.children.size());
+    std::transform(hierarchy.children.begin(), hierarchy.children.end(), packed.children.begin(),
+                   [](int64_t id) { return static_cast<uint32_t>(id); });
     return packed;
 }
 

@@ -19,9 +19,13 @@ struct PackedLodNodes {
     uint32_t num_leaves = 0;
     uint32_t num_inner = 0;
     std::vector<shader::GaussianLodNode> nodes;  ///< [num_leaves + num_inner], node order
+    /// [num_leaves + num_inner - 1]: the inner nodes' children, inner nodes in order (node k's
+    /// from nodes[N + k].first_child on, nodes[N + k].children of them).
+    std::vector<uint32_t> children;
 };
 
-/// Radius (3 x the largest scale, inner nodes), parent and child count of every node.
+/// Radius (3 x the largest scale, inner nodes), parent, child count and first child of every
+/// node, and the children.
 /// Throws core::Open3DError above 2^32 - 2 nodes (ids are uint32 on the GPU).
 PackedLodNodes PackLodNodes(const t::geometry::SplatHierarchy& hierarchy);
 

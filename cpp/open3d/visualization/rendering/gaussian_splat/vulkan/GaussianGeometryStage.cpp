@@ -257,6 +257,7 @@ void GaussianGeometryStage::Record(VkCommandBuffer cmd, const GeometryStageScene
         cut.view_params = buffers.view_params;
         cut.positions = scene.positions;
         cut.nodes = scene.lod_nodes;
+        cut.children = scene.lod_children;
         cut.buckets = buffers.lod_buckets;
         cut.histogram = buffers.lod_histogram;
         cut.counters = buffers.counters;

@@ -66,7 +66,8 @@ struct GeometryStageSceneBuffers {
     /// the cut (GaussianLodCut) writes the view's list of nodes into GeometryStageViewBuffers,
     /// and the stage runs over shader::LodListSlots list slots, not N.
     bool lod = false;
-    BufferRange lod_nodes;  ///< shader::GaussianLodNode [N]
+    BufferRange lod_nodes;     ///< shader::GaussianLodNode [N]
+    BufferRange lod_children;  ///< uint32 [N - 1]: the inner nodes' children
     uint32_t lod_leaves = 0, lod_inner = 0;
     int packed_sh_degree = 0;
     uint32_t sh_words_per_splat = 0;

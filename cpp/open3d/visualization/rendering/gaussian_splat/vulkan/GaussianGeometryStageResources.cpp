@@ -44,12 +44,23 @@ constexpr VkBufferUsageFlags kAddressed = VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_
 
 Buffer UploadStorageBuffer(const VulkanContext& context, const CommandPool& pool, const void* data,
                            VkDeviceSize bytes, VkBufferUsageFlags extra_usage) {
+    return UploadStorageBuffer(
+        context, pool, bytes,
+        [&](uint8_t* staging) {
+            if (bytes > 0) std::memcpy(staging, data, bytes);
+        },
+        extra_usage);
+}
+
+Buffer UploadStorageBuffer(const VulkanContext& context, const CommandPool& pool,
+                           VkDeviceSize bytes, const std::function<void(uint8_t*)>& fill,
+                           VkBufferUsageFlags extra_usage) {
     const VkDeviceSize size = std::max<VkDeviceSize>(bytes, 16);
     Buffer device(context, size, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | kTransfer | extra_usage,
                   MemoryUsage::kDevice);
     Buffer staging(context, size, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, MemoryUsage::kHostUpload);
     std::memset(staging.GetMapped(), 0, size);
-    if (bytes > 0) std::memcpy(staging.GetMapped(), data, bytes);
+    fill(static_cast<uint8_t*>(staging.GetMapped()));
     SubmitAndWait(context, pool, [&](VkCommandBuffer cmd) {
         const VkBufferCopy region{0, 0, size};
         vkCmdCopyBuffer(cmd, staging.Get(), device.Get(), 1, &region);
@@ -91,10 +102,22 @@ void GeometryStageResources::UploadLod(const VulkanContext& context, const Comma
         core::ThrowError("a hierarchy of {} + {} nodes for a scene of {} splats", lod.num_leaves,
                          lod.num_inner, layout_.num_splats);
     }
-    RequireStorageBinding(context, "hierarchy nodes",
-                          lod.nodes.size() * sizeof(shader::GaussianLodNode), lod.nodes.size());
-    lod_nodes = UploadStorageBuffer(context, pool, lod.nodes.data(),
-                                    lod.nodes.size() * sizeof(shader::GaussianLodNode));
+    // One buffer: the nodes, then their children from an offset every device can bind at.
+    const VkDeviceSize node_bytes = lod.nodes.size() * sizeof(shader::GaussianLodNode);
+    const VkDeviceSize alignment =
+        std::max<VkDeviceSize>(context.GetDeviceInfo().min_storage_buffer_offset_alignment, 16);
+    const VkDeviceSize children_offset = (node_bytes + alignment - 1) / alignment * alignment;
+    const VkDeviceSize children_bytes = std::max<VkDeviceSize>(lod.children.size() * 4, 4);
+    RequireStorageBinding(context, "hierarchy nodes", node_bytes, lod.nodes.size());
+    RequireStorageBinding(context, "hierarchy children", children_bytes, lod.nodes.size());
+    lod_nodes =
+        UploadStorageBuffer(context, pool, children_offset + children_bytes, [&](uint8_t* staging) {
+            std::memcpy(staging, lod.nodes.data(), node_bytes);
+            if (lod.children.empty()) return;  // one leaf
+            std::memcpy(staging + children_offset, lod.children.data(), lod.children.size() * 4);
+        });
+    lod_nodes_bytes_ = node_bytes;
+    lod_children_offset_ = children_offset;
     lod_leaves_ = lod.num_leaves;
     lod_inner_ = lod.num_inner;
     view_ = GeometryStageViewResources();  // the view needs the cut's buffers
@@ -174,7 +197,8 @@ GeometryStageSceneBuffers GeometryStageResources::Scene() const {
     scene.visibility = visibility.Range();
     scene.lod = HasLod();
     if (scene.lod) {
-        scene.lod_nodes = lod_nodes.Range();
+        scene.lod_nodes = lod_nodes.Range(0, lod_nodes_bytes_);
+        scene.lod_children = lod_nodes.Range(lod_children_offset_);
         scene.lod_leaves = lod_leaves_;
         scene.lod_inner = lod_inner_;
     }

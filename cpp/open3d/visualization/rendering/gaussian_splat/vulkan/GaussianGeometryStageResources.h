@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <vector>
 
@@ -25,6 +26,10 @@ namespace vulkan {
 /// transfer usages (VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT for what is read by address).
 Buffer UploadStorageBuffer(const VulkanContext& context, const CommandPool& pool, const void* data,
                            VkDeviceSize bytes, VkBufferUsageFlags extra_usage = 0);
+/// The same for `bytes` that `fill` writes into the (zeroed) staging memory.
+Buffer UploadStorageBuffer(const VulkanContext& context, const CommandPool& pool,
+                           VkDeviceSize bytes, const std::function<void(uint8_t*)>& fill,
+                           VkBufferUsageFlags extra_usage = 0);
 
 /// One view's geometry-stage outputs and scratch, sized for a splat count and an entry
 /// capacity. The backend keeps one per frame slot, so frames in flight never share them.
@@ -94,10 +99,13 @@ public:
 
     // Scene.
     Buffer positions, shape, sh, visibility;
-    Buffer lod_nodes;  ///< shader::GaussianLodNode per splat, for a hierarchy's nodes
+    /// For a hierarchy: shader::GaussianLodNode per splat, then (from an aligned offset) the
+    /// inner nodes' children (PackedLodNodes::children).
+    Buffer lod_nodes;
 
 private:
     uint32_t lod_leaves_ = 0, lod_inner_ = 0;
+    VkDeviceSize lod_nodes_bytes_ = 0, lod_children_offset_ = 0;
     PackedGaussianSplats layout_;
     // One view's outputs (projected splats, counters, sorted entries) and scratch.
     GeometryStageViewResources view_;

@@ -33,10 +33,10 @@ GaussianLodCut::GaussianLodCut(const VulkanContext& context) : context_(context)
     pipeline_layout_ =
         CreatePipelineLayout(context, set_layout_.Get(), sizeof(GaussianLodPushConstants));
     const char* names[kLodNumPasses] = {
-        "gaussian_lod_cut (sizes)",     "gaussian_lod_cut (buckets)",
-        "gaussian_lod_cut (threshold)", "gaussian_lod_cut (mask)",
-        "gaussian_lod_cut (offsets)",   "gaussian_lod_cut (block offsets)",
-        "gaussian_lod_cut (list)"};
+        "gaussian_lod_cut (sizes)",         "gaussian_lod_cut (buckets)",
+        "gaussian_lod_cut (threshold)",     "gaussian_lod_cut (mask)",
+        "gaussian_lod_cut (counts)",        "gaussian_lod_cut (offsets)",
+        "gaussian_lod_cut (block offsets)", "gaussian_lod_cut (list)"};
     for (uint32_t pass = 0; pass < kLodNumPasses; ++pass) {
         const VkSpecializationMapEntry entry{kSpecLodPass, 0, sizeof(uint32_t)};
         const VkSpecializationInfo info{1, &entry, sizeof(uint32_t), &pass};
@@ -65,13 +65,14 @@ VkDeviceSize GaussianLodCut::ListBytes(uint32_t num_leaves) {
 
 void GaussianLodCut::PushBindings(VkCommandBuffer cmd, const LodCutBuffers& buffers) const {
     const std::array<const BufferRange*, kLodNumBindings> ranges{
-        &buffers.view_params, &buffers.positions,    &buffers.nodes,
-        &buffers.buckets,     &buffers.histogram,    &buffers.counters,
-        &buffers.visibility,  &buffers.group_counts, &buffers.list};
+        &buffers.view_params, &buffers.positions, &buffers.nodes,      &buffers.buckets,
+        &buffers.histogram,   &buffers.counters,  &buffers.visibility, &buffers.group_counts,
+        &buffers.list,        &buffers.children};
     static_assert(kLodViewBinding == 0 && kLodPositionsBinding == 1 && kLodNodesBinding == 2 &&
                       kLodBucketsBinding == 3 && kLodHistogramBinding == 4 &&
                       kLodCountersBinding == 5 && kLodVisibilityBinding == 6 &&
-                      kLodGroupCountsBinding == 7 && kLodListBinding == 8,
+                      kLodGroupCountsBinding == 7 && kLodListBinding == 8 &&
+                      kLodChildrenBinding == 9,
                   "ranges above are listed in binding order");
     std::array<VkDescriptorBufferInfo, kLodNumBindings> infos{};
     std::array<VkWriteDescriptorSet, kLodNumBindings> writes{};
@@ -94,6 +95,8 @@ void GaussianLodCut::PushBindings(VkCommandBuffer cmd, const LodCutBuffers& buff
 void GaussianLodCut::Record(VkCommandBuffer cmd, const LodCutBuffers& buffers) const {
     const uint32_t nodes = buffers.num_leaves + buffers.num_inner;
     vkCmdFillBuffer(cmd, buffers.histogram.buffer, buffers.histogram.offset, HistogramBytes(), 0u);
+    vkCmdFillBuffer(cmd, buffers.visibility.buffer, buffers.visibility.offset,
+                    VisibilityBytes(nodes), 0u);
     RecordMemoryBarrier(cmd, VK_PIPELINE_STAGE_2_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
                         VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
                         VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
@@ -107,8 +110,9 @@ void GaussianLodCut::Record(VkCommandBuffer cmd, const LodCutBuffers& buffers) c
     const uint32_t inner_groups = std::max(DivCeil(buffers.num_inner, kLodWorkgroupSize), 1u);
     const uint32_t node_groups = std::max(DivCeil(nodes, kLodWorkgroupSize), 1u);
     const uint32_t blocks = std::max(LodBlocks(nodes), 1u);
-    const uint32_t groups[kLodNumPasses] = {inner_groups, inner_groups, 1u,         node_groups,
-                                            blocks,       1u,           node_groups};
+    const uint32_t count_groups = std::max(DivCeil(LodGroups(nodes), kLodWorkgroupSize), 1u);
+    const uint32_t groups[kLodNumPasses] = {inner_groups, inner_groups, 1u, inner_groups,
+                                            count_groups, blocks,       1u, node_groups};
     for (uint32_t pass = 0; pass < kLodNumPasses; ++pass) {
         if (pass > 0) ComputeToCompute(cmd);
         vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, passes_[pass].Get());

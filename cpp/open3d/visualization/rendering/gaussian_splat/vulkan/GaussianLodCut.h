@@ -28,6 +28,7 @@ struct LodCutBuffers {
     BufferRange view_params;   ///< shader::GaussianViewParams, already written
     BufferRange positions;     ///< vec4 [nodes]
     BufferRange nodes;         ///< shader::GaussianLodNode [nodes]
+    BufferRange children;      ///< uint32 [nodes - 1]: the inner nodes' children, in order
     BufferRange buckets;       ///< uint32 [2 inner]: effective, then own buckets
     BufferRange histogram;     ///< uint32 [kLodBuckets]
     BufferRange counters;      ///< shader::GaussianGeometryStageCounters, already zeroed
@@ -52,9 +53,9 @@ public:
     /// The list for any budget: at most a slot per leaf.
     static VkDeviceSize ListBytes(uint32_t num_leaves);
 
-    /// Records the cut: clears the histogram, then the seven passes with compute barriers
-    /// between them. The caller orders the view parameters' and counters' writes before it
-    /// and the list's compute write before the projection reads it.
+    /// Records the cut: clears the histogram and the visibility words, then the eight passes with
+    /// compute barriers between them. The caller orders the view parameters' and counters' writes
+    /// before it and the list's compute write before the projection reads it.
     void Record(VkCommandBuffer cmd, const LodCutBuffers& buffers) const;
 
 private:
