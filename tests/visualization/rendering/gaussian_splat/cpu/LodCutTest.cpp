@@ -10,6 +10,7 @@
 #include "GaussianSplatLodContract.h"
 #include "open3d/t/geometry/SplatHierarchy.h"
 #include "open3d/visualization/rendering/gaussian_splat/DefaultScene.h"
+#include "open3d/visualization/rendering/gaussian_splat/GaussianSplatLodPacking.h"
 #include "open3d/visualization/rendering/gaussian_splat/cpu/LodCut.h"
 
 namespace open3d {
@@ -119,6 +120,39 @@ TEST(LodCutMirror, NodesOutsideTheViewOpenLast) {
     away.world_to_camera = Eigen::Vector4d(-1.0, 1.0, -1.0, 1.0).asDiagonal() * cam.world_to_camera;
     const cpu::LodCutResult behind = cpu::CutLikeGpu(h, away, every_visible.size());
     EXPECT_LT(behind.nodes.size() * 10, in_view.nodes.size());
+}
+
+TEST(LodPacking, EveryInnerNodeListsItsChildrenAndEveryChildItsParent) {
+    // The GPU cut's mask pass reaches a leaf only through its parent's entry in the packed
+    // children (GaussianLodNode::first_child, children): each node must be listed once, by
+    // its parent, in the hierarchy's order.
+    const SplatHierarchy h = t::geometry::BuildSplatHierarchy(CreateDefaultGaussianSplatScene());
+    const PackedLodNodes packed = PackLodNodes(h);
+    const int64_t n = h.num_leaves, total = h.NumNodes();
+    ASSERT_EQ(int64_t(packed.nodes.size()), total);
+    ASSERT_EQ(int64_t(packed.children.size()), total - 1);  // every node but the root
+    std::vector<int> listed(size_t(total), 0);
+    for (int64_t id = 0; id < total; ++id) {
+        const shader::GaussianLodNode& node = packed.nodes[size_t(id)];
+        if (id < n) {
+            EXPECT_EQ(node.children, 0u);
+            EXPECT_EQ(node.first_child, 0u);
+            continue;
+        }
+        const int64_t k = id - n;
+        ASSERT_EQ(node.first_child, uint32_t(h.child_offsets[size_t(k)]));
+        ASSERT_EQ(node.children, uint32_t(h.child_offsets[size_t(k) + 1] - h.child_offsets[k]));
+        for (uint32_t c = 0; c < node.children; ++c) {
+            const uint32_t child = packed.children[node.first_child + c];
+            ASSERT_EQ(int64_t(child), h.children[node.first_child + c]);
+            ASSERT_LT(int64_t(child), id);  // children before parents
+            EXPECT_EQ(packed.nodes[child].parent, uint32_t(id));
+            ++listed[child];
+        }
+    }
+    EXPECT_EQ(packed.nodes.back().parent, shader::kLodNoParent);
+    EXPECT_EQ(std::count(listed.begin(), listed.end(), 1), total - 1);
+    EXPECT_EQ(listed.back(), 0);  // the root
 }
 
 }  // namespace
