@@ -151,6 +151,16 @@ Buffer Buffer::ImportHost(const VulkanContext& context, void* data, VkDeviceSize
     return result;
 }
 
+std::array<uint32_t, 2> DeviceAddressWords(const BufferRange& range, const char* what) {
+    if (range.address == 0 || range.address % 16 != 0) {
+        core::ThrowError(
+            "{} need a buffer made for device addresses "
+            "(VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT) at a 16-byte aligned address",
+            what);
+    }
+    return {static_cast<uint32_t>(range.address), static_cast<uint32_t>(range.address >> 32)};
+}
+
 BufferRange Buffer::Range(VkDeviceSize offset, VkDeviceSize size) const {
     assert(offset <= size_);
     return BufferRange{buffer_.Get(), offset, size == VK_WHOLE_SIZE ? size_ - offset : size,

@@ -5,6 +5,7 @@
 
 #include <vulkan/vulkan.h>
 
+#include <array>
 #include <cstdint>
 #include <utility>
 
@@ -27,6 +28,12 @@ struct BufferRange {
     /// VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT, else 0.
     VkDeviceAddress address = 0;
 };
+
+/// `range`'s device address as the shaders' push constants take it: low word, high word.
+/// Throws core::Open3DError naming `what` unless its buffer was made with
+/// VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT and the address is 16-byte aligned (the
+/// shaders read 128-bit words there).
+std::array<uint32_t, 2> DeviceAddressWords(const BufferRange& range, const char* what);
 
 enum class MemoryUsage {
     /// GPU-only memory (DEVICE_LOCAL).

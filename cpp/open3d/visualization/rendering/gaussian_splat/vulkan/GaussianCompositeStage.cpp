@@ -222,11 +222,8 @@ void GaussianCompositeStage::RecordComposite(VkCommandBuffer cmd,
                 alignment);
         }
     }
-    if (inputs.projected.address == 0 || inputs.projected.address % 16 != 0) {
-        core::ThrowError(
-            "GaussianCompositeStage: the projected records need a buffer made for device "
-            "addresses (VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT) at a 16-byte aligned address");
-    }
+    const std::array<uint32_t, 2> projected =
+        DeviceAddressWords(inputs.projected, "GaussianCompositeStage: the projected records");
     if (inputs.entry_count.buffer == VK_NULL_HANDLE || inputs.entry_count.offset % 4 != 0) {
         core::ThrowError(
             "GaussianCompositeStage: entry_count needs a buffer and a 4-byte aligned offset");
@@ -285,8 +282,8 @@ void GaussianCompositeStage::RecordComposite(VkCommandBuffer cmd,
     push.scene_depth_flip_y = params.scene_depth && params.scene_depth->flip_y ? 1u : 0u;
     push.background = {params.background[0], params.background[1], params.background[2]};
     push.scene_near = params.scene_depth ? params.scene_depth->near_plane : 0.f;
-    push.projected_lo = static_cast<uint32_t>(inputs.projected.address);
-    push.projected_hi = static_cast<uint32_t>(inputs.projected.address >> 32);
+    push.projected_lo = projected[0];
+    push.projected_hi = projected[1];
 
     const VkDeviceSize entry_bytes = VkDeviceSize(std::max(inputs.entry_capacity, 1u)) * 4;
     // Without a colour buffer the binding is never written (kSpecColorBuffer 0) but must hold

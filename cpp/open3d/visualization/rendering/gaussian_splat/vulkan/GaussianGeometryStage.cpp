@@ -160,25 +160,12 @@ void GaussianGeometryStage::PushBindings(VkCommandBuffer cmd,
     context_.GetCmdPushDescriptorSet()(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_layout_.Get(),
                                        0, kGeometryStageNumBindings, writes.data());
     // The buffers a splat count can grow past one binding's range go by device address.
-    GaussianGeometryAddresses addresses{};
-    const std::array<std::pair<const BufferRange*, const char*>, 3> addressed{
-        {{&scene.shape, "shape words"},
-         {&scene.sh, "SH words"},
-         {&buffers.projected, "projected"}}};
-    for (const auto& [range, what] : addressed) {
-        if (range->address == 0 || range->address % 16 != 0) {
-            core::ThrowError(
-                "GaussianGeometryStage: the {} need a buffer made for device addresses "
-                "(VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT) at a 16-byte aligned address",
-                what);
-        }
-    }
-    addresses.shape_lo = static_cast<uint32_t>(scene.shape.address);
-    addresses.shape_hi = static_cast<uint32_t>(scene.shape.address >> 32);
-    addresses.sh_lo = static_cast<uint32_t>(scene.sh.address);
-    addresses.sh_hi = static_cast<uint32_t>(scene.sh.address >> 32);
-    addresses.projected_lo = static_cast<uint32_t>(buffers.projected.address);
-    addresses.projected_hi = static_cast<uint32_t>(buffers.projected.address >> 32);
+    const auto shape = DeviceAddressWords(scene.shape, "GaussianGeometryStage: the shape words");
+    const auto sh = DeviceAddressWords(scene.sh, "GaussianGeometryStage: the SH words");
+    const auto projected =
+        DeviceAddressWords(buffers.projected, "GaussianGeometryStage: the projected records");
+    const GaussianGeometryAddresses addresses{shape[0],     shape[1],     sh[0], sh[1],
+                                              projected[0], projected[1], 0u,    0u};
     vkCmdPushConstants(cmd, pipeline_layout_.Get(), VK_SHADER_STAGE_COMPUTE_BIT,
                        kGeometryAddressesPushOffset, sizeof(addresses), &addresses);
 }
