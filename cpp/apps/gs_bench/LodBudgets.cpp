@@ -9,6 +9,7 @@
 
 #include "open3d/core/Exception.h"
 #include "open3d/core/Timer.h"
+#include "open3d/visualization/rendering/gaussian_splat/SplatStreamer.h"
 
 namespace open3d {
 namespace bench {
@@ -57,16 +58,8 @@ LodCut CutForView(const t::geometry::SplatHierarchy& hierarchy,
                   const t::geometry::PointCloud& source, const camera::PinholeCamera& camera,
                   int64_t budget) {
     const auto start = std::chrono::steady_clock::now();
-    t::geometry::SplatCutView view;
-    view.world_to_camera = camera.world_to_camera;
-    view.focal_px = std::max(camera.fx, camera.fy);
-    view.width = camera.width;
-    view.height = camera.height;
-    view.fx = camera.fx;
-    view.fy = camera.fy;
-    view.cx = camera.cx;
-    view.cy = camera.cy;
-    const std::vector<int64_t> nodes = t::geometry::CutSplatHierarchy(hierarchy, view, budget);
+    const std::vector<int64_t> nodes = t::geometry::CutSplatHierarchy(
+        hierarchy, visualization::rendering::SplatCutViewOf(camera), budget);
     LodCut cut;
     cut.cloud = t::geometry::ExtractSplatNodes(hierarchy, source, nodes);
     cut.nodes = static_cast<int64_t>(nodes.size());

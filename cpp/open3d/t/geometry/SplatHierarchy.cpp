@@ -264,12 +264,14 @@ GaussianSplatArrays InnerArrays(const SplatHierarchy& hierarchy) {
                                      : hierarchy.inner.GetGaussianSplatArrays();
 }
 
+}  // namespace
+
 // Whether a sphere of `radius` about camera-space point `c` lies wholly behind the camera
 // or, where the view has an image, wholly outside one of its frustum's four side planes,
 // widened like the renderer's guard band: splats up to 1.3x the half-angle out are still
 // projected, and the footprint's 0.3 px dilation reaches 1.6 px beyond the ellipse
 // (docs/lod.md "Cut").
-bool OutsideView(const SplatCutView& view, const Eigen::Vector3d& c, double radius) {
+bool SplatOutsideView(const SplatCutView& view, const Eigen::Vector3d& c, double radius) {
     if (c.z() + radius <= 0.0) return true;
     if (view.width <= 0 || view.height <= 0) return false;
     // x / z on the image lies in [lo, hi], widened by 15% of the span and 2 px each side;
@@ -287,8 +289,6 @@ bool OutsideView(const SplatCutView& view, const Eigen::Vector3d& c, double radi
                    view.fy);
 }
 
-}  // namespace
-
 SplatHierarchy BuildSplatHierarchy(const PointCloud& splats) {
     if (splats.IsEmpty()) core::ThrowError("BuildSplatHierarchy: the cloud has no splat");
     return Builder(splats).Build();
@@ -302,14 +302,14 @@ std::vector<int64_t> CutSplatHierarchy(const SplatHierarchy& hierarchy, const Sp
     const GaussianSplatArrays inner = InnerArrays(hierarchy);
     // Projected size of inner node k: 3 sigma of its largest axis over its depth; a node
     // nearer than its own size counts as its size in pixels times a large factor.
-    // A node wholly outside the view (OutsideView) gets -1: it is opened only after every
+    // A node wholly outside the view (SplatOutsideView) gets -1: it is opened only after every
     // node in view, where the budget still allows (so a budget of every leaf stays exact).
     const auto size = [&](int64_t k) {
         const float* p = inner.positions + 3 * k;
         const float* s = inner.scale + 3 * k;
         const double radius = 3.0 * std::max({std::abs(s[0]), std::abs(s[1]), std::abs(s[2])});
         const Eigen::Vector3d c = r * Eigen::Vector3d(p[0], p[1], p[2]) + t;
-        if (OutsideView(view, c, radius)) return -1.0;
+        if (SplatOutsideView(view, c, radius)) return -1.0;
         return view.focal_px * radius / std::max(c.z(), 1e-3 * radius + 1e-30);
     };
     std::vector<int64_t> cut;

@@ -52,6 +52,11 @@ struct SplatCutView {
     double fx = 1.0, fy = 1.0, cx = 0.0, cy = 0.0;
 };
 
+/// Whether a sphere of `radius` about camera-space point `c` lies wholly behind the camera or,
+/// where `view` has an image, wholly outside one of its frustum's four side planes widened
+/// like the renderer's guard band (docs/lod.md "Cut"): nothing inside it can colour a pixel.
+bool SplatOutsideView(const SplatCutView& view, const Eigen::Vector3d& c, double radius);
+
 /// A cut of at most `budget` (>= 1) nodes, every leaf under exactly one of them, in ascending
 /// node id. From the root, the node of largest projected size (focal_px * 3 * largest scale /
 /// depth, nodes nearer than their own size first) is replaced by its children while that

@@ -56,7 +56,7 @@ void SplatColumns::Allocate(const std::string& filename, int64_t n, bool gaussia
     f_rest = Tensor::Empty({n, NumSHRestCoeffs(degree), 3}, Dtype::Float32);
 }
 
-MappedFile::MappedFile(const std::string& filename) {
+MappedFile::MappedFile(const std::string& filename, bool populate) {
     core::RequireRegularFile(filename);  // before open(), which blocks on a FIFO
     const int fd = ::open(filename.c_str(), O_RDONLY | O_CLOEXEC);
     if (fd < 0)
@@ -75,8 +75,9 @@ MappedFile::MappedFile(const std::string& filename) {
     // progress callback a file above 16 MiB is populated in 4 MiB blocks instead, reported as
     // "reading" (the disk is then what a large file waits for).
     constexpr size_t kBlock = size_t(4) << 20;
-    const bool report = core::HasProgressCallback() && size_ > 4 * kBlock;
-    void* p = ::mmap(nullptr, size_, PROT_READ, MAP_PRIVATE | (report ? 0 : MAP_POPULATE), fd, 0);
+    const bool report = populate && core::HasProgressCallback() && size_ > 4 * kBlock;
+    const int flags = MAP_PRIVATE | (populate && !report ? MAP_POPULATE : 0);
+    void* p = ::mmap(nullptr, size_, PROT_READ, flags, fd, 0);
     ::close(fd);
     if (p == MAP_FAILED) core::ThrowError("Cannot map '{}': {}", filename, std::strerror(errno));
     data_ = static_cast<const uint8_t*>(p);

@@ -32,10 +32,12 @@ struct SplatColumns {
 };
 
 /// A read-only view of a whole file (memory-mapped). Throws naming the file when it
-/// cannot be opened or mapped, or when it is empty.
+/// cannot be opened or mapped, or when it is empty. `populate` reads the whole file in at
+/// once (readers of whole files); without it the pages are read when first touched (the
+/// streaming of SplatPageFile, which reads a page of the scene at a time).
 class MappedFile {
 public:
-    explicit MappedFile(const std::string& filename);
+    explicit MappedFile(const std::string& filename, bool populate = true);
     ~MappedFile();
     MappedFile(const MappedFile&) = delete;
     MappedFile& operator=(const MappedFile&) = delete;

@@ -96,6 +96,45 @@ void GeometryStageResources::UploadScene(const VulkanContext& context, const Com
     view_ = GeometryStageViewResources();
 }
 
+void GeometryStageResources::WriteSplats(const VulkanContext& context, const CommandPool& pool,
+                                         int64_t first, const PackedGaussianSplats& part) {
+    if (part.precision != layout_.precision || part.sh_degree != layout_.sh_degree ||
+        part.shape_words_per_splat != layout_.shape_words_per_splat ||
+        part.sh_words_per_splat != layout_.sh_words_per_splat) {
+        core::ThrowError("writing splats packed at SH degree {} into a scene packed at {}",
+                         part.sh_degree, layout_.sh_degree);
+    }
+    if (first < 0 || part.num_splats < 0 || first + part.num_splats > layout_.num_splats) {
+        core::ThrowError("writing splats [{}, {}) into a scene of {} splats", first,
+                         first + part.num_splats, layout_.num_splats);
+    }
+    if (part.num_splats == 0) return;
+    const VkDeviceSize position_bytes = part.positions.size() * sizeof(float);
+    const VkDeviceSize shape_bytes = part.shape.size() * 4;
+    const VkDeviceSize sh_bytes = part.sh.size() * 4;
+    Buffer staging(context, position_bytes + shape_bytes + sh_bytes,
+                   VK_BUFFER_USAGE_TRANSFER_SRC_BIT, MemoryUsage::kHostUpload);
+    auto* bytes = static_cast<uint8_t*>(staging.GetMapped());
+    std::memcpy(bytes, part.positions.data(), position_bytes);
+    std::memcpy(bytes + position_bytes, part.shape.data(), shape_bytes);
+    if (sh_bytes > 0) std::memcpy(bytes + position_bytes + shape_bytes, part.sh.data(), sh_bytes);
+    const VkDeviceSize at = static_cast<VkDeviceSize>(first);
+    SubmitAndWait(context, pool, [&](VkCommandBuffer cmd) {
+        const VkBufferCopy to_positions{0, at * 4 * sizeof(float), position_bytes};
+        vkCmdCopyBuffer(cmd, staging.Get(), positions.Get(), 1, &to_positions);
+        const VkBufferCopy to_shape{position_bytes, at * part.shape_words_per_splat * 4,
+                                    shape_bytes};
+        vkCmdCopyBuffer(cmd, staging.Get(), shape.Get(), 1, &to_shape);
+        if (sh_bytes > 0) {
+            const VkBufferCopy to_sh{position_bytes + shape_bytes, at * part.sh_words_per_splat * 4,
+                                     sh_bytes};
+            vkCmdCopyBuffer(cmd, staging.Get(), sh.Get(), 1, &to_sh);
+        }
+    });
+    layout_.center_min = layout_.center_min.cwiseMin(part.center_min);
+    layout_.center_max = layout_.center_max.cwiseMax(part.center_max);
+}
+
 void GeometryStageResources::UploadLod(const VulkanContext& context, const CommandPool& pool,
                                        const PackedLodNodes& lod) {
     if (int64_t(lod.num_leaves) + lod.num_inner != layout_.num_splats) {

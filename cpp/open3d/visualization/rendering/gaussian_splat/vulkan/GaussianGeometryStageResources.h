@@ -64,6 +64,11 @@ public:
     /// binding must name a buffer) and keeps the packing's sizes.
     void UploadScene(const VulkanContext& context, const CommandPool& pool,
                      const PackedGaussianSplats& packed);
+    /// Writes `part` (packed like the scene) over splats [first, first + part.num_splats) of
+    /// the uploaded scene, and widens the centre bounds the depth range comes from to hold
+    /// its centres (the streaming pool's page writes). The visibility mask is not touched.
+    void WriteSplats(const VulkanContext& context, const CommandPool& pool, int64_t first,
+                     const PackedGaussianSplats& part);
     /// Uploads the nodes of the hierarchy the scene's splats are (GaussianSplatLodPacking.h);
     /// ClearLod forgets them (a plain scene).
     void UploadLod(const VulkanContext& context, const CommandPool& pool,

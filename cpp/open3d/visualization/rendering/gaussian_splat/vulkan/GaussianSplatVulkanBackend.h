@@ -19,6 +19,7 @@
 #include "open3d/camera/PinholeCamera.h"
 #include "open3d/visualization/rendering/gaussian_splat/GaussianSplatBackend.h"
 #include "open3d/visualization/rendering/gaussian_splat/GaussianSplatDataPacking.h"
+#include "open3d/visualization/rendering/gaussian_splat/SplatStreamer.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/Buffer.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/Commands.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/DeferredRelease.h"
@@ -138,6 +139,22 @@ public:
     /// SetScene returns to a plain scene. Throws for an invalid source or hierarchy.
     void SetSceneHierarchy(const t::geometry::PointCloud& source,
                            const t::geometry::SplatHierarchy& hierarchy);
+
+    /// A scene of `capacity` splat slots at SH degree `sh_degree`, every one hidden, whose
+    /// splats arrive by WriteSceneSplats and are shown by SetVisibility: the pool a
+    /// SplatStreamer streams a paged file into (docs/streaming.md). The empty slots sit at
+    /// `center_min` and `center_max`, the bounds of every centre that will be written, so the
+    /// depth range holds the whole scene from the start. Throws for a capacity below 1.
+    void SetScenePool(int64_t capacity, int sh_degree, const Eigen::Vector3d& center_min,
+                      const Eigen::Vector3d& center_max);
+    /// Writes `splats` (valid, of the scene's SH degree) over splats [first, first + n) of the
+    /// scene, on the GPU and in the copy kept for re-packing, after the frames that read the
+    /// scene complete. The visibility mask is unchanged. Throws for a range outside the scene,
+    /// another SH degree or a scene drawn through its hierarchy.
+    void WriteSceneSplats(int64_t first, const t::geometry::PointCloud& splats);
+
+    /// Writes a SplatStreamer step's pages into the pool and shows its cut.
+    void ApplyStreamStep(const SplatStreamStep& step);
 
     /// Replaces the visibility mask: bit i of word i / 32 shows splat i ([ceil(N / 32)]).
     void SetVisibility(const std::vector<uint32_t>& mask);

@@ -1,0 +1,99 @@
+// Streaming of a paged splat file (t/io/SplatPageFile.h) through a fixed pool of page slots
+// on the GPU (docs/streaming.md). Each Step cuts the hierarchy for a view using only the
+// pages in the pool, reads the pages the cut wants next (largest projected node first) into
+// free slots or slots whose page the view does not use (least recently used first), and
+// returns the slots' new contents and the pool's visibility mask: the cut. The renderer draws
+// the pool as one scene of PoolSplats() splats (GaussianSplatVulkanBackend::SetScenePool).
+//
+// With every page resident and a budget of at least the leaves, the cut draws every leaf the
+// view can see: the exact image. Nodes whose bounding sphere (over their whole subtree) lies
+// outside the view are neither drawn nor opened: nothing below them colours a pixel.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "open3d/camera/PinholeCamera.h"
+#include "open3d/t/geometry/PointCloud.h"
+#include "open3d/t/geometry/SplatHierarchy.h"
+#include "open3d/t/io/SplatPageFile.h"
+
+namespace open3d {
+namespace visualization {
+namespace rendering {
+
+/// The cut's view of `camera`: its pose, its larger focal length, its image for the frustum.
+t::geometry::SplatCutView SplatCutViewOf(const camera::PinholeCamera& camera);
+
+/// What one SplatStreamer::Step changed.
+struct SplatStreamStep {
+    /// A page read into the pool: its splats go to slots [first_splat, first_splat + n).
+    struct PageWrite {
+        int64_t page = 0;
+        int64_t first_splat = 0;
+        t::geometry::PointCloud splats;
+    };
+    std::vector<PageWrite> writes;     ///< to write before drawing `visibility`
+    std::vector<uint32_t> visibility;  ///< [PoolSplats() / 32]: bit s shows pool slot s
+    int64_t cut_nodes = 0;             ///< nodes drawn
+    int64_t pages_evicted = 0;         ///< pages whose slots this step reused
+    /// Pages the cut would open into next that are not in the pool after this step; 0 when
+    /// the cut is what unlimited memory would give for this view and budget.
+    int64_t pages_wanted = 0;
+    /// A wanted page found no slot: every slot holds a page this view's cut uses.
+    bool starved = false;
+};
+
+class SplatStreamer {
+public:
+    /// Streams `file` (which must outlive the streamer) into `pool_pages` slots of
+    /// file.PageCapacity() splats each, with cuts of at most `splat_budget` (>= 1) nodes.
+    /// Throws core::Open3DError for a pool of no slot or a budget below 1.
+    SplatStreamer(const t::io::SplatPageFile& file, int64_t pool_pages, int64_t splat_budget);
+
+    /// Splat slots of the pool: pool pages x page capacity.
+    int64_t PoolSplats() const { return pool_pages_ * file_.PageCapacity(); }
+    int64_t PoolPages() const { return pool_pages_; }
+
+    /// Cuts for `view`, reads up to `max_reads` wanted pages (the root's page is read on the
+    /// first step whatever `max_reads` is), cuts again with them and returns the changes.
+    SplatStreamStep Step(const t::geometry::SplatCutView& view, int64_t max_reads);
+
+    int64_t ResidentPages() const;
+    int64_t PagesRead() const { return pages_read_; }   ///< since construction
+    uint64_t BytesRead() const { return bytes_read_; }  ///< bytes of the pages read
+    int64_t Evictions() const { return evictions_; }
+
+    /// Page of every slot (-1 empty), for tests.
+    const std::vector<int64_t>& SlotPages() const { return slot_page_; }
+
+private:
+    struct Cut {
+        std::vector<int64_t> drawn;                      // node ids
+        std::vector<std::pair<double, int64_t>> wanted;  // (priority, page) not in the pool
+    };
+    Cut MakeCut(const t::geometry::SplatCutView& view);
+    const t::io::SplatPageNode& Node(int64_t id, int64_t page) const {
+        return records_[page][id - file_.Page(page).first_node];
+    }
+    /// Reads `page` into a free slot or the least recently used slot this step's cut does not
+    /// use; false when there is none.
+    bool Load(int64_t page, SplatStreamStep& step);
+
+    const t::io::SplatPageFile& file_;
+    int64_t pool_pages_ = 0;
+    int64_t budget_ = 0;
+    /// Node records of every page read so far: they stay when the page's splats leave the
+    /// pool (40 bytes a node), so a cut walks what it has seen without reading it again.
+    std::vector<std::vector<t::io::SplatPageNode>> records_;
+    std::vector<int64_t> page_slot_;   // page -> slot, -1 when not in the pool
+    std::vector<int64_t> slot_page_;   // slot -> page, -1 when empty
+    std::vector<uint64_t> last_used_;  // page -> the last step whose cut used it
+    uint64_t step_ = 0;
+    int64_t pages_read_ = 0, evictions_ = 0;
+    uint64_t bytes_read_ = 0;
+};
+
+}  // namespace rendering
+}  // namespace visualization
+}  // namespace open3d

@@ -1,0 +1,215 @@
+// Streaming a paged splat file through a pool of page slots (SplatStreamer): with room for
+// what the view needs the cut converges to every leaf the view can see (counted here
+// independently from the source splats), pages the view stops using are evicted for the
+// ones it asks for and read again when it returns, the cut stays within its budget, and a
+// pool too small for the view says so.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "TestUtility.h"
+#include "open3d/core/Exception.h"
+#include "open3d/t/geometry/SplatHierarchy.h"
+#include "open3d/t/io/SplatPageFile.h"
+#include "open3d/visualization/rendering/gaussian_splat/SplatStreamer.h"
+#include "t/io/RandomSplatCloud.h"
+
+namespace open3d {
+namespace tests {
+namespace {
+
+using t::geometry::PointCloud;
+using visualization::rendering::SplatCutViewOf;
+using visualization::rendering::SplatStreamer;
+using visualization::rendering::SplatStreamStep;
+
+// Two clusters of `n` splats each, 1000 units apart on x, 20 units in front of cameras at
+// x = 0 and x = 1000 that look down +z: each camera sees one cluster only.
+PointCloud TwoClusters(int64_t n) {
+    PointCloud cloud = t::io::RandomCloud(2 * n, 1, 11);
+    float* p = cloud.GetPointAttr("positions").Data<float>();
+    float* s = cloud.GetPointAttr("scale").Data<float>();
+    for (int64_t i = 0; i < 2 * n; ++i) {
+        p[3 * i + 0] = 0.2f * p[3 * i + 0] + (i < n ? 0.0f : 1000.0f);
+        p[3 * i + 1] = 0.2f * p[3 * i + 1];
+        p[3 * i + 2] = 0.1f * p[3 * i + 2] + 20.0f;
+        for (int axis = 0; axis < 3; ++axis) s[3 * i + axis] = std::min(s[3 * i + axis], 0.3f);
+    }
+    return cloud;
+}
+
+camera::PinholeCamera CameraAt(double x) {
+    camera::PinholeCamera cam;
+    cam.width = cam.height = 64;
+    cam.fx = cam.fy = 60.0;
+    cam.cx = cam.cy = 31.5;
+    cam.world_to_camera(0, 3) = -x;
+    return cam;
+}
+
+// The leaves a camera can see: those whose 3-sigma sphere is not outside its view.
+std::set<int64_t> LeavesInView(const PointCloud& cloud, const camera::PinholeCamera& cam) {
+    const t::geometry::SplatCutView view = SplatCutViewOf(cam);
+    const float* p = cloud.GetPointAttr("positions").Data<float>();
+    const float* s = cloud.GetPointAttr("scale").Data<float>();
+    std::set<int64_t> in_view;
+    for (int64_t i = 0; i < cloud.NumPoints(); ++i) {
+        const Eigen::Vector3d c =
+            (cam.world_to_camera * Eigen::Vector4d(p[3 * i], p[3 * i + 1], p[3 * i + 2], 1.0))
+                .head<3>();
+        const double radius = 3.0 * std::max({s[3 * i], s[3 * i + 1], s[3 * i + 2]});
+        if (!t::geometry::SplatOutsideView(view, c, radius)) in_view.insert(i);
+    }
+    return in_view;
+}
+
+// The hierarchy ids of the nodes a step's mask shows.
+std::set<int64_t> Drawn(const t::io::SplatPageFile& file, const SplatStreamer& streamer,
+                        const SplatStreamStep& step) {
+    std::set<int64_t> drawn;
+    for (int64_t s = 0; s < streamer.PoolSplats(); ++s) {
+        if (!(step.visibility[s / 32] >> (s % 32) & 1u)) continue;
+        const int64_t page = streamer.SlotPages().at(s / file.PageCapacity());
+        EXPECT_GE(page, 0) << "slot " << s << " is shown but empty";
+        if (page < 0) continue;
+        drawn.insert(file.ReadNodes(page).at(s % file.PageCapacity()).source_id);
+    }
+    return drawn;
+}
+
+// Steps until nothing the view wants is missing; returns the last step.
+SplatStreamStep Converge(SplatStreamer& streamer, const camera::PinholeCamera& cam) {
+    SplatStreamStep step;
+    for (int i = 0; i < 1000; ++i) {
+        step = streamer.Step(SplatCutViewOf(cam), 2);
+        if (step.pages_wanted == 0) return step;
+    }
+    ADD_FAILURE() << "did not converge";
+    return step;
+}
+
+struct Paged {
+    PointCloud cloud;
+    std::string path;
+};
+Paged WritePaged(int64_t n, int64_t capacity) {
+    Paged paged{TwoClusters(n), TempDir() + "/two_clusters.gspages"};
+    t::io::WriteSplatPages(paged.path, paged.cloud, t::geometry::BuildSplatHierarchy(paged.cloud),
+                           capacity);
+    return paged;
+}
+
+TEST(SplatStreamer, ConvergesToEveryLeafInView) {
+    const Paged paged = WritePaged(300, 16);
+    const t::io::SplatPageFile file(paged.path);
+    const camera::PinholeCamera cam = CameraAt(0.0);
+    const std::set<int64_t> expected = LeavesInView(paged.cloud, cam);
+    ASSERT_GT(expected.size(), 200u);
+    ASSERT_LT(expected.size(), 320u);  // the other cluster is not in view
+    SplatStreamer streamer(file, file.NumPages(), file.NumLeaves());
+    // The first step reads the root's page alone and already draws something.
+    const SplatStreamStep first = streamer.Step(SplatCutViewOf(cam), 0);
+    EXPECT_EQ(first.writes.size(), 1u);
+    EXPECT_GE(first.cut_nodes, 1);
+    EXPECT_GT(first.pages_wanted, 0);
+    const SplatStreamStep last = Converge(streamer, cam);
+    EXPECT_FALSE(last.starved);
+    EXPECT_EQ(Drawn(file, streamer, last), expected);
+    EXPECT_EQ(last.cut_nodes, int64_t(expected.size()));
+    // Only what the view opened into was read.
+    EXPECT_LT(streamer.ResidentPages(), file.NumPages());
+}
+
+TEST(SplatStreamer, EvictsWhatTheViewLeftAndReadsItAgain) {
+    const Paged paged = WritePaged(300, 16);
+    const t::io::SplatPageFile file(paged.path);
+    const camera::PinholeCamera a = CameraAt(0.0), b = CameraAt(1000.0);
+    int64_t need_a = 0, need_b = 0;
+    for (const auto& [cam, need] : {std::pair{a, &need_a}, std::pair{b, &need_b}}) {
+        SplatStreamer unlimited(file, file.NumPages(), file.NumLeaves());
+        Converge(unlimited, cam);
+        *need = unlimited.ResidentPages();
+    }
+    // Room for either view, not for both (they share the root's page and little more).
+    const int64_t pool = std::max(need_a, need_b);
+    ASSERT_LT(pool, need_a + need_b - 2);
+    SplatStreamer streamer(file, pool, file.NumLeaves());
+    for (const camera::PinholeCamera& cam : {a, b, a}) {
+        const SplatStreamStep last = Converge(streamer, cam);
+        EXPECT_EQ(Drawn(file, streamer, last), LeavesInView(paged.cloud, cam));
+    }
+    EXPECT_GT(streamer.Evictions(), 0);
+    EXPECT_GT(streamer.PagesRead(), need_a + need_b);  // a's pages were read twice
+}
+
+TEST(SplatStreamer, TheCutStaysWithinItsBudget) {
+    const Paged paged = WritePaged(300, 16);
+    const t::io::SplatPageFile file(paged.path);
+    const camera::PinholeCamera cam = CameraAt(0.0);
+    for (const int64_t budget : {int64_t(1), int64_t(7), int64_t(40), int64_t(150)}) {
+        SplatStreamer streamer(file, file.NumPages(), budget);
+        SplatStreamStep step;
+        for (int i = 0; i < 200; ++i) {
+            step = streamer.Step(SplatCutViewOf(cam), 1);
+            ASSERT_LE(step.cut_nodes, budget);
+            ASSERT_EQ(Drawn(file, streamer, step).size(), size_t(step.cut_nodes));
+            if (step.pages_wanted == 0) break;
+        }
+        EXPECT_EQ(step.pages_wanted, 0);
+        // A cut that fills less than its budget less the largest group (8) could open more.
+        if (budget >= 40) {
+            EXPECT_GT(step.cut_nodes, budget - 8);
+        }
+    }
+    EXPECT_THROW(SplatStreamer(file, 4, 0), core::Open3DError);
+    EXPECT_THROW(SplatStreamer(file, 0, 10), core::Open3DError);
+}
+
+TEST(SplatStreamer, APoolTooSmallForTheViewSaysSo) {
+    const Paged paged = WritePaged(300, 16);
+    const t::io::SplatPageFile file(paged.path);
+    SplatStreamer streamer(file, 1, file.NumLeaves());
+    const camera::PinholeCamera cam = CameraAt(0.0);
+    streamer.Step(SplatCutViewOf(cam), 4);
+    const SplatStreamStep second = streamer.Step(SplatCutViewOf(cam), 4);
+    EXPECT_TRUE(second.starved);
+    EXPECT_GT(second.pages_wanted, 0);
+    EXPECT_EQ(streamer.SlotPages(), std::vector<int64_t>{0});  // the root's page stays
+    EXPECT_GE(Drawn(file, streamer, second).size(), 1u);
+}
+
+TEST(SplatStreamer, AFullPoolKeepsWhatTheCutUsesInsteadOfThrashing) {
+    // One slot short of what the view needs: once the pool is full of pages the cut uses, a
+    // step must read nothing (evicting a used page would coarsen the picture, ask for the page
+    // again and read pages every step without end).
+    const Paged paged = WritePaged(300, 16);
+    const t::io::SplatPageFile file(paged.path);
+    const camera::PinholeCamera cam = CameraAt(0.0);
+    int64_t need = 0;
+    {
+        SplatStreamer unlimited(file, file.NumPages(), file.NumLeaves());
+        Converge(unlimited, cam);
+        need = unlimited.ResidentPages();
+    }
+    ASSERT_GT(need, 3);
+    SplatStreamer streamer(file, need - 1, file.NumLeaves());
+    SplatStreamStep step;
+    for (int i = 0; i < 100 && !step.starved; ++i) step = streamer.Step(SplatCutViewOf(cam), 1);
+    ASSERT_TRUE(step.starved);
+    const int64_t read = streamer.PagesRead();
+    const std::set<int64_t> drawn = Drawn(file, streamer, step);
+    for (int i = 0; i < 5; ++i) {
+        step = streamer.Step(SplatCutViewOf(cam), 1);
+        EXPECT_TRUE(step.starved);
+        EXPECT_GT(step.pages_wanted, 0);
+    }
+    EXPECT_EQ(streamer.PagesRead(), read);
+    EXPECT_EQ(Drawn(file, streamer, step), drawn);
+}
+
+}  // namespace
+}  // namespace tests
+}  // namespace open3d
