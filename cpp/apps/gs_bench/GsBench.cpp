@@ -18,6 +18,7 @@
 
 #include "BenchScenes.h"
 #include "LodBudgets.h"
+#include "StreamBench.h"
 #include "Throughput.h"
 #include "open3d/camera/CamerasJson.h"
 #include "open3d/core/Exception.h"
@@ -52,6 +53,11 @@ struct Options {
     int frames_in_flight = 2;
     std::string lod_budgets;        // --lod-budgets, empty: no level-of-detail rows
     uint64_t max_tile_entries = 0;  // --max-tile-entries, 0: RenderConfig's default
+    std::string stream;             // --stream, empty: no streaming run
+    std::string gpu_budget = "2G";
+    std::string stream_budget;  // empty: what the pool holds
+    int64_t page_capacity = 65536;
+    int64_t reads_per_step = 16;
 };
 
 struct Knob {
@@ -535,7 +541,7 @@ int Run(const Options& opt) {
             opt.reference_max_splats > 0 && job.cloud.NumPoints() <= opt.reference_max_splats;
         t::geometry::SplatHierarchy hierarchy;
         double hierarchy_ms = 0.0;
-        if (!budgets.empty()) {
+        if (!budgets.empty() || !opt.stream.empty()) {
             const auto start = std::chrono::steady_clock::now();
             hierarchy = t::geometry::BuildSplatHierarchy(job.cloud);
             hierarchy_ms = core::MillisecondsSince(start);
@@ -547,6 +553,21 @@ int Run(const Options& opt) {
         }
         auto job_resolutions = resolutions;
         if (job_resolutions.empty()) job_resolutions.push_back(job.native);
+        if (!opt.stream.empty()) {
+            // The first resolution's first view, against the exact render of the whole scene.
+            const camera::PinholeCamera cam =
+                job.cameras(job_resolutions[0].first, job_resolutions[0].second).at(0);
+            const rendering::RenderConfig config = TimedConfig(opt);
+            bench::StreamBenchOptions stream;
+            stream.path = opt.stream;
+            stream.gpu_budget = bench::ParseBytes(opt.gpu_budget);
+            stream.splat_budget =
+                opt.stream_budget.empty() ? 0 : bench::ParseBudgets(opt.stream_budget).at(0);
+            stream.page_capacity = opt.page_capacity;
+            stream.reads_per_step = opt.reads_per_step;
+            bench::RunStreamBench(job.cloud, hierarchy, cam, config,
+                                  backend->Render(cam, config).color, stream);
+        }
         for (const auto& [w, h] : job_resolutions) {
             const auto cams = job.cameras(w, h);
             // Phase 1, the GPU alone: every knob and view is timed before any CPU reference
@@ -788,6 +809,25 @@ int main(int argc, char** argv) {
                    "(RenderConfig::max_tile_entries_total; default 2^26 = 67,108,864; the "
                    "Vulkan sort takes at most 134,215,680)")
         ->check(CLI::Range(uint64_t(1), uint64_t(1) << 40));
+    app.add_option("--stream", opt.stream,
+                   "Write the scene's hierarchy as a paged file here, then stream it back into "
+                   "a GPU pool of --gpu-budget for the first view, rendering after every step: "
+                   "prints the time to the first image and to the converged one and the "
+                   "converged image's error against the exact render (Vulkan; "
+                   "docs/streaming.md)");
+    app.add_option("--gpu-budget", opt.gpu_budget,
+                   "--stream: bytes of the pool's splat storage (K, M, G = powers of 1024)")
+        ->capture_default_str();
+    app.add_option("--stream-budget", opt.stream_budget,
+                   "--stream: splats per cut (k = 1000, M = 1000000; default: what the pool "
+                   "holds)");
+    app.add_option("--page-capacity", opt.page_capacity, "--stream: nodes per page")
+        ->check(CLI::Range(int64_t(8), int64_t(1) << 30))
+        ->capture_default_str();
+    app.add_option("--reads-per-step", opt.reads_per_step,
+                   "--stream: pages read from the file per step (one rendered frame each)")
+        ->check(CLI::Range(int64_t(1), int64_t(1) << 20))
+        ->capture_default_str();
     app.add_option("--reference-max-splats", opt.reference_max_splats,
                    "Skip the CPU reference for scenes larger than this (0: never compare)")
         ->capture_default_str();

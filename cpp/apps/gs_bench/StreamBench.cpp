@@ -1,0 +1,122 @@
+#include "StreamBench.h"
+
+#include <fmt/format.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+
+#include "open3d/core/Exception.h"
+#include "open3d/core/Timer.h"
+#include "open3d/t/geometry/ImageMetrics.h"
+#include "open3d/t/io/SplatPageFile.h"
+#include "open3d/visualization/rendering/gaussian_splat/GaussianSplatDataPacking.h"
+#include "open3d/visualization/rendering/gaussian_splat/SplatStreamer.h"
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/GaussianSplatVulkanBackend.h"
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/VulkanBackendRegistry.h"
+
+namespace open3d {
+namespace bench {
+
+namespace rendering = visualization::rendering;
+
+uint64_t ParseBytes(const std::string& text) {
+    char* end = nullptr;
+    const double value = std::strtod(text.c_str(), &end);
+    double unit = 1.0;
+    const std::string suffix = end ? std::string(end) : "";
+    if (suffix == "K" || suffix == "k")
+        unit = 1024.0;
+    else if (suffix == "M")
+        unit = 1024.0 * 1024.0;
+    else if (suffix == "G")
+        unit = 1024.0 * 1024.0 * 1024.0;
+    else if (suffix == "T")
+        unit = 1024.0 * 1024.0 * 1024.0 * 1024.0;
+    else if (!suffix.empty())
+        unit = -1.0;
+    if (text.empty() || end == text.c_str() || unit < 0 || !(value > 0) ||
+        !std::isfinite(value * unit) || value * unit > 1.8e19) {
+        core::ThrowError("'{}' is not a size in bytes (for example 2G, 512M, 1.5G, 123456)", text);
+    }
+    return static_cast<uint64_t>(value * unit);
+}
+
+void RunStreamBench(const t::geometry::PointCloud& scene,
+                    const t::geometry::SplatHierarchy& hierarchy,
+                    const camera::PinholeCamera& camera, const rendering::RenderConfig& config,
+                    const t::geometry::Image& exact, const StreamBenchOptions& options) {
+    {
+        const auto start = std::chrono::steady_clock::now();
+        t::io::WriteSplatPages(options.path, scene, hierarchy, options.page_capacity);
+        std::printf("stream: wrote %s (%lld nodes, pages of %lld) in %.0f ms\n",
+                    options.path.c_str(), static_cast<long long>(hierarchy.NumNodes()),
+                    static_cast<long long>(options.page_capacity), core::MillisecondsSince(start));
+    }
+    // The backend exists before the load starts, as in a viewer that opens a scene.
+    auto made = rendering::CreateGaussianSplatBackend("vulkan");
+    auto* backend = dynamic_cast<rendering::vulkan::GaussianSplatVulkanBackend*>(made.get());
+    if (backend == nullptr) core::ThrowError("--stream needs the Vulkan backend");
+
+    const auto start = std::chrono::steady_clock::now();
+    const t::io::SplatPageFile file(options.path);
+    // Pool slots from the budget: the bytes a packed splat takes on the GPU (positions,
+    // shape and SH words, its visibility bit), as the pool's first page packs.
+    const double bytes_per_splat =
+        rendering::PackGaussianSplatAttrs(file.ReadSplats(0)).BytesPerSplat() + 1.0 / 8.0;
+    const int64_t pool_pages = static_cast<int64_t>(
+        double(options.gpu_budget) / (bytes_per_splat * double(file.PageCapacity())));
+    if (pool_pages < 1) {
+        core::ThrowError("--gpu-budget {} bytes holds no page of {} splats ({:.0f} bytes each)",
+                         options.gpu_budget, file.PageCapacity(), bytes_per_splat);
+    }
+    const int64_t pool_splats = pool_pages * file.PageCapacity();
+    const int64_t budget = options.splat_budget > 0 ? options.splat_budget : pool_splats;
+    rendering::SplatStreamer streamer(file, pool_pages, budget);
+    backend->SetScenePool(pool_splats, file.ShDegree(), file.CenterMin(), file.CenterMax());
+    std::printf(
+        "stream: %s, %.2f GB on disk, %lld pages; pool %lld pages = %lld splats = %.2f GB "
+        "(%.0f bytes a splat), cut budget %lld\n",
+        options.path.c_str(), file.FileBytes() / 1e9, static_cast<long long>(file.NumPages()),
+        static_cast<long long>(pool_pages), static_cast<long long>(pool_splats),
+        pool_splats * bytes_per_splat / 1e9, bytes_per_splat, static_cast<long long>(budget));
+
+    double first_ms = -1.0, last_print = -1.0;
+    rendering::SplatStreamStep step;
+    rendering::RenderOutput frame;
+    int steps = 0;
+    for (; steps < 100000; ++steps) {
+        step = streamer.Step(rendering::SplatCutViewOf(camera), options.reads_per_step);
+        backend->ApplyStreamStep(step);
+        frame = backend->Render(camera, config);
+        const double ms = core::MillisecondsSince(start);
+        if (first_ms < 0) first_ms = ms;
+        const bool done = step.pages_wanted == 0 || (step.starved && step.writes.empty());
+        if (done || ms - last_print >= 250.0 || steps == 0) {
+            last_print = ms;
+            std::printf(
+                "stream step %d at %.0f ms: %lld pages in the pool, %lld read (%.2f GB), %lld "
+                "evicted, cut %lld nodes, %lld pages wanted%s, frame %.2f ms GPU\n",
+                steps, ms, static_cast<long long>(streamer.ResidentPages()),
+                static_cast<long long>(streamer.PagesRead()), streamer.BytesRead() / 1e9,
+                static_cast<long long>(streamer.Evictions()),
+                static_cast<long long>(step.cut_nodes), static_cast<long long>(step.pages_wanted),
+                step.starved ? " (pool full)" : "",
+                frame.stats.gpu_project_ms + frame.stats.gpu_sort_ms +
+                    frame.stats.gpu_composite_ms);
+        }
+        if (done) break;
+    }
+    const double converged_ms = core::MillisecondsSince(start);
+    const auto m = t::geometry::ComputeImageErrorMetrics(frame.color, exact, 1.0, 1.0 / 255.0);
+    std::printf(
+        "stream: first image %.0f ms after the load started, converged after %d steps in %.0f "
+        "ms (%.2f GB read, %.0f MB/s); converged image against the exact render: %.1f dB, max "
+        "%.3g, %.2f%% of pixels > 1/255\n",
+        first_ms, steps + 1, converged_ms, streamer.BytesRead() / 1e9,
+        streamer.BytesRead() / 1e6 / (converged_ms / 1e3), m.psnr_db, m.max_abs_error,
+        100.0 * m.fraction_over_threshold);
+}
+
+}  // namespace bench
+}  // namespace open3d
