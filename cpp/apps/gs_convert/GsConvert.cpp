@@ -18,6 +18,7 @@
 #include "open3d/t/io/OutputFiles.h"
 #include "open3d/t/io/PointCloudIO.h"
 #include "open3d/t/io/SplatHierarchyIO.h"
+#include "open3d/t/io/SplatPageFile.h"
 
 namespace {
 
@@ -60,7 +61,8 @@ private:
 int main(int argc, char** argv) {
     using namespace open3d;
     std::string input, output;
-    bool drop_non_finite = false, force = false, no_progress = false, lod = false;
+    bool drop_non_finite = false, force = false, no_progress = false, lod = false, pages = false;
+    int64_t page_capacity = 65536;
     CLI::App app{
         "gs-convert: converts a Gaussian splat scene between file formats.\n"
         "Reads .ply, .compressed.ply, .splat, .spz, .sog (or a SOG folder / its meta.json),\n"
@@ -76,10 +78,17 @@ int main(int argc, char** argv) {
         ->required();
     app.add_flag("--drop-non-finite", drop_non_finite,
                  "Drop splats with NaN or Inf values instead of refusing the file");
-    app.add_flag("-f,--force", force, "Overwrite the output (and its .lod) if it exists");
+    app.add_flag("-f,--force", force,
+                 "Overwrite the output (and its .lod and .gspages) if it exists");
     app.add_flag("--lod", lod,
                  "Also build the level-of-detail hierarchy (docs/lod.md) and write it beside "
                  "the output as <output>.lod");
+    app.add_flag("--pages", pages,
+                 "Also write the scene and its hierarchy as a paged file for streaming "
+                 "(docs/streaming.md) beside the output as <output>.gspages");
+    app.add_option("--page-capacity", page_capacity, "--pages: nodes per page")
+        ->check(CLI::Range(int64_t(8), int64_t(1) << 30))
+        ->capture_default_str();
     app.add_flag("--no-progress", no_progress,
                  "No progress bar (drawn on a terminal for conversions longer than 0.3 s: "
                  "reading, decoding, clustering and compressing as they happen)");
@@ -89,10 +98,12 @@ int main(int argc, char** argv) {
         // at once, not after a large scene has been decoded.
         t::io::PointCloudFileFormatForWriting(output);
         t::io::CheckOutputPath("output", output);
-        const std::string lod_path = output + ".lod";
+        const std::string lod_path = output + ".lod", pages_path = output + ".gspages";
+        std::vector<std::string> outputs = {output};
+        if (lod) outputs.push_back(lod_path);
+        if (pages) outputs.push_back(pages_path);
         std::error_code ec;
-        for (const std::string& path :
-             lod ? std::vector<std::string>{output, lod_path} : std::vector<std::string>{output}) {
+        for (const std::string& path : outputs) {
             if (!force && std::filesystem::exists(path, ec)) {
                 core::ThrowError("'{}' exists; pass --force to overwrite it", path);
             }
@@ -114,19 +125,22 @@ int main(int argc, char** argv) {
                     t::io::PointCloudFileFormatName(format),
                     static_cast<long long>(report.num_points),
                     cloud.IsGaussianSplat() ? cloud.GetGaussianSplatArrays().sh_degree : 0);
-        if (lod && !cloud.IsGaussianSplat()) {
-            core::ThrowError("--lod: '{}' holds points without Gaussian attributes", input);
+        if ((lod || pages) && !cloud.IsGaussianSplat()) {
+            core::ThrowError("{}: '{}' holds points without Gaussian attributes",
+                             lod ? "--lod" : "--pages", input);
         }
         // Written beside the output and renamed when complete: a failed write leaves no
         // partial file, and --force onto the input never truncates what is being read.
         t::io::OutputFileSet files;
         t::io::WritePointCloud(files.Add(output), cloud);
         int64_t lod_nodes = 0;
-        if (lod) {
+        if (lod || pages) {
             // Built from the cloud as read: a lossy output format's splats differ slightly
-            // from the leaves it was built on.
+            // from the leaves it was built on (the paged file holds the leaves themselves).
             const t::geometry::SplatHierarchy hierarchy = t::geometry::BuildSplatHierarchy(cloud);
-            t::io::WriteSplatHierarchy(files.Add(lod_path), hierarchy);
+            if (lod) t::io::WriteSplatHierarchy(files.Add(lod_path), hierarchy);
+            if (pages)
+                t::io::WriteSplatPages(files.Add(pages_path), cloud, hierarchy, page_capacity);
             lod_nodes = hierarchy.NumInner();
         }
         files.Commit();
@@ -139,6 +153,14 @@ int main(int argc, char** argv) {
             std::printf("wrote %s (%lld inner nodes over %lld splats)\n", lod_path.c_str(),
                         static_cast<long long>(lod_nodes),
                         static_cast<long long>(report.num_points));
+        }
+        if (pages) {
+            const t::io::SplatPageFile paged(pages_path);
+            std::printf("wrote %s (%lld nodes in %lld pages of up to %lld, %llu bytes)\n",
+                        pages_path.c_str(), static_cast<long long>(paged.NumNodes()),
+                        static_cast<long long>(paged.NumPages()),
+                        static_cast<long long>(page_capacity),
+                        static_cast<unsigned long long>(paged.FileBytes()));
         }
     } catch (const core::Open3DError& e) {
         std::fprintf(stderr, "gs-convert: error: %s\n", e.what());
