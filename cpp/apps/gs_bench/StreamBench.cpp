@@ -84,7 +84,9 @@ void RunStreamBench(const t::geometry::PointCloud& scene,
         static_cast<long long>(pool_pages), static_cast<long long>(pool_splats),
         pool_splats * bytes_per_splat / 1e9, bytes_per_splat, static_cast<long long>(budget));
 
-    double first_ms = -1.0, last_print = -1.0;
+    std::printf("stream: pool ready %.0f ms after the load started\n",
+                core::MillisecondsSince(start));
+    double first_ms = -1.0, first_db = 0.0, last_print = -1.0;
     rendering::SplatStreamStep step;
     rendering::RenderOutput frame;
     int steps = 0;
@@ -95,18 +97,24 @@ void RunStreamBench(const t::geometry::PointCloud& scene,
         backend->ApplyStreamStep(step);
         frame = backend->Render(camera, config);
         const double ms = core::MillisecondsSince(start);
-        if (first_ms < 0) first_ms = ms;
+        if (first_ms < 0) {
+            first_ms = ms;
+            first_db =
+                t::geometry::ComputeImageErrorMetrics(frame.color, exact, 1.0, 1.0 / 255.0).psnr_db;
+        }
         const bool done = step.pages_wanted == 0 || (step.starved && step.writes.empty());
         if (done || ms - last_print >= 250.0 || steps == 0) {
             last_print = ms;
             std::printf(
                 "stream step %d at %.0f ms: %lld pages in the pool, %lld read (%.2f GB), %lld "
-                "evicted, cut %lld nodes, %lld pages wanted%s, frame %.2f ms GPU\n",
+                "evicted, cut %lld nodes (%.0f ms), %lld pages wanted%s, read %.0f ms, frame "
+                "%.2f ms GPU\n",
                 steps, ms, static_cast<long long>(streamer.ResidentPages()),
                 static_cast<long long>(streamer.PagesRead()), streamer.BytesRead() / 1e9,
                 static_cast<long long>(streamer.Evictions()),
-                static_cast<long long>(step.cut_nodes), static_cast<long long>(step.pages_wanted),
-                step.starved ? " (pool full)" : "",
+                static_cast<long long>(step.cut_nodes), step.cut_ms,
+                static_cast<long long>(step.pages_wanted), step.starved ? " (pool full)" : "",
+                step.read_ms,
                 frame.stats.gpu_project_ms + frame.stats.gpu_sort_ms +
                     frame.stats.gpu_composite_ms);
         }
@@ -115,10 +123,11 @@ void RunStreamBench(const t::geometry::PointCloud& scene,
     const double converged_ms = core::MillisecondsSince(start);
     const auto m = t::geometry::ComputeImageErrorMetrics(frame.color, exact, 1.0, 1.0 / 255.0);
     std::printf(
-        "stream: first image %.0f ms after the load started, converged after %d steps in %.0f "
+        "stream: first image %.0f ms after the load started (%.1f dB), converged after %d steps "
+        "in %.0f "
         "ms (%.2f GB read, %.0f MB/s); converged image against the exact render: %.1f dB, max "
         "%.3g, %.2f%% of pixels > 1/255\n",
-        first_ms, steps + 1, converged_ms, streamer.BytesRead() / 1e9,
+        first_ms, first_db, steps + 1, converged_ms, streamer.BytesRead() / 1e9,
         streamer.BytesRead() / 1e6 / (converged_ms / 1e3), m.psnr_db, m.max_abs_error,
         100.0 * m.fraction_over_threshold);
 }

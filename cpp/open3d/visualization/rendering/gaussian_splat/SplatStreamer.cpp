@@ -1,9 +1,11 @@
 #include "open3d/visualization/rendering/gaussian_splat/SplatStreamer.h"
 
 #include <algorithm>
+#include <chrono>
 #include <queue>
 
 #include "open3d/core/Exception.h"
+#include "open3d/core/Timer.h"
 
 namespace open3d {
 namespace visualization {
@@ -45,55 +47,78 @@ int64_t SplatStreamer::ResidentPages() const {
 SplatStreamer::Cut SplatStreamer::MakeCut(const t::geometry::SplatCutView& view) {
     // The greedy cut of CutSplatHierarchy (largest projected size opens first, a node whose
     // children do not fit the budget stays whole) over the pages in the pool: a node whose
-    // children's page is not there stays whole too, and asks for that page.
+    // children's page is not there stays whole too, and asks for that page. A budget of at
+    // least the leaves never binds (a cut holds at most every leaf), and then the order in
+    // which nodes open does not matter: a stack replaces the priority queue.
     const Eigen::Matrix3d r = view.world_to_camera.topLeftCorner<3, 3>();
     const Eigen::Vector3d t = view.world_to_camera.topRightCorner<3, 1>();
+    const bool ordered = budget_ < file_.NumLeaves();
+    struct Open {
+        double size;
+        int64_t id, page;
+        bool operator<(const Open& o) const { return size < o.size; }
+    };
+    std::priority_queue<Open> heap;
+    std::vector<Open> stack;
     Cut cut;
-    std::priority_queue<std::pair<double, int64_t>> open;  // (size, node)
-    int64_t count = 0;                                     // nodes drawn and open
-    const auto add = [&](int64_t id, int64_t page) -> bool {
-        const t::io::SplatPageNode& node = Node(id, page);
+    int64_t count = 0;  // nodes drawn and open
+    // Whether `node` is in view; if so, its projected size.
+    const auto in_view = [&](const t::io::SplatPageNode& node, double& size) {
         const Eigen::Vector3d c =
             r * Eigen::Vector3d(node.position[0], node.position[1], node.position[2]) + t;
         if (t::geometry::SplatOutsideView(view, c, node.bound_radius)) return false;
-        if (node.num_children == 0) {
-            cut.drawn.push_back(id);
-        } else {
-            const double radius = node.radius;
-            open.push({view.focal_px * radius / std::max(c.z(), 1e-3 * radius + 1e-30), id});
-        }
+        const double radius = node.radius;
+        size = view.focal_px * radius / std::max(c.z(), 1e-3 * radius + 1e-30);
         return true;
     };
+    const auto add = [&](int64_t id, int64_t page, double size) {
+        ++count;
+        if (Node(id, page).num_children == 0) {
+            cut.drawn.push_back({id, page});
+        } else if (ordered) {
+            heap.push({size, id, page});
+        } else {
+            stack.push_back({size, id, page});
+        }
+    };
     last_used_[0] = step_;
-    count += add(0, 0);
+    if (double size; in_view(Node(0, 0), size)) add(0, 0, size);
     std::vector<double> wanted(file_.NumPages(), -1.0);
     std::vector<int64_t> wanted_pages;
-    while (!open.empty()) {
-        const auto [size, id] = open.top();
-        open.pop();
-        const t::io::SplatPageNode& node = Node(id, file_.PageOfNode(id));
+    while (ordered ? !heap.empty() : !stack.empty()) {
+        Open top;
+        if (ordered) {
+            top = heap.top();
+            heap.pop();
+        } else {
+            top = stack.back();
+            stack.pop_back();
+        }
+        const t::io::SplatPageNode& node = Node(top.id, top.page);
         const int64_t page = file_.PageOfNode(node.first_child);
         if (page_slot_[page] < 0) {
-            cut.drawn.push_back(id);
+            cut.drawn.push_back({top.id, top.page});
             if (wanted[page] < 0) wanted_pages.push_back(page);
-            wanted[page] = std::max(wanted[page], size);
+            wanted[page] = std::max(wanted[page], top.size);
             continue;
         }
         // Children outside the view are dropped, so opening adds the visible ones less one.
-        int64_t visible = 0;
+        double sizes[8];
+        bool visible[8];
+        int64_t num_visible = 0;
         for (uint32_t i = 0; i < node.num_children; ++i) {
-            const t::io::SplatPageNode& child = Node(node.first_child + i, page);
-            const Eigen::Vector3d c =
-                r * Eigen::Vector3d(child.position[0], child.position[1], child.position[2]) + t;
-            visible += !t::geometry::SplatOutsideView(view, c, child.bound_radius);
+            visible[i] = in_view(Node(node.first_child + i, page), sizes[i]);
+            num_visible += visible[i];
         }
-        if (count - 1 + visible > budget_) {
-            cut.drawn.push_back(id);
+        if (count - 1 + num_visible > budget_) {
+            cut.drawn.push_back({top.id, top.page});
             continue;
         }
         last_used_[page] = step_;
-        count -= 1;
-        for (uint32_t i = 0; i < node.num_children; ++i) count += add(node.first_child + i, page);
+        --count;
+        for (uint32_t i = 0; i < node.num_children; ++i) {
+            if (visible[i]) add(node.first_child + i, page, sizes[i]);
+        }
     }
     for (int64_t page : wanted_pages) cut.wanted.push_back({wanted[page], page});
     std::sort(cut.wanted.begin(), cut.wanted.end(), std::greater<>());
@@ -138,23 +163,24 @@ bool SplatStreamer::Load(int64_t page, SplatStreamStep& step) {
 SplatStreamStep SplatStreamer::Step(const t::geometry::SplatCutView& view, int64_t max_reads) {
     ++step_;
     SplatStreamStep step;
+    const auto start = std::chrono::steady_clock::now();
     if (page_slot_[0] < 0) Load(0, step);  // the root: always there, never evicted
-    Cut cut = MakeCut(view);
-    int64_t reads = 0;
+    const Cut cut = MakeCut(view);
+    step.cut_ms = core::MillisecondsSince(start);
+    // The pages read now show from the next step's cut on: one cut per step, since a cut of
+    // millions of nodes takes as long as reading several pages.
     for (const auto& [priority, page] : cut.wanted) {
-        if (reads >= max_reads) break;
+        if (int64_t(step.writes.size()) >= max_reads) break;
         if (!Load(page, step)) {
             step.starved = true;
             break;
         }
-        ++reads;
     }
-    if (reads > 0) cut = MakeCut(view);
+    step.read_ms = core::MillisecondsSince(start) - step.cut_ms;
     step.pages_wanted = static_cast<int64_t>(cut.wanted.size());
     step.cut_nodes = static_cast<int64_t>(cut.drawn.size());
     step.visibility.assign((PoolSplats() + 31) / 32, 0u);
-    for (int64_t id : cut.drawn) {
-        const int64_t page = file_.PageOfNode(id);
+    for (const auto& [id, page] : cut.drawn) {
         const int64_t s =
             page_slot_[page] * file_.PageCapacity() + (id - file_.Page(page).first_node);
         step.visibility[s / 32] |= 1u << (s % 32);

@@ -37,9 +37,12 @@ struct SplatStreamStep {
     std::vector<uint32_t> visibility;  ///< [PoolSplats() / 32]: bit s shows pool slot s
     int64_t cut_nodes = 0;             ///< nodes drawn
     int64_t pages_evicted = 0;         ///< pages whose slots this step reused
-    /// Pages the cut would open into next that are not in the pool after this step; 0 when
-    /// the cut is what unlimited memory would give for this view and budget.
+    /// Pages this step's cut would open into and did not have (those read by this step
+    /// show from the next step's cut on); 0 when the cut is what unlimited memory would give
+    /// for this view and budget.
     int64_t pages_wanted = 0;
+    double cut_ms = 0.0;   ///< host time of the cut
+    double read_ms = 0.0;  ///< host time of reading and checking the pages
     /// A wanted page found no slot: every slot holds a page this view's cut uses.
     bool starved = false;
 };
@@ -55,8 +58,10 @@ public:
     int64_t PoolSplats() const { return pool_pages_ * file_.PageCapacity(); }
     int64_t PoolPages() const { return pool_pages_; }
 
-    /// Cuts for `view`, reads up to `max_reads` wanted pages (the root's page is read on the
-    /// first step whatever `max_reads` is), cuts again with them and returns the changes.
+    /// Cuts for `view` over the pages in the pool and reads up to `max_reads` of the pages
+    /// that cut wants, largest projected node first (the root's page is read on the first
+    /// step whatever `max_reads` is). Returns the pages to write and the cut's mask; the pages
+    /// read show from the next step on.
     SplatStreamStep Step(const t::geometry::SplatCutView& view, int64_t max_reads);
 
     int64_t ResidentPages() const;
@@ -69,7 +74,7 @@ public:
 
 private:
     struct Cut {
-        std::vector<int64_t> drawn;                      // node ids
+        std::vector<std::pair<int64_t, int64_t>> drawn;  // (node id, its page)
         std::vector<std::pair<double, int64_t>> wanted;  // (priority, page) not in the pool
     };
     Cut MakeCut(const t::geometry::SplatCutView& view);

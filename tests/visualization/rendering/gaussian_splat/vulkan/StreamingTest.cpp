@@ -163,6 +163,15 @@ TEST_F(Streaming, WritesOutsideThePoolOrOfAnotherDegreeAreRefused) {
     EXPECT_THROW(backend->WriteSceneSplats(0, scene), core::Open3DError);
     EXPECT_THROW(backend->SetScenePool(0, 1, Eigen::Vector3d::Zero(), Eigen::Vector3d::Ones()),
                  core::Open3DError);
+    // The pool has no host copy to re-pack at half precision.
+    camera::PinholeCamera cam;
+    cam.width = cam.height = 16;
+    cam.fx = cam.fy = 16.0;
+    cam.cx = cam.cy = 7.5;
+    RenderConfig compact;
+    compact.compact_storage = true;
+    EXPECT_NO_THROW(backend->Render(cam, {}));
+    EXPECT_THROW(backend->Render(cam, compact), core::Open3DError);
 }
 
 }  // namespace

@@ -96,43 +96,87 @@ void GeometryStageResources::UploadScene(const VulkanContext& context, const Com
     view_ = GeometryStageViewResources();
 }
 
-void GeometryStageResources::WriteSplats(const VulkanContext& context, const CommandPool& pool,
-                                         int64_t first, const PackedGaussianSplats& part) {
-    if (part.precision != layout_.precision || part.sh_degree != layout_.sh_degree ||
-        part.shape_words_per_splat != layout_.shape_words_per_splat ||
-        part.sh_words_per_splat != layout_.sh_words_per_splat) {
-        core::ThrowError("writing splats packed at SH degree {} into a scene packed at {}",
-                         part.sh_degree, layout_.sh_degree);
+void GeometryStageResources::AllocateScene(const VulkanContext& context, const CommandPool& pool,
+                                           const PackedGaussianSplats& like, int64_t capacity) {
+    const uint64_t n = static_cast<uint64_t>(capacity);
+    const auto zeroed = [&](VkDeviceSize bytes, VkBufferUsageFlags extra_usage) {
+        Buffer device(context, std::max<VkDeviceSize>(bytes, 16),
+                      VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | kTransfer | extra_usage,
+                      MemoryUsage::kDevice);
+        SubmitAndWait(context, pool, [&](VkCommandBuffer cmd) {
+            vkCmdFillBuffer(cmd, device.Get(), 0, VK_WHOLE_SIZE, 0u);
+        });
+        return device;
+    };
+    RequireStorageBinding(context, "positions", n * 4 * sizeof(float), n);
+    const VkDeviceSize visibility_bytes = (n + 31) / 32 * 4;
+    RequireStorageBinding(context, "visibility", visibility_bytes, n);
+    positions = zeroed(n * 4 * sizeof(float), 0);
+    shape = zeroed(n * like.shape_words_per_splat * 4, kAddressed);
+    sh = zeroed(n * like.sh_words_per_splat * 4, kAddressed);
+    visibility = zeroed(visibility_bytes, 0);
+    scene_bytes_ =
+        n * (4 * sizeof(float) + 4 * like.shape_words_per_splat + 4 * like.sh_words_per_splat) +
+        visibility_bytes;
+    layout_.precision = like.precision;
+    layout_.num_splats = capacity;
+    layout_.sh_degree = like.sh_degree;
+    layout_.shape_words_per_splat = like.shape_words_per_splat;
+    layout_.sh_words_per_splat = like.sh_words_per_splat;
+    layout_.center_min = like.center_min;
+    layout_.center_max = like.center_max;
+    view_ = GeometryStageViewResources();
+}
+
+void GeometryStageResources::WriteSplats(
+    const VulkanContext& context, const CommandPool& pool,
+    const std::vector<std::pair<int64_t, PackedGaussianSplats>>& parts) {
+    VkDeviceSize total = 0;
+    for (const auto& [first, part] : parts) {
+        if (part.precision != layout_.precision || part.sh_degree != layout_.sh_degree ||
+            part.shape_words_per_splat != layout_.shape_words_per_splat ||
+            part.sh_words_per_splat != layout_.sh_words_per_splat) {
+            core::ThrowError("writing splats packed at SH degree {} into a scene packed at {}",
+                             part.sh_degree, layout_.sh_degree);
+        }
+        if (first < 0 || part.num_splats < 0 || first + part.num_splats > layout_.num_splats) {
+            core::ThrowError("writing splats [{}, {}) into a scene of {} splats", first,
+                             first + part.num_splats, layout_.num_splats);
+        }
+        total += (part.positions.size() + part.shape.size() + part.sh.size()) * 4;
     }
-    if (first < 0 || part.num_splats < 0 || first + part.num_splats > layout_.num_splats) {
-        core::ThrowError("writing splats [{}, {}) into a scene of {} splats", first,
-                         first + part.num_splats, layout_.num_splats);
-    }
-    if (part.num_splats == 0) return;
-    const VkDeviceSize position_bytes = part.positions.size() * sizeof(float);
-    const VkDeviceSize shape_bytes = part.shape.size() * 4;
-    const VkDeviceSize sh_bytes = part.sh.size() * 4;
-    Buffer staging(context, position_bytes + shape_bytes + sh_bytes,
-                   VK_BUFFER_USAGE_TRANSFER_SRC_BIT, MemoryUsage::kHostUpload);
+    if (total == 0) return;
+    // One staging buffer and one submission for every part: a streaming step writes many
+    // pages at once.
+    Buffer staging(context, total, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, MemoryUsage::kHostUpload);
     auto* bytes = static_cast<uint8_t*>(staging.GetMapped());
-    std::memcpy(bytes, part.positions.data(), position_bytes);
-    std::memcpy(bytes + position_bytes, part.shape.data(), shape_bytes);
-    if (sh_bytes > 0) std::memcpy(bytes + position_bytes + shape_bytes, part.sh.data(), sh_bytes);
-    const VkDeviceSize at = static_cast<VkDeviceSize>(first);
+    std::vector<VkBufferCopy> to_positions, to_shape, to_sh;
+    VkDeviceSize at = 0;
+    const auto stage = [&](const void* data, VkDeviceSize size, VkDeviceSize dst,
+                           std::vector<VkBufferCopy>& regions) {
+        if (size == 0) return;
+        std::memcpy(bytes + at, data, size);
+        regions.push_back({at, dst, size});
+        at += size;
+    };
+    for (const auto& [first, part] : parts) {
+        const VkDeviceSize splat = static_cast<VkDeviceSize>(first);
+        stage(part.positions.data(), part.positions.size() * 4, splat * 4 * sizeof(float),
+              to_positions);
+        stage(part.shape.data(), part.shape.size() * 4, splat * part.shape_words_per_splat * 4,
+              to_shape);
+        stage(part.sh.data(), part.sh.size() * 4, splat * part.sh_words_per_splat * 4, to_sh);
+        layout_.center_min = layout_.center_min.cwiseMin(part.center_min);
+        layout_.center_max = layout_.center_max.cwiseMax(part.center_max);
+    }
     SubmitAndWait(context, pool, [&](VkCommandBuffer cmd) {
-        const VkBufferCopy to_positions{0, at * 4 * sizeof(float), position_bytes};
-        vkCmdCopyBuffer(cmd, staging.Get(), positions.Get(), 1, &to_positions);
-        const VkBufferCopy to_shape{position_bytes, at * part.shape_words_per_splat * 4,
-                                    shape_bytes};
-        vkCmdCopyBuffer(cmd, staging.Get(), shape.Get(), 1, &to_shape);
-        if (sh_bytes > 0) {
-            const VkBufferCopy to_sh{position_bytes + shape_bytes, at * part.sh_words_per_splat * 4,
-                                     sh_bytes};
-            vkCmdCopyBuffer(cmd, staging.Get(), sh.Get(), 1, &to_sh);
+        for (const auto& [buffer, regions] :
+             {std::pair{&positions, &to_positions}, {&shape, &to_shape}, {&sh, &to_sh}}) {
+            if (regions->empty()) continue;
+            vkCmdCopyBuffer(cmd, staging.Get(), buffer->Get(), uint32_t(regions->size()),
+                            regions->data());
         }
     });
-    layout_.center_min = layout_.center_min.cwiseMin(part.center_min);
-    layout_.center_max = layout_.center_max.cwiseMax(part.center_max);
 }
 
 void GeometryStageResources::UploadLod(const VulkanContext& context, const CommandPool& pool,

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <functional>
 #include <optional>
+#include <utility>
 #include <vector>
 
 #include "open3d/camera/PinholeCamera.h"
@@ -64,11 +65,17 @@ public:
     /// binding must name a buffer) and keeps the packing's sizes.
     void UploadScene(const VulkanContext& context, const CommandPool& pool,
                      const PackedGaussianSplats& packed);
-    /// Writes `part` (packed like the scene) over splats [first, first + part.num_splats) of
-    /// the uploaded scene, and widens the centre bounds the depth range comes from to hold
-    /// its centres (the streaming pool's page writes). The visibility mask is not touched.
-    void WriteSplats(const VulkanContext& context, const CommandPool& pool, int64_t first,
-                     const PackedGaussianSplats& part);
+    /// Zero-filled buffers for `capacity` splats packed like `like` (its words per splat,
+    /// precision, degree and centre bounds), every splat hidden: a scene whose splats are
+    /// written later (WriteSplats).
+    void AllocateScene(const VulkanContext& context, const CommandPool& pool,
+                       const PackedGaussianSplats& like, int64_t capacity);
+    /// Writes each part (first splat, splats packed like the scene) over splats
+    /// [first, first + num_splats) of the scene in one submission, and widens the centre
+    /// bounds the depth range comes from to hold their centres (the streaming pool's page
+    /// writes). The visibility mask is not touched.
+    void WriteSplats(const VulkanContext& context, const CommandPool& pool,
+                     const std::vector<std::pair<int64_t, PackedGaussianSplats>>& parts);
     /// Uploads the nodes of the hierarchy the scene's splats are (GaussianSplatLodPacking.h);
     /// ClearLod forgets them (a plain scene).
     void UploadLod(const VulkanContext& context, const CommandPool& pool,

@@ -90,6 +90,7 @@ void GaussianSplatVulkanBackend::SetScene(const t::geometry::PointCloud& cloud) 
     if (geometry_.in_flight) Wait(*context_, geometry_stage_fence_.Get());
     geometry_ = GeometryState{};
     cloud_ = cloud;
+    pool_scene_ = false;
     visibility_mask_.clear();
     RetireLod();
     UploadScene(SplatPrecision::kExact);
@@ -113,6 +114,7 @@ void GaussianSplatVulkanBackend::SetSceneHierarchy(const t::geometry::PointCloud
     if (geometry_.in_flight) Wait(*context_, geometry_stage_fence_.Get());
     geometry_ = GeometryState{};
     cloud_ = std::move(nodes);
+    pool_scene_ = false;
     visibility_mask_.clear();
     RetireLod();
     UploadScene(SplatPrecision::kExact);
@@ -122,82 +124,112 @@ void GaussianSplatVulkanBackend::SetSceneHierarchy(const t::geometry::PointCloud
 void GaussianSplatVulkanBackend::SetScenePool(int64_t capacity, int sh_degree,
                                               const Eigen::Vector3d& center_min,
                                               const Eigen::Vector3d& center_max) {
-    if (capacity < 1) core::ThrowError("Vulkan backend: a scene pool of {} splats", capacity);
+    if (capacity < 1 || capacity > int64_t(UINT32_MAX)) {
+        core::ThrowError("Vulkan backend: a scene pool of {} splats (1 to 2^32 - 1)", capacity);
+    }
     if (sh_degree < 0 || sh_degree > 3) {
         core::ThrowError("Vulkan backend: a scene pool of SH degree {}", sh_degree);
     }
-    // Empty slots: unit Gaussians at the bounds' corners (the first at the low one), hidden.
-    std::vector<float> positions(3 * capacity);
-    for (int64_t i = 0; i < capacity; ++i) {
-        const Eigen::Vector3d& at = i == 0 ? center_min : center_max;
-        for (int axis = 0; axis < 3; ++axis) positions[3 * i + axis] = float(at[axis]);
-    }
-    t::geometry::PointCloud pool(core::Tensor::FromVector(positions, {capacity, 3}));
-    pool.SetPointAttr(
-        t::geometry::gs_attr::kScale,
-        core::Tensor::FromVector(std::vector<float>(3 * capacity, 1.0f), {capacity, 3}));
-    std::vector<float> rot(4 * capacity, 0.0f);
-    for (int64_t i = 0; i < capacity; ++i) rot[4 * i] = 1.0f;
-    pool.SetPointAttr(t::geometry::gs_attr::kRot, core::Tensor::FromVector(rot, {capacity, 4}));
-    pool.SetPointAttr(t::geometry::gs_attr::kOpacity,
-                      core::Tensor({capacity, 1}, core::Dtype::Float32));
-    pool.SetPointAttr(t::geometry::gs_attr::kFDc,
-                      core::Tensor({capacity, 3}, core::Dtype::Float32));
+    // The words per splat of that degree, from one packed placeholder splat. The pool's
+    // buffers are zero-filled on the GPU: packing millions of placeholders on the host took
+    // seconds before the first image.
+    t::geometry::PointCloud one(core::Tensor::FromVector(
+        std::vector<float>{float(center_min.x()), float(center_min.y()), float(center_min.z())},
+        {1, 3}));
+    one.SetPointAttr(t::geometry::gs_attr::kScale,
+                     core::Tensor::FromVector(std::vector<float>{1, 1, 1}, {1, 3}));
+    one.SetPointAttr(t::geometry::gs_attr::kRot,
+                     core::Tensor::FromVector(std::vector<float>{1, 0, 0, 0}, {1, 4}));
+    one.SetPointAttr(t::geometry::gs_attr::kOpacity, core::Tensor({1, 1}, core::Dtype::Float32));
+    one.SetPointAttr(t::geometry::gs_attr::kFDc, core::Tensor({1, 3}, core::Dtype::Float32));
     if (sh_degree > 0) {
         const int64_t rest = (sh_degree + 1) * (sh_degree + 1) - 1;
-        pool.SetPointAttr(t::geometry::gs_attr::kFRest,
-                          core::Tensor({capacity, rest, 3}, core::Dtype::Float32));
+        one.SetPointAttr(t::geometry::gs_attr::kFRest,
+                         core::Tensor({1, rest, 3}, core::Dtype::Float32));
     }
-    SetScene(pool);
-    SetVisibility(std::vector<uint32_t>((capacity + 31) / 32, 0u));
+    PackedGaussianSplats like = PackGaussianSplatAttrs(one, SplatPrecision::kExact);
+    like.center_min = center_min;
+    like.center_max = center_max;
+    if (geometry_.in_flight) Wait(*context_, geometry_stage_fence_.Get());
+    geometry_ = GeometryState{};
+    RetireLod();
+    RetireSceneBuffers(false);
+    ++scene_serial_;
+    geometry_stage_resources_.AllocateScene(*context_, pool_, like, capacity);
+    cloud_ = t::geometry::PointCloud();  // no host copy: the pages are on disk
+    pool_scene_ = true;
+    visibility_mask_.assign((capacity + 31) / 32, 0u);
+    ++counters_.scene_uploads;
 }
 
 void GaussianSplatVulkanBackend::WriteSceneSplats(int64_t first,
                                                   const t::geometry::PointCloud& splats) {
+    WriteSceneSplatRanges({{first, &splats}});
+}
+
+void GaussianSplatVulkanBackend::WriteSceneSplatRanges(
+    const std::vector<std::pair<int64_t, const t::geometry::PointCloud*>>& ranges) {
     if (!cloud_) core::ThrowError("Vulkan backend: WriteSceneSplats before SetScene");
     if (geometry_stage_resources_.HasLod()) {
         core::ThrowError(
             "Vulkan backend: a scene drawn through its hierarchy takes no splat writes");
     }
-    splats.ValidateGaussianSplat();
-    const int64_t n = splats.NumPoints();
-    if (first < 0 || first + n > cloud_->NumPoints()) {
-        core::ThrowError("Vulkan backend: writing splats [{}, {}) into a scene of {}", first,
-                         first + n, cloud_->NumPoints());
-    }
-    const int degree = cloud_->GetGaussianSplatArrays().sh_degree;
-    if (splats.GetGaussianSplatArrays().sh_degree != degree) {
-        core::ThrowError("Vulkan backend: writing splats of SH degree {} into a scene of degree {}",
-                         splats.GetGaussianSplatArrays().sh_degree, degree);
-    }
-    for (const std::string& name : cloud_->GetPointAttrNames()) {
-        const core::Tensor& to = cloud_->GetPointAttr(name);
-        const core::Tensor& from = splats.GetPointAttr(name);  // throws when absent
-        if (from.NumBytes() != n * (to.NumBytes() / cloud_->NumPoints()) ||
-            from.GetDtype() != to.GetDtype()) {
+    const int64_t scene_splats = geometry_stage_resources_.Layout().num_splats;
+    const int degree = geometry_stage_resources_.Layout().sh_degree;
+    // A plain scene keeps its host copy (re-packed when the storage precision changes) in
+    // step; a pool has none.
+    const bool host_copy = !pool_scene_;
+    for (const auto& [first, cloud] : ranges) {
+        const t::geometry::PointCloud& splats = *cloud;
+        splats.ValidateGaussianSplat();
+        const int64_t n = splats.NumPoints();
+        if (first < 0 || first + n > scene_splats) {
+            core::ThrowError("Vulkan backend: writing splats [{}, {}) into a scene of {}", first,
+                             first + n, scene_splats);
+        }
+        if (splats.GetGaussianSplatArrays().sh_degree != degree) {
             core::ThrowError(
-                "Vulkan backend: the written splats' {} is not shaped like the scene's", name);
+                "Vulkan backend: writing splats of SH degree {} into a scene of degree {}",
+                splats.GetGaussianSplatArrays().sh_degree, degree);
+        }
+        if (!host_copy) continue;
+        for (const std::string& name : cloud_->GetPointAttrNames()) {
+            const core::Tensor& to = cloud_->GetPointAttr(name);
+            const core::Tensor& from = splats.GetPointAttr(name);  // throws when absent
+            if (from.NumBytes() != n * (to.NumBytes() / cloud_->NumPoints()) ||
+                from.GetDtype() != to.GetDtype()) {
+                core::ThrowError(
+                    "Vulkan backend: the written splats' {} is not shaped like the scene's", name);
+            }
         }
     }
     if (geometry_.in_flight) Wait(*context_, geometry_stage_fence_.Get());
     geometry_.in_flight = false;
     WaitAllSlots();  // frames in flight read the buffers written here
-    for (const std::string& name : cloud_->GetPointAttrNames()) {
-        core::Tensor& to = cloud_->GetPointAttr(name);
-        const core::Tensor& from = splats.GetPointAttr(name);
-        const int64_t row = to.NumBytes() / cloud_->NumPoints();
-        std::memcpy(static_cast<uint8_t*>(to.RawData()) + first * row, from.RawData(), n * row);
+    std::vector<std::pair<int64_t, PackedGaussianSplats>> packed;
+    for (const auto& [first, cloud] : ranges) {
+        if (host_copy) {
+            for (const std::string& name : cloud_->GetPointAttrNames()) {
+                core::Tensor& to = cloud_->GetPointAttr(name);
+                const core::Tensor& from = cloud->GetPointAttr(name);
+                const int64_t row = to.NumBytes() / cloud_->NumPoints();
+                std::memcpy(static_cast<uint8_t*>(to.RawData()) + first * row, from.RawData(),
+                            cloud->NumPoints() * row);
+            }
+        }
+        packed.emplace_back(
+            first, PackGaussianSplatAttrs(*cloud, geometry_stage_resources_.Layout().precision));
     }
-    geometry_stage_resources_.WriteSplats(
-        *context_, pool_, first,
-        PackGaussianSplatAttrs(splats, geometry_stage_resources_.Layout().precision));
+    geometry_stage_resources_.WriteSplats(*context_, pool_, packed);
     geometry_.valid = false;  // the geometry stage's output is stale
 }
 
 void GaussianSplatVulkanBackend::ApplyStreamStep(const SplatStreamStep& step) {
+    std::vector<std::pair<int64_t, const t::geometry::PointCloud*>> ranges;
     for (const SplatStreamStep::PageWrite& write : step.writes) {
-        WriteSceneSplats(write.first_splat, write.splats);
+        ranges.emplace_back(write.first_splat, &write.splats);
     }
+    if (!ranges.empty()) WriteSceneSplatRanges(ranges);
     SetVisibility(step.visibility);
 }
 

@@ -142,9 +142,10 @@ public:
 
     /// A scene of `capacity` splat slots at SH degree `sh_degree`, every one hidden, whose
     /// splats arrive by WriteSceneSplats and are shown by SetVisibility: the pool a
-    /// SplatStreamer streams a paged file into (docs/streaming.md). The empty slots sit at
-    /// `center_min` and `center_max`, the bounds of every centre that will be written, so the
-    /// depth range holds the whole scene from the start. Throws for a capacity below 1.
+    /// SplatStreamer streams a paged file into (docs/streaming.md). Stored exactly (float32;
+    /// a frame with RenderConfig::compact_storage throws) and kept on the GPU only. The depth
+    /// range starts from `center_min` .. `center_max`, the bounds of every centre that will
+    /// be written. Throws for a capacity outside 1 .. 2^32 - 1 or a degree outside 0..3.
     void SetScenePool(int64_t capacity, int sh_degree, const Eigen::Vector3d& center_min,
                       const Eigen::Vector3d& center_max);
     /// Writes `splats` (valid, of the scene's SH degree) over splats [first, first + n) of the
@@ -233,6 +234,9 @@ private:
     void WarnNewFlags(uint32_t flags);
 
     void UploadScene(SplatPrecision precision);
+    /// WriteSceneSplats of several ranges, checked first, written in one submission.
+    void WriteSceneSplatRanges(
+        const std::vector<std::pair<int64_t, const t::geometry::PointCloud*>>& ranges);
     void EnsureViewBuffers(uint32_t entry_capacity);
     /// Refuses a view size whose images cannot fit in device memory, naming a size that
     /// would (checked before the geometry stage, so nothing is half made).
@@ -252,6 +256,8 @@ private:
 
     // The scene: kept on the CPU to re-pack when the storage precision changes.
     std::optional<t::geometry::PointCloud> cloud_;
+    /// SetScenePool's scene: buffers written page by page, no host copy (cloud_ is empty).
+    bool pool_scene_ = false;
     std::vector<uint32_t> visibility_mask_;
     GeometryStageResources geometry_stage_resources_;
     Buffer counters_readback_;

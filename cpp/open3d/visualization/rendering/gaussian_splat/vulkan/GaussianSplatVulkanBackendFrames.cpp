@@ -172,6 +172,11 @@ void GaussianSplatVulkanBackend::EnsureScenePrecision(const RenderConfig& config
     const SplatPrecision precision =
         config.compact_storage ? SplatPrecision::kCompact : SplatPrecision::kExact;
     if (precision == geometry_stage_resources_.Layout().precision) return;
+    if (pool_scene_) {
+        core::ThrowError(
+            "Vulkan backend: a streamed scene pool is stored exactly (float32); "
+            "RenderConfig::compact_storage is not available for it");
+    }
     if (geometry_.in_flight) Wait(*context_, geometry_stage_fence_.Get());
     geometry_.in_flight = false;
     UploadScene(precision);
