@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <set>
 #include <string>
 #include <vector>
@@ -143,6 +144,31 @@ TEST(SplatStreamer, EvictsWhatTheViewLeftAndReadsItAgain) {
     }
     EXPECT_GT(streamer.Evictions(), 0);
     EXPECT_GT(streamer.PagesRead(), need_a + need_b);  // a's pages were read twice
+}
+
+TEST(SplatStreamer, AStepForTheSameViewCutsAsACutFromTheRoot) {
+    // A step for the view of the step before only opens the nodes that waited for the pages
+    // read since. A second streamer whose view differs in the last bit of the focal length
+    // every other step (sizes scale alike, so it reads the same pages in the same order)
+    // cuts from the root each time: the two must draw the same nodes from the same slots.
+    const Paged paged = WritePaged(300, 16);
+    const t::io::SplatPageFile file(paged.path);
+    const t::geometry::SplatCutView view = SplatCutViewOf(CameraAt(0.0));
+    t::geometry::SplatCutView nudged = view;
+    nudged.focal_px = std::nextafter(view.focal_px, 1e9);
+    SplatStreamer incremental(file, file.NumPages(), file.NumLeaves());
+    SplatStreamer from_root(file, file.NumPages(), file.NumLeaves());
+    int steps = 0;
+    for (; steps < 200; ++steps) {
+        const SplatStreamStep a = incremental.Step(view, 1);
+        const SplatStreamStep b = from_root.Step(steps % 2 ? view : nudged, 1);
+        ASSERT_EQ(a.visibility, b.visibility) << "step " << steps;
+        ASSERT_EQ(incremental.SlotPages(), from_root.SlotPages()) << "step " << steps;
+        EXPECT_EQ(a.cut_nodes, b.cut_nodes);
+        EXPECT_EQ(a.pages_wanted, b.pages_wanted);
+        if (a.pages_wanted == 0) break;
+    }
+    EXPECT_GT(steps, 10);  // many steps extended the cut
 }
 
 TEST(SplatStreamer, TheCutStaysWithinItsBudget) {

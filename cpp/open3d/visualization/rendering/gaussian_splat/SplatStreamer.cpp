@@ -35,6 +35,9 @@ SplatStreamer::SplatStreamer(const t::io::SplatPageFile& file, int64_t pool_page
         core::ThrowError("SplatStreamer: the splat budget must be >= 1, not {}", splat_budget);
     }
     records_.resize(file.NumPages());
+    waiting_.resize(file.NumPages());
+    waiting_size_.assign(file.NumPages(), -1.0);
+    page_used_.assign(file.NumPages(), 0);
     page_slot_.assign(file.NumPages(), -1);
     slot_page_.assign(pool_pages, -1);
     last_used_.assign(file.NumPages(), 0);
@@ -44,62 +47,79 @@ int64_t SplatStreamer::ResidentPages() const {
     return std::count_if(slot_page_.begin(), slot_page_.end(), [](int64_t p) { return p >= 0; });
 }
 
-SplatStreamer::Cut SplatStreamer::MakeCut(const t::geometry::SplatCutView& view) {
+namespace {
+
+// Whether `node` is in `view`; if so, its projected size (focal x radius / depth, a node
+// nearer than its size counted large), as CutSplatHierarchy measures it.
+bool InView(const t::geometry::SplatCutView& view, const t::io::SplatPageNode& node, double& size) {
+    const Eigen::Vector3d p(node.position[0], node.position[1], node.position[2]);
+    const Eigen::Vector3d c = view.world_to_camera.topLeftCorner<3, 3>() * p +
+                              view.world_to_camera.topRightCorner<3, 1>();
+    if (t::geometry::SplatOutsideView(view, c, node.bound_radius)) return false;
+    const double radius = node.radius;
+    size = view.focal_px * radius / std::max(c.z(), 1e-3 * radius + 1e-30);
+    return true;
+}
+
+bool SameView(const t::geometry::SplatCutView& a, const t::geometry::SplatCutView& b) {
+    return a.world_to_camera == b.world_to_camera && a.focal_px == b.focal_px &&
+           a.width == b.width && a.height == b.height && a.fx == b.fx && a.fy == b.fy &&
+           a.cx == b.cx && a.cy == b.cy;
+}
+
+}  // namespace
+
+void SplatStreamer::ClearCut() {
+    drawn_.clear();
+    opened_since_cut_ = 0;
+    for (int64_t page : waiting_pages_) {
+        waiting_[page].clear();
+        waiting_size_[page] = -1.0;
+    }
+    waiting_pages_.clear();
+    for (int64_t page : used_pages_) page_used_[page] = 0;
+    used_pages_.clear();
+    UsePage(0);
+}
+
+void SplatStreamer::UsePage(int64_t page) {
+    if (page_used_[page]) return;
+    page_used_[page] = 1;
+    used_pages_.push_back(page);
+}
+
+void SplatStreamer::DrawWaiting(int64_t id, int64_t page, int64_t wanted, double size) {
+    drawn_.push_back({id, page});
+    if (waiting_[wanted].empty()) waiting_pages_.push_back(wanted);
+    waiting_[wanted].push_back(static_cast<int64_t>(drawn_.size()) - 1);
+    waiting_size_[wanted] = std::max(waiting_size_[wanted], size);
+}
+
+void SplatStreamer::OrderedCut(const t::geometry::SplatCutView& view) {
     // The greedy cut of CutSplatHierarchy (largest projected size opens first, a node whose
     // children do not fit the budget stays whole) over the pages in the pool: a node whose
-    // children's page is not there stays whole too, and asks for that page. A budget of at
-    // least the leaves never binds (a cut holds at most every leaf), and then the order in
-    // which nodes open does not matter: a stack replaces the priority queue.
-    const Eigen::Matrix3d r = view.world_to_camera.topLeftCorner<3, 3>();
-    const Eigen::Vector3d t = view.world_to_camera.topRightCorner<3, 1>();
-    const bool ordered = budget_ < file_.NumLeaves();
-    struct Open {
-        double size;
-        int64_t id, page;
-        bool operator<(const Open& o) const { return size < o.size; }
-    };
-    std::priority_queue<Open> heap;
-    std::vector<Open> stack;
-    Cut cut;
+    // children's page is not there stays whole too, and waits for that page.
+    ClearCut();
+    have_cut_ = false;
+    arrived_.clear();
+    std::priority_queue<Open> open;
     int64_t count = 0;  // nodes drawn and open
-    // Whether `node` is in view; if so, its projected size.
-    const auto in_view = [&](const t::io::SplatPageNode& node, double& size) {
-        const Eigen::Vector3d c =
-            r * Eigen::Vector3d(node.position[0], node.position[1], node.position[2]) + t;
-        if (t::geometry::SplatOutsideView(view, c, node.bound_radius)) return false;
-        const double radius = node.radius;
-        size = view.focal_px * radius / std::max(c.z(), 1e-3 * radius + 1e-30);
-        return true;
-    };
     const auto add = [&](int64_t id, int64_t page, double size) {
         ++count;
         if (Node(id, page).num_children == 0) {
-            cut.drawn.push_back({id, page});
-        } else if (ordered) {
-            heap.push({size, id, page});
+            drawn_.push_back({id, page});
         } else {
-            stack.push_back({size, id, page});
+            open.push({size, id, page});
         }
     };
-    last_used_[0] = step_;
-    if (double size; in_view(Node(0, 0), size)) add(0, 0, size);
-    std::vector<double> wanted(file_.NumPages(), -1.0);
-    std::vector<int64_t> wanted_pages;
-    while (ordered ? !heap.empty() : !stack.empty()) {
-        Open top;
-        if (ordered) {
-            top = heap.top();
-            heap.pop();
-        } else {
-            top = stack.back();
-            stack.pop_back();
-        }
+    if (double size; InView(view, Node(0, 0), size)) add(0, 0, size);
+    while (!open.empty()) {
+        const Open top = open.top();
+        open.pop();
         const t::io::SplatPageNode& node = Node(top.id, top.page);
         const int64_t page = file_.PageOfNode(node.first_child);
         if (page_slot_[page] < 0) {
-            cut.drawn.push_back({top.id, top.page});
-            if (wanted[page] < 0) wanted_pages.push_back(page);
-            wanted[page] = std::max(wanted[page], top.size);
+            DrawWaiting(top.id, top.page, page, top.size);
             continue;
         }
         // Children outside the view are dropped, so opening adds the visible ones less one.
@@ -107,22 +127,80 @@ SplatStreamer::Cut SplatStreamer::MakeCut(const t::geometry::SplatCutView& view)
         bool visible[8];
         int64_t num_visible = 0;
         for (uint32_t i = 0; i < node.num_children; ++i) {
-            visible[i] = in_view(Node(node.first_child + i, page), sizes[i]);
+            visible[i] = InView(view, Node(node.first_child + i, page), sizes[i]);
             num_visible += visible[i];
         }
         if (count - 1 + num_visible > budget_) {
-            cut.drawn.push_back({top.id, top.page});
+            drawn_.push_back({top.id, top.page});
             continue;
         }
-        last_used_[page] = step_;
+        UsePage(page);
         --count;
         for (uint32_t i = 0; i < node.num_children; ++i) {
             if (visible[i]) add(node.first_child + i, page, sizes[i]);
         }
     }
-    for (int64_t page : wanted_pages) cut.wanted.push_back({wanted[page], page});
-    std::sort(cut.wanted.begin(), cut.wanted.end(), std::greater<>());
-    return cut;
+}
+
+void SplatStreamer::Expand(const t::geometry::SplatCutView& view, std::vector<Open>& stack) {
+    while (!stack.empty()) {
+        const Open top = stack.back();
+        stack.pop_back();
+        const t::io::SplatPageNode& node = Node(top.id, top.page);
+        const int64_t page = file_.PageOfNode(node.first_child);
+        if (page_slot_[page] < 0) {
+            DrawWaiting(top.id, top.page, page, top.size);
+            continue;
+        }
+        UsePage(page);
+        for (uint32_t i = 0; i < node.num_children; ++i) {
+            const int64_t child = node.first_child + i;
+            double size;
+            if (!InView(view, Node(child, page), size)) continue;  // nothing below it is seen
+            if (Node(child, page).num_children == 0) {
+                drawn_.push_back({child, page});
+            } else {
+                stack.push_back({size, child, page});
+            }
+        }
+    }
+}
+
+void SplatStreamer::UnorderedCut(const t::geometry::SplatCutView& view) {
+    // A budget of at least the leaves never binds (a cut holds at most every leaf), so the
+    // order in which nodes open does not matter, and a step for the same view as the last one
+    // only opens the nodes that waited for the pages read since: the cut's cost follows what
+    // arrived, not the cut's size (8M nodes took 4 s to cut again from the root).
+    std::vector<Open> stack;
+    if (!have_cut_ || !SameView(view, cut_view_)) {
+        ClearCut();
+        if (double size; InView(view, Node(0, 0), size)) {
+            if (Node(0, 0).num_children == 0) {
+                drawn_.push_back({0, 0});
+            } else {
+                stack.push_back({size, 0, 0});
+            }
+        }
+        have_cut_ = true;
+        cut_view_ = view;
+    } else {
+        for (int64_t page : arrived_) {
+            if (page_slot_[page] < 0) continue;  // read, then evicted unused
+            for (int64_t index : waiting_[page]) {
+                auto& [id, node_page] = drawn_[index];
+                if (id < 0) continue;
+                stack.push_back({waiting_size_[page], id, node_page});
+                id = -1;
+                ++opened_since_cut_;
+            }
+            waiting_[page].clear();
+            waiting_size_[page] = -1.0;
+        }
+    }
+    arrived_.clear();
+    Expand(view, stack);
+    // Drawn entries opened since the cut from the root: dropped once they are half.
+    if (opened_since_cut_ * 2 > static_cast<int64_t>(drawn_.size())) have_cut_ = false;
 }
 
 bool SplatStreamer::Load(int64_t page, SplatStreamStep& step) {
@@ -153,6 +231,7 @@ bool SplatStreamer::Load(int64_t page, SplatStreamStep& step) {
     step.writes.push_back(std::move(write));
     slot_page_[slot] = page;
     page_slot_[page] = slot;
+    arrived_.push_back(page);
     // Read this step: not evicted again before the next step's cut has had a chance to use it.
     last_used_[page] = step_;
     ++pages_read_;
@@ -165,11 +244,25 @@ SplatStreamStep SplatStreamer::Step(const t::geometry::SplatCutView& view, int64
     SplatStreamStep step;
     const auto start = std::chrono::steady_clock::now();
     if (page_slot_[0] < 0) Load(0, step);  // the root: always there, never evicted
-    const Cut cut = MakeCut(view);
+    if (budget_ < file_.NumLeaves()) {
+        OrderedCut(view);
+    } else {
+        UnorderedCut(view);
+    }
+    for (int64_t page : used_pages_) last_used_[page] = step_;
+    std::vector<std::pair<double, int64_t>> wanted;
+    std::vector<int64_t> still_waiting;
+    for (int64_t page : waiting_pages_) {
+        if (waiting_[page].empty()) continue;
+        still_waiting.push_back(page);
+        wanted.push_back({waiting_size_[page], page});
+    }
+    waiting_pages_.swap(still_waiting);
+    std::sort(wanted.begin(), wanted.end(), std::greater<>());
     step.cut_ms = core::MillisecondsSince(start);
     // The pages read now show from the next step's cut on: one cut per step, since a cut of
-    // millions of nodes takes as long as reading several pages.
-    for (const auto& [priority, page] : cut.wanted) {
+    // millions of nodes takes as long as reading many pages.
+    for (const auto& [priority, page] : wanted) {
         if (int64_t(step.writes.size()) >= max_reads) break;
         if (!Load(page, step)) {
             step.starved = true;
@@ -177,13 +270,14 @@ SplatStreamStep SplatStreamer::Step(const t::geometry::SplatCutView& view, int64
         }
     }
     step.read_ms = core::MillisecondsSince(start) - step.cut_ms;
-    step.pages_wanted = static_cast<int64_t>(cut.wanted.size());
-    step.cut_nodes = static_cast<int64_t>(cut.drawn.size());
+    step.pages_wanted = static_cast<int64_t>(wanted.size());
     step.visibility.assign((PoolSplats() + 31) / 32, 0u);
-    for (const auto& [id, page] : cut.drawn) {
+    for (const auto& [id, page] : drawn_) {
+        if (id < 0) continue;
         const int64_t s =
             page_slot_[page] * file_.PageCapacity() + (id - file_.Page(page).first_node);
         step.visibility[s / 32] |= 1u << (s % 32);
+        ++step.cut_nodes;
     }
     return step;
 }

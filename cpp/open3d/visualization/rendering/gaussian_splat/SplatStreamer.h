@@ -73,11 +73,23 @@ public:
     const std::vector<int64_t>& SlotPages() const { return slot_page_; }
 
 private:
-    struct Cut {
-        std::vector<std::pair<int64_t, int64_t>> drawn;  // (node id, its page)
-        std::vector<std::pair<double, int64_t>> wanted;  // (priority, page) not in the pool
+    struct Open {
+        double size;
+        int64_t id, page;
+        bool operator<(const Open& o) const { return size < o.size; }
     };
-    Cut MakeCut(const t::geometry::SplatCutView& view);
+    /// The ordered cut (a budget below the leaves): from the root, largest node first.
+    void OrderedCut(const t::geometry::SplatCutView& view);
+    /// The unordered cut (a budget that cannot bind): from the root when the view changed or
+    /// there is no cut yet, else only below the nodes that waited for the pages read since.
+    void UnorderedCut(const t::geometry::SplatCutView& view);
+    /// Opens the stack's inner nodes and what lies below them in the pool (unordered).
+    void Expand(const t::geometry::SplatCutView& view, std::vector<Open>& stack);
+    /// Forgets the cut: no node drawn, none waiting, no page used.
+    void ClearCut();
+    /// `id` (of `page`) stays whole: drawn, and waiting for its children's page `wanted`.
+    void DrawWaiting(int64_t id, int64_t page, int64_t wanted, double size);
+    void UsePage(int64_t page);
     const t::io::SplatPageNode& Node(int64_t id, int64_t page) const {
         return records_[page][id - file_.Page(page).first_node];
     }
@@ -96,6 +108,20 @@ private:
     std::vector<uint64_t> last_used_;  // page -> the last step whose cut used it
     uint64_t step_ = 0;
     int64_t pages_read_ = 0, evictions_ = 0;
+
+    // The cut: drawn nodes as (id, page), id -1 once opened by a later step; for each page
+    // not in the pool, the drawn nodes (indices into drawn_) that wait for it and the
+    // largest of their projected sizes; the pages the cut opened into.
+    std::vector<std::pair<int64_t, int64_t>> drawn_;
+    int64_t opened_since_cut_ = 0;  // entries of drawn_ marked -1
+    std::vector<std::vector<int64_t>> waiting_;
+    std::vector<double> waiting_size_;
+    std::vector<int64_t> waiting_pages_;  // pages with waiters (some may have none left)
+    std::vector<int64_t> used_pages_;
+    std::vector<char> page_used_;
+    std::vector<int64_t> arrived_;        // pages read since the last cut
+    bool have_cut_ = false;               // an unordered cut that a step may extend
+    t::geometry::SplatCutView cut_view_;  // the view it was made for
     uint64_t bytes_read_ = 0;
 };
 
