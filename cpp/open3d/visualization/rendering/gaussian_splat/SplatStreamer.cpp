@@ -71,7 +71,6 @@ bool SameView(const t::geometry::SplatCutView& a, const t::geometry::SplatCutVie
 
 void SplatStreamer::ClearCut() {
     drawn_.clear();
-    opened_since_cut_ = 0;
     for (int64_t page : waiting_pages_) {
         waiting_[page].clear();
         waiting_size_[page] = -1.0;
@@ -167,10 +166,9 @@ void SplatStreamer::Expand(const t::geometry::SplatCutView& view, std::vector<Op
 }
 
 void SplatStreamer::UnorderedCut(const t::geometry::SplatCutView& view) {
-    // A budget of at least the leaves never binds (a cut holds at most every leaf), so the
-    // order in which nodes open does not matter, and a step for the same view as the last one
-    // only opens the nodes that waited for the pages read since: the cut's cost follows what
-    // arrived, not the cut's size (8M nodes took 4 s to cut again from the root).
+    // A budget that cannot bind leaves the order in which nodes open free, and a step for the same
+    // view as the last one only opens the nodes that waited for the pages read since: the cut's
+    // cost follows what arrived, not the cut's size (8M nodes took 4 s to cut again from the root).
     std::vector<Open> stack;
     if (!have_cut_ || !SameView(view, cut_view_)) {
         ClearCut();
@@ -191,7 +189,6 @@ void SplatStreamer::UnorderedCut(const t::geometry::SplatCutView& view) {
                 if (id < 0) continue;
                 stack.push_back({waiting_size_[page], id, node_page});
                 id = -1;
-                ++opened_since_cut_;
             }
             waiting_[page].clear();
             waiting_size_[page] = -1.0;
@@ -199,8 +196,6 @@ void SplatStreamer::UnorderedCut(const t::geometry::SplatCutView& view) {
     }
     arrived_.clear();
     Expand(view, stack);
-    // Drawn entries opened since the cut from the root: dropped once they are half.
-    if (opened_since_cut_ * 2 > static_cast<int64_t>(drawn_.size())) have_cut_ = false;
 }
 
 bool SplatStreamer::Load(int64_t page, SplatStreamStep& step) {
@@ -244,7 +239,9 @@ SplatStreamStep SplatStreamer::Step(const t::geometry::SplatCutView& view, int64
     SplatStreamStep step;
     const auto start = std::chrono::steady_clock::now();
     if (page_slot_[0] < 0) Load(0, step);  // the root: always there, never evicted
-    if (budget_ < file_.NumLeaves()) {
+    // The cut holds distinct nodes of the pool's pages: a budget of at least the pool's
+    // splats (or the leaves) cannot bind.
+    if (budget_ < std::min(file_.NumLeaves(), PoolSplats())) {
         OrderedCut(view);
     } else {
         UnorderedCut(view);

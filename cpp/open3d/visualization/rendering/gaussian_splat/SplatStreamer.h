@@ -78,7 +78,8 @@ private:
         int64_t id, page;
         bool operator<(const Open& o) const { return size < o.size; }
     };
-    /// The ordered cut (a budget below the leaves): from the root, largest node first.
+    /// The ordered cut (a budget below the leaves and the pool's splats): from the root,
+    /// largest node first.
     void OrderedCut(const t::geometry::SplatCutView& view);
     /// The unordered cut (a budget that cannot bind): from the root when the view changed or
     /// there is no cut yet, else only below the nodes that waited for the pages read since.
@@ -109,11 +110,11 @@ private:
     uint64_t step_ = 0;
     int64_t pages_read_ = 0, evictions_ = 0;
 
-    // The cut: drawn nodes as (id, page), id -1 once opened by a later step; for each page
+    // The cut: drawn nodes as (id, page), id -1 once opened by a later step (a few entries
+    // per page read, kept until the next cut from the root); for each page
     // not in the pool, the drawn nodes (indices into drawn_) that wait for it and the
     // largest of their projected sizes; the pages the cut opened into.
     std::vector<std::pair<int64_t, int64_t>> drawn_;
-    int64_t opened_since_cut_ = 0;  // entries of drawn_ marked -1
     std::vector<std::vector<int64_t>> waiting_;
     std::vector<double> waiting_size_;
     std::vector<int64_t> waiting_pages_;  // pages with waiters (some may have none left)
