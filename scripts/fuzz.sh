@@ -14,7 +14,7 @@ CC=clang-14 CXX=clang++-14 cmake -S "$root" -B "$build_dir" -G Ninja -DCMAKE_BUI
   -DOPEN3D_SANITIZE=ON -DOPEN3D_BUILD_FUZZERS=ON -DOPEN3D_BUILD_TESTS=OFF -DOPEN3D_BUILD_BENCHMARKS=OFF >/dev/null
 cmake --build "$build_dir" -j"$(nproc)" --target fuzz_ply_reader fuzz_splat_reader fuzz_cameras_json \
   fuzz_spz_reader fuzz_compressed_ply_reader fuzz_sog_reader fuzz_gltf_reader fuzz_glb_reader \
-  fuzz_ksplat_reader fuzz_splat_hierarchy_reader fuzz_render_agreement
+  fuzz_ksplat_reader fuzz_splat_hierarchy_reader fuzz_splat_page_reader fuzz_render_agreement
 artifacts="$build_dir/fuzz-artifacts"
 mkdir -p "$artifacts"
 run() {  # name, seed files... (FUZZ_MAX_LEN: longest input, default 64 KiB; FUZZ_LEN_CONTROL:
@@ -46,6 +46,7 @@ run fuzz_gltf_reader "$formats/cesium_synthetic_0.gltf" "$root"/tests/fuzz/seeds
 run fuzz_glb_reader "$root"/tests/fuzz/seeds/*.glb
 run fuzz_ksplat_reader "$formats/minimal.ksplat" "$root"/tests/fuzz/seeds/*.ksplat
 run fuzz_splat_hierarchy_reader "$root"/tests/fuzz/seeds/*.lod
+run fuzz_splat_page_reader "$root"/tests/fuzz/seeds/*.gspages
 # The harness reads at most ~130 bytes (six splats and a camera) and runs at ~5 inputs/s on
 # lavapipe under ASan (~570 MB resident): without -len_control=0, libFuzzer's slowly growing
 # length limit kept a 20 s run at 4-byte inputs (one splat, all else zero).
