@@ -98,6 +98,39 @@ MappedFile::~MappedFile() {
     if (data_ != nullptr) ::munmap(const_cast<uint8_t*>(data_), size_);
 }
 
+std::vector<SplatAttribute> SplatAttributesInFileOrder(int num_rest) {
+    std::vector<SplatAttribute> list = {{geometry::gs_attr::kPositions, 3},
+                                        {geometry::gs_attr::kScale, 3},
+                                        {geometry::gs_attr::kRot, 4},
+                                        {geometry::gs_attr::kOpacity, 1},
+                                        {geometry::gs_attr::kFDc, 3}};
+    if (num_rest > 0) list.push_back({geometry::gs_attr::kFRest, 3 * int64_t(num_rest)});
+    return list;
+}
+
+geometry::PointCloud ReadSplatAttributeBlocks(
+    const uint8_t* at, int64_t n, int num_rest,
+    const std::function<void(const char* name, int64_t row)>& non_finite) {
+    geometry::PointCloud cloud;
+    for (const SplatAttribute& a : SplatAttributesInFileOrder(num_rest)) {
+        core::SizeVector shape = {n, a.width};
+        if (a.name == std::string(geometry::gs_attr::kFRest)) shape = {n, num_rest, 3};
+        core::Tensor values(shape, core::Dtype::Float32);
+        std::memcpy(values.Data<float>(), at, 4 * n * a.width);
+        at += 4 * n * a.width;
+        const float* v = values.Data<float>();
+        for (int64_t i = 0; i < n * a.width; ++i) {
+            if (!std::isfinite(v[i])) non_finite(a.name, i / a.width);
+        }
+        if (a.name == std::string(geometry::gs_attr::kPositions)) {
+            cloud = geometry::PointCloud(values);
+        } else {
+            cloud.SetPointAttr(a.name, values);
+        }
+    }
+    return cloud;
+}
+
 void WriteFileBytes(const std::string& filename, const std::vector<uint8_t>& bytes) {
     std::unique_ptr<FILE, int (*)(FILE*)> file(std::fopen(filename.c_str(), "wb"), &std::fclose);
     if (!file) core::ThrowError("Cannot open '{}' for writing: {}", filename, std::strerror(errno));

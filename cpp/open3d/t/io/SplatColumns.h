@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -49,6 +50,22 @@ private:
     const uint8_t* data_ = nullptr;
     size_t size_ = 0;
 };
+
+/// A Gaussian attribute as the hierarchy's files store it (SplatHierarchyIO, SplatPageFile):
+/// its name and float32 values per splat, a block of all the splats' rows per attribute.
+struct SplatAttribute {
+    const char* name;
+    int64_t width;
+};
+/// The blocks in file order: positions 3, scale 3, rot 4, opacity 1, f_dc 3, then f_rest
+/// 3 x num_rest where num_rest > 0.
+std::vector<SplatAttribute> SplatAttributesInFileOrder(int num_rest);
+
+/// The splat cloud of `n` splats whose attribute blocks (SplatAttributesInFileOrder) start at
+/// `at`; `non_finite(name, row)` is called for the first NaN or infinite value and must throw.
+geometry::PointCloud ReadSplatAttributeBlocks(
+    const uint8_t* at, int64_t n, int num_rest,
+    const std::function<void(const char* name, int64_t row)>& non_finite);
 
 /// Writes bytes to a file, throwing with the file name on failure.
 void WriteFileBytes(const std::string& filename, const std::vector<uint8_t>& bytes);

@@ -22,21 +22,6 @@ constexpr uint32_t kVersion = 1;
 constexpr int kMaxChildren = 8;
 constexpr size_t kHeaderBytes = 8 + 4 + 4 + 3 * 8;
 
-// The inner nodes' attributes in file order, with their float count per node.
-struct Attribute {
-    const char* name;
-    int64_t width;
-};
-std::vector<Attribute> Attributes(int num_rest) {
-    std::vector<Attribute> list = {{geometry::gs_attr::kPositions, 3},
-                                   {geometry::gs_attr::kScale, 3},
-                                   {geometry::gs_attr::kRot, 4},
-                                   {geometry::gs_attr::kOpacity, 1},
-                                   {geometry::gs_attr::kFDc, 3}};
-    if (num_rest > 0) list.push_back({geometry::gs_attr::kFRest, 3 * int64_t(num_rest)});
-    return list;
-}
-
 template <typename T>
 void Append(std::vector<uint8_t>& bytes, const T* values, size_t count) {
     const size_t at = bytes.size();
@@ -60,7 +45,8 @@ void WriteSplatHierarchy(const std::string& filename, const geometry::SplatHiera
     Append(bytes, hierarchy.child_offsets.data(), hierarchy.child_offsets.size());
     Append(bytes, hierarchy.children.data(), hierarchy.children.size());
     if (k > 0) {
-        for (const Attribute& a : Attributes(geometry::NumSHRestCoeffs(degree))) {
+        for (const SplatAttribute& a :
+             SplatAttributesInFileOrder(geometry::NumSHRestCoeffs(degree))) {
             const core::Tensor& values = hierarchy.inner.GetPointAttr(a.name);
             Append(bytes, values.Data<float>(), static_cast<size_t>(k * a.width));
         }
@@ -96,9 +82,8 @@ geometry::SplatHierarchy ReadSplatHierarchy(const std::string& filename) {
              std::to_string(size) + " bytes");
     }
     const int num_rest = geometry::NumSHRestCoeffs(static_cast<int>(sh_degree));
-    const std::vector<Attribute> attributes = Attributes(num_rest);
     int64_t floats_per_node = 0;
-    for (const Attribute& a : attributes) floats_per_node += a.width;
+    for (const SplatAttribute& a : SplatAttributesInFileOrder(num_rest)) floats_per_node += a.width;
     const uint64_t expected = kHeaderBytes + 8 * uint64_t(inner + 1) + 8 * uint64_t(links) +
                               4 * uint64_t(inner) * uint64_t(floats_per_node);
     if (expected != size) {
@@ -141,25 +126,9 @@ geometry::SplatHierarchy ReadSplatHierarchy(const std::string& filename) {
     }
 
     if (inner > 0) {
-        for (const Attribute& a : attributes) {
-            core::SizeVector shape = {inner, a.width};
-            if (a.name == std::string(geometry::gs_attr::kFRest)) shape = {inner, num_rest, 3};
-            core::Tensor values(shape, core::Dtype::Float32);
-            std::memcpy(values.Data<float>(), at, 4 * inner * a.width);
-            at += 4 * inner * a.width;
-            const float* v = values.Data<float>();
-            for (int64_t i = 0; i < inner * a.width; ++i) {
-                if (!std::isfinite(v[i])) {
-                    fail(std::string("a non-finite ") + a.name + " of inner node " +
-                         std::to_string(i / a.width));
-                }
-            }
-            if (a.name == std::string(geometry::gs_attr::kPositions)) {
-                h.inner = geometry::PointCloud(values);
-            } else {
-                h.inner.SetPointAttr(a.name, values);
-            }
-        }
+        h.inner = ReadSplatAttributeBlocks(at, inner, num_rest, [&](const char* name, int64_t row) {
+            fail(std::string("a non-finite ") + name + " of inner node " + std::to_string(row));
+        });
     }
     return h;
 }

@@ -28,21 +28,6 @@ constexpr int kMaxChildren = 8;
 constexpr size_t kHeaderBytes = 8 + 4 + 4 + 4 * 8 + 6 * 8;
 constexpr size_t kPageEntryBytes = 3 * 8;
 
-// A node's Gaussian in the file: positions 3, scale 3, rot 4, opacity 1, f_dc 3, f_rest 3 Nc
-// floats, each attribute of a page's nodes together.
-struct Attribute {
-    const char* name;
-    int64_t width;
-};
-std::vector<Attribute> Attributes(int num_rest) {
-    std::vector<Attribute> list = {{geometry::gs_attr::kPositions, 3},
-                                   {geometry::gs_attr::kScale, 3},
-                                   {geometry::gs_attr::kRot, 4},
-                                   {geometry::gs_attr::kOpacity, 1},
-                                   {geometry::gs_attr::kFDc, 3}};
-    if (num_rest > 0) list.push_back({geometry::gs_attr::kFRest, 3 * int64_t(num_rest)});
-    return list;
-}
 int NumRest(int degree) { return (degree + 1) * (degree + 1) - 1; }
 uint64_t BytesPerNode(int num_rest) {
     return sizeof(SplatPageNode) + 4 * uint64_t(14 + 3 * num_rest);
@@ -203,7 +188,7 @@ void WriteSplatPages(const std::string& filename, const geometry::PointCloud& so
         }
     };
     write(header);
-    const std::vector<Attribute> attributes = Attributes(num_rest);
+    const std::vector<SplatAttribute> attributes = SplatAttributesInFileOrder(num_rest);
     std::vector<uint8_t> page;
     for (int64_t p = 0; p < num_pages; ++p) {
         core::ReportProgress("writing pages", double(p) / num_pages);
@@ -226,7 +211,7 @@ void WriteSplatPages(const std::string& filename, const geometry::PointCloud& so
             }
             Store(page, record);
         }
-        for (const Attribute& a : attributes) {
+        for (const SplatAttribute& a : attributes) {
             for (int64_t f = first; f < last; ++f) {
                 int64_t row;
                 const geometry::GaussianSplatArrays& from = arrays(layout.order[f], row);
@@ -370,31 +355,17 @@ geometry::PointCloud SplatPageFile::ReadSplats(int64_t page) const {
     const int64_t n = info.num_nodes;
     const int num_rest = NumRest(sh_degree_);
     const uint8_t* at = file_->data() + info.offset + n * sizeof(SplatPageNode);
-    geometry::PointCloud cloud;
-    for (const Attribute& a : Attributes(num_rest)) {
-        core::SizeVector shape = {n, a.width};
-        if (a.name == std::string(geometry::gs_attr::kFRest)) shape = {n, num_rest, 3};
-        core::Tensor values(shape, core::Dtype::Float32);
-        std::memcpy(values.Data<float>(), at, 4 * n * a.width);
-        at += 4 * n * a.width;
-        const float* v = values.Data<float>();
-        for (int64_t i = 0; i < n * a.width; ++i) {
-            if (!std::isfinite(v[i])) {
-                Fail("page " + std::to_string(page) + ": a non-finite " + a.name + " of node " +
-                     std::to_string(info.first_node + i / a.width));
-            }
-        }
-        if (a.name == std::string(geometry::gs_attr::kPositions)) {
-            for (int64_t i = 0; i < 3 * n; ++i) {
-                if (v[i] < center_min_[i % 3] || v[i] > center_max_[i % 3]) {
-                    Fail("page " + std::to_string(page) + ": node " +
-                         std::to_string(info.first_node + i / 3) +
-                         "'s centre lies outside the header's bounds");
-                }
-            }
-            cloud = geometry::PointCloud(values);
-        } else {
-            cloud.SetPointAttr(a.name, values);
+    geometry::PointCloud cloud =
+        ReadSplatAttributeBlocks(at, n, num_rest, [&](const char* name, int64_t row) {
+            Fail("page " + std::to_string(page) + ": a non-finite " + name + " of node " +
+                 std::to_string(info.first_node + row));
+        });
+    const float* v = cloud.GetPointPositions().Data<float>();
+    for (int64_t i = 0; i < 3 * n; ++i) {
+        if (v[i] < center_min_[i % 3] || v[i] > center_max_[i % 3]) {
+            Fail("page " + std::to_string(page) + ": node " +
+                 std::to_string(info.first_node + i / 3) +
+                 "'s centre lies outside the header's bounds");
         }
     }
     return cloud;

@@ -85,13 +85,17 @@ void GeometryStageResources::UploadScene(const VulkanContext& context, const Com
     scene_bytes_ = (packed.positions.size() + packed.shape.size() + packed.sh.size() +
                     packed.visibility.size()) *
                    4;
-    layout_.precision = packed.precision;
-    layout_.num_splats = packed.num_splats;
-    layout_.sh_degree = packed.sh_degree;
-    layout_.shape_words_per_splat = packed.shape_words_per_splat;
-    layout_.sh_words_per_splat = packed.sh_words_per_splat;
-    layout_.center_min = packed.center_min;
-    layout_.center_max = packed.center_max;
+    SetLayout(packed, packed.num_splats);
+}
+
+void GeometryStageResources::SetLayout(const PackedGaussianSplats& like, int64_t num_splats) {
+    layout_.precision = like.precision;
+    layout_.num_splats = num_splats;
+    layout_.sh_degree = like.sh_degree;
+    layout_.shape_words_per_splat = like.shape_words_per_splat;
+    layout_.sh_words_per_splat = like.sh_words_per_splat;
+    layout_.center_min = like.center_min;
+    layout_.center_max = like.center_max;
     // The per-view buffers are sized for a splat count: a new scene needs new ones.
     view_ = GeometryStageViewResources();
 }
@@ -118,14 +122,7 @@ void GeometryStageResources::AllocateScene(const VulkanContext& context, const C
     scene_bytes_ =
         n * (4 * sizeof(float) + 4 * like.shape_words_per_splat + 4 * like.sh_words_per_splat) +
         visibility_bytes;
-    layout_.precision = like.precision;
-    layout_.num_splats = capacity;
-    layout_.sh_degree = like.sh_degree;
-    layout_.shape_words_per_splat = like.shape_words_per_splat;
-    layout_.sh_words_per_splat = like.sh_words_per_splat;
-    layout_.center_min = like.center_min;
-    layout_.center_max = like.center_max;
-    view_ = GeometryStageViewResources();
+    SetLayout(like, capacity);
 }
 
 void GeometryStageResources::WriteSplats(

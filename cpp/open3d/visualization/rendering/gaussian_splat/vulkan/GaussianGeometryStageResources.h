@@ -116,6 +116,9 @@ public:
     Buffer lod_nodes;
 
 private:
+    /// The packing's sizes of `like` for a scene of `num_splats`; drops the view buffers.
+    void SetLayout(const PackedGaussianSplats& like, int64_t num_splats);
+
     uint32_t lod_leaves_ = 0, lod_inner_ = 0;
     VkDeviceSize lod_nodes_bytes_ = 0, lod_children_offset_ = 0;
     PackedGaussianSplats layout_;
