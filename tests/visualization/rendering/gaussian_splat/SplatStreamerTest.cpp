@@ -6,15 +6,19 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
+#include <optional>
 #include <set>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "TestUtility.h"
 #include "open3d/core/Exception.h"
 #include "open3d/t/geometry/SplatHierarchy.h"
 #include "open3d/t/io/SplatPageFile.h"
+#include "open3d/visualization/rendering/gaussian_splat/SplatStreamWorker.h"
 #include "open3d/visualization/rendering/gaussian_splat/SplatStreamer.h"
 #include "t/io/RandomSplatCloud.h"
 
@@ -26,6 +30,7 @@ using t::geometry::PointCloud;
 using visualization::rendering::SplatCutViewOf;
 using visualization::rendering::SplatStreamer;
 using visualization::rendering::SplatStreamStep;
+using visualization::rendering::SplatStreamWorker;
 
 // Two clusters of `n` splats each, 1000 units apart on x, 20 units in front of cameras at
 // x = 0 and x = 1000 that look down +z: each camera sees one cluster only.
@@ -67,18 +72,22 @@ std::set<int64_t> LeavesInView(const PointCloud& cloud, const camera::PinholeCam
     return in_view;
 }
 
-// The hierarchy ids of the nodes a step's mask shows.
-std::set<int64_t> Drawn(const t::io::SplatPageFile& file, const SplatStreamer& streamer,
-                        const SplatStreamStep& step) {
+// The hierarchy ids of the nodes a mask shows, the pool's slots holding `slot_pages`.
+std::set<int64_t> Drawn(const t::io::SplatPageFile& file, const std::vector<int64_t>& slot_pages,
+                        const std::vector<uint32_t>& mask) {
     std::set<int64_t> drawn;
-    for (int64_t s = 0; s < streamer.PoolSplats(); ++s) {
-        if (!(step.visibility[s / 32] >> (s % 32) & 1u)) continue;
-        const int64_t page = streamer.SlotPages().at(s / file.PageCapacity());
+    for (int64_t s = 0; s < int64_t(slot_pages.size()) * file.PageCapacity(); ++s) {
+        if (!(mask[s / 32] >> (s % 32) & 1u)) continue;
+        const int64_t page = slot_pages.at(s / file.PageCapacity());
         EXPECT_GE(page, 0) << "slot " << s << " is shown but empty";
         if (page < 0) continue;
         drawn.insert(file.ReadNodes(page).at(s % file.PageCapacity()).source_id);
     }
     return drawn;
+}
+std::set<int64_t> Drawn(const t::io::SplatPageFile& file, const SplatStreamer& streamer,
+                        const SplatStreamStep& step) {
+    return Drawn(file, streamer.SlotPages(), step.visibility);
 }
 
 // Steps until nothing the view wants is missing; returns the last step.
@@ -234,6 +243,51 @@ TEST(SplatStreamer, AFullPoolKeepsWhatTheCutUsesInsteadOfThrashing) {
     }
     EXPECT_EQ(streamer.PagesRead(), read);
     EXPECT_EQ(Drawn(file, streamer, step), drawn);
+}
+
+TEST(SplatStreamWorker, ConvergesOffTheCallersThreadAsTheViewMoves) {
+    // The worker steps on its own thread; this thread takes what changed now and then (as a
+    // render loop would), applies the page writes to its own record of the slots, and must
+    // end with every leaf in view drawn, for each view in turn, in a pool too small for both.
+    const Paged paged = WritePaged(300, 16);
+    const t::io::SplatPageFile file(paged.path);
+    const camera::PinholeCamera a = CameraAt(0.0), b = CameraAt(1000.0);
+    int64_t need = 0;
+    for (const camera::PinholeCamera& cam : {a, b}) {
+        SplatStreamer unlimited(file, file.NumPages(), file.NumLeaves());
+        Converge(unlimited, cam);
+        need = std::max(need, unlimited.ResidentPages());
+    }
+    SplatStreamer streamer(file, need, file.NumLeaves());
+    std::vector<int64_t> slot_pages(need, -1);
+    std::vector<uint32_t> mask((streamer.PoolSplats() + 31) / 32, 0u);
+    int64_t takes = 0;
+    const auto take = [&](SplatStreamWorker& worker) {
+        if (std::optional<SplatStreamStep> step = worker.Take()) {
+            for (const SplatStreamStep::PageWrite& write : step->writes) {
+                slot_pages.at(write.first_splat / file.PageCapacity()) = write.page;
+            }
+            mask = step->visibility;
+            ++takes;
+        }
+    };
+    {
+        SplatStreamWorker worker(streamer, 1);
+        for (const camera::PinholeCamera& cam : {a, b, a}) {
+            worker.SetView(SplatCutViewOf(cam));
+            for (int i = 0; i < 20000 && !worker.Idle(); ++i) {
+                take(worker);
+                std::this_thread::sleep_for(std::chrono::microseconds(200));
+            }
+            ASSERT_TRUE(worker.Idle());
+            take(worker);  // the last step's changes
+            EXPECT_EQ(Drawn(file, slot_pages, mask), LeavesInView(paged.cloud, cam));
+        }
+        worker.SetView(SplatCutViewOf(b));  // destroyed while it works: joins, no hang
+    }
+    EXPECT_GT(takes, 3);
+    EXPECT_GT(streamer.Evictions(), 0);
+    EXPECT_THROW(SplatStreamWorker(streamer, 0), core::Open3DError);
 }
 
 }  // namespace
