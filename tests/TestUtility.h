@@ -22,6 +22,8 @@ std::string TempDir();
 
 /// The bytes of a file (empty when it cannot be read).
 std::vector<uint8_t> ReadFileBytes(const std::string& path);
+/// Writes `bytes` as the whole file at `path`.
+void WriteFileBytes(const std::string& path, const std::vector<uint8_t>& bytes);
 /// True in CI (environment CI=true): there a test that lacks an X display, a Vulkan device,
 /// a tool or a shared scene fails instead of skipping, so the suite cannot pass by skipping.
 bool SkipsAreFailures();

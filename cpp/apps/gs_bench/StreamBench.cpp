@@ -64,9 +64,11 @@ void RunStreamBench(const t::geometry::PointCloud& scene,
     const auto start = std::chrono::steady_clock::now();
     const t::io::SplatPageFile file(options.path);
     // Pool slots from the budget: the bytes a packed splat takes on the GPU (positions,
-    // shape and SH words, its visibility bit), as the pool's first page packs.
+    // shape and SH words, its visibility bit).
     const double bytes_per_splat =
-        rendering::PackGaussianSplatAttrs(file.ReadSplats(0)).BytesPerSplat() + 1.0 / 8.0;
+        rendering::PackedSplatLayout(file.ShDegree(), rendering::SplatPrecision::kExact)
+            .BytesPerSplat() +
+        1.0 / 8.0;
     const int64_t pool_pages = static_cast<int64_t>(
         double(options.gpu_budget) / (bytes_per_splat * double(file.PageCapacity())));
     if (pool_pages < 1) {

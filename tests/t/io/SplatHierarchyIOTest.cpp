@@ -3,7 +3,6 @@
 #include <gtest/gtest.h>
 
 #include <cstring>
-#include <fstream>
 #include <string>
 #include <vector>
 
@@ -21,15 +20,10 @@ namespace {
 using geometry::PointCloud;
 using geometry::SplatHierarchy;
 
-void WriteBytes(const std::string& path, const std::vector<uint8_t>& bytes) {
-    std::ofstream out(path, std::ios::binary);
-    out.write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
-}
-
 // Reading `bytes` fails with a message that contains `expected`.
 void ExpectRefused(const std::string& path, const std::vector<uint8_t>& bytes,
                    const std::string& expected) {
-    WriteBytes(path, bytes);
+    tests::WriteFileBytes(path, bytes);
     try {
         ReadSplatHierarchy(path);
         ADD_FAILURE() << "accepted; expected an error with '" << expected << "'";

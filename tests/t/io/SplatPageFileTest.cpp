@@ -6,8 +6,6 @@
 
 #include <algorithm>
 #include <cstring>
-#include <fstream>
-#include <iterator>
 #include <limits>
 #include <string>
 #include <vector>
@@ -112,18 +110,10 @@ TEST(SplatPageFile, EveryNodeOnceWithItsGaussianAndChildren) {
     }
 }
 
-std::vector<uint8_t> ReadAll(const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    return std::vector<uint8_t>(std::istreambuf_iterator<char>(in), {});
-}
-void WriteAll(const std::string& path, const std::vector<uint8_t>& bytes) {
-    std::ofstream out(path, std::ios::binary);
-    out.write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
-}
 // Opening and reading every page of `bytes` fails with a message holding `expected`.
 void ExpectRefused(const std::string& path, const std::vector<uint8_t>& bytes,
                    const std::string& expected) {
-    WriteAll(path, bytes);
+    tests::WriteFileBytes(path, bytes);
     try {
         const SplatPageFile file(path);
         for (int64_t p = 0; p < file.NumPages(); ++p) {
@@ -143,7 +133,7 @@ TEST(SplatPageFile, MalformedFilesAreRefused) {
     const SplatHierarchy h = geometry::BuildSplatHierarchy(cloud);
     const std::string good = dir + "/good.gspages", bad = dir + "/bad.gspages";
     WriteSplatPages(good, cloud, h, 16);
-    const std::vector<uint8_t> bytes = ReadAll(good);
+    const std::vector<uint8_t> bytes = tests::ReadFileBytes(good);
     const SplatPageFile file(good);
     ASSERT_GT(file.NumPages(), 2);
     const size_t table = 96;  // header bytes; page entries follow

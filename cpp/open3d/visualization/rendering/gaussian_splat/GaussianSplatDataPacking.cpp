@@ -88,6 +88,17 @@ uint32_t WordsFor(int values, SplatPrecision precision) {
 
 }  // namespace
 
+PackedGaussianSplats PackedSplatLayout(int sh_degree, SplatPrecision precision) {
+    if (sh_degree < 0 || sh_degree > 3) core::ThrowError("a packing of SH degree {}", sh_degree);
+    PackedGaussianSplats packed;
+    packed.precision = precision;
+    packed.sh_degree = sh_degree;
+    packed.shape_words_per_splat = WordsFor(10, precision);
+    packed.sh_words_per_splat = WordsFor(3 * t::geometry::NumSHRestCoeffs(sh_degree), precision);
+    static_assert(shader::kShapeWordsExact == 10 && shader::kShapeWordsCompact == 5);
+    return packed;
+}
+
 PackedGaussianSplats PackGaussianSplatAttrs(const t::geometry::PointCloud& cloud,
                                             SplatPrecision precision, int max_sh_degree) {
     const t::geometry::GaussianSplatArrays a = cloud.GetGaussianSplatArrays();  // validates
@@ -97,14 +108,10 @@ PackedGaussianSplats PackGaussianSplatAttrs(const t::geometry::PointCloud& cloud
                          n);
     }
 
-    PackedGaussianSplats packed;
-    packed.precision = precision;
+    PackedGaussianSplats packed =
+        PackedSplatLayout(std::clamp(max_sh_degree, 0, a.sh_degree), precision);
     packed.num_splats = n;
-    packed.sh_degree = std::clamp(max_sh_degree, 0, a.sh_degree);
     const int rest_values = 3 * t::geometry::NumSHRestCoeffs(packed.sh_degree);
-    packed.shape_words_per_splat = WordsFor(10, precision);
-    packed.sh_words_per_splat = WordsFor(rest_values, precision);
-    static_assert(shader::kShapeWordsExact == 10 && shader::kShapeWordsCompact == 5);
 
     packed.positions.reserve(4 * n);
     packed.shape.reserve(packed.shape_words_per_splat * n);

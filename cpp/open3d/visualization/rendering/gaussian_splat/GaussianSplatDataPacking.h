@@ -50,6 +50,11 @@ struct PackedGaussianSplats {
     uint64_t BytesPerSplat() const;
 };
 
+/// The sizes a packing of splats of SH degree `sh_degree` (0..3) gets: precision, degree and
+/// words per splat, no splats and empty attribute vectors (what a scene whose splats arrive
+/// later is allocated from).
+PackedGaussianSplats PackedSplatLayout(int sh_degree, SplatPrecision precision);
+
 /// Packs a valid Gaussian splat cloud: the sigmoid is applied to the opacity logits and
 /// quaternions are normalised here (in double, then rounded), SH is cut to
 /// min(scene degree, max_sh_degree). Every splat starts visible. Throws core::Open3DError

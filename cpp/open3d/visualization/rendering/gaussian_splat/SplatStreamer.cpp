@@ -87,11 +87,14 @@ void SplatStreamer::UsePage(int64_t page) {
     used_pages_.push_back(page);
 }
 
-void SplatStreamer::DrawWaiting(int64_t id, int64_t page, int64_t wanted, double size) {
-    drawn_.push_back({id, page});
-    if (waiting_[wanted].empty()) waiting_pages_.push_back(wanted);
-    waiting_[wanted].push_back(static_cast<int64_t>(drawn_.size()) - 1);
-    waiting_size_[wanted] = std::max(waiting_size_[wanted], size);
+int64_t SplatStreamer::ChildrenPageOrWait(const Open& open) {
+    const int64_t page = file_.PageOfNode(Node(open.id, open.page).first_child);
+    if (page_slot_[page] >= 0) return page;
+    drawn_.push_back({open.id, open.page});
+    if (waiting_[page].empty()) waiting_pages_.push_back(page);
+    waiting_[page].push_back(static_cast<int64_t>(drawn_.size()) - 1);
+    waiting_size_[page] = std::max(waiting_size_[page], open.size);
+    return -1;
 }
 
 void SplatStreamer::OrderedCut(const t::geometry::SplatCutView& view) {
@@ -115,12 +118,9 @@ void SplatStreamer::OrderedCut(const t::geometry::SplatCutView& view) {
     while (!open.empty()) {
         const Open top = open.top();
         open.pop();
+        const int64_t page = ChildrenPageOrWait(top);
+        if (page < 0) continue;
         const t::io::SplatPageNode& node = Node(top.id, top.page);
-        const int64_t page = file_.PageOfNode(node.first_child);
-        if (page_slot_[page] < 0) {
-            DrawWaiting(top.id, top.page, page, top.size);
-            continue;
-        }
         // Children outside the view are dropped, so opening adds the visible ones less one.
         double sizes[8];
         bool visible[8];
@@ -145,12 +145,9 @@ void SplatStreamer::Expand(const t::geometry::SplatCutView& view, std::vector<Op
     while (!stack.empty()) {
         const Open top = stack.back();
         stack.pop_back();
+        const int64_t page = ChildrenPageOrWait(top);
+        if (page < 0) continue;
         const t::io::SplatPageNode& node = Node(top.id, top.page);
-        const int64_t page = file_.PageOfNode(node.first_child);
-        if (page_slot_[page] < 0) {
-            DrawWaiting(top.id, top.page, page, top.size);
-            continue;
-        }
         UsePage(page);
         for (uint32_t i = 0; i < node.num_children; ++i) {
             const int64_t child = node.first_child + i;

@@ -88,8 +88,9 @@ private:
     void Expand(const t::geometry::SplatCutView& view, std::vector<Open>& stack);
     /// Forgets the cut: no node drawn, none waiting, no page used.
     void ClearCut();
-    /// `id` (of `page`) stays whole: drawn, and waiting for its children's page `wanted`.
-    void DrawWaiting(int64_t id, int64_t page, int64_t wanted, double size);
+    /// The page of `open`'s children when it is in the pool; else `open` stays whole (drawn,
+    /// waiting for that page with its size) and the result is -1.
+    int64_t ChildrenPageOrWait(const Open& open);
     void UsePage(int64_t page);
     const t::io::SplatPageNode& Node(int64_t id, int64_t page) const {
         return records_[page][id - file_.Page(page).first_node];

@@ -130,24 +130,9 @@ void GaussianSplatVulkanBackend::SetScenePool(int64_t capacity, int sh_degree,
     if (sh_degree < 0 || sh_degree > 3) {
         core::ThrowError("Vulkan backend: a scene pool of SH degree {}", sh_degree);
     }
-    // The words per splat of that degree, from one packed placeholder splat. The pool's
-    // buffers are zero-filled on the GPU: packing millions of placeholders on the host took
-    // seconds before the first image.
-    t::geometry::PointCloud one(core::Tensor::FromVector(
-        std::vector<float>{float(center_min.x()), float(center_min.y()), float(center_min.z())},
-        {1, 3}));
-    one.SetPointAttr(t::geometry::gs_attr::kScale,
-                     core::Tensor::FromVector(std::vector<float>{1, 1, 1}, {1, 3}));
-    one.SetPointAttr(t::geometry::gs_attr::kRot,
-                     core::Tensor::FromVector(std::vector<float>{1, 0, 0, 0}, {1, 4}));
-    one.SetPointAttr(t::geometry::gs_attr::kOpacity, core::Tensor({1, 1}, core::Dtype::Float32));
-    one.SetPointAttr(t::geometry::gs_attr::kFDc, core::Tensor({1, 3}, core::Dtype::Float32));
-    if (sh_degree > 0) {
-        const int64_t rest = (sh_degree + 1) * (sh_degree + 1) - 1;
-        one.SetPointAttr(t::geometry::gs_attr::kFRest,
-                         core::Tensor({1, rest, 3}, core::Dtype::Float32));
-    }
-    PackedGaussianSplats like = PackGaussianSplatAttrs(one, SplatPrecision::kExact);
+    // Allocated and zero-filled on the GPU: packing millions of placeholder splats on the
+    // host took seconds before the first image.
+    PackedGaussianSplats like = PackedSplatLayout(sh_degree, SplatPrecision::kExact);
     like.center_min = center_min;
     like.center_max = center_max;
     if (geometry_.in_flight) Wait(*context_, geometry_stage_fence_.Get());
