@@ -107,6 +107,14 @@ TEST(SplatHierarchyFile, MalformedFilesAreRefusedNamingTheField) {
     ExpectRefused(bad, patched(first_child, &outside, 8), "is not a node built before it");
     const int64_t twice = built.children[1];  // the first child repeats the second
     ExpectRefused(bad, patched(first_child, &twice, 8), "has two parents");
+    // The documented two-level file with offsets {0, 6, 5} for its 5 children: node 0's
+    // count (6) fits 2..8 but runs past the children, node 1's is -1. Reading node 0's
+    // children before checking node 1 read past the array (fuzz_splat_hierarchy_reader).
+    std::vector<uint8_t> two_levels = tests::ReadFileBytes(
+            std::string(OPEN3D_TEST_SOURCE_DIR) + "/fuzz/seeds/two_levels_sh1.lod");
+    const int64_t past_the_end = 6;
+    std::memcpy(two_levels.data() + 40 + 8, &past_the_end, 8);
+    ExpectRefused(bad, two_levels, "inner node 1 has -1 children");
     const float nan = std::nanf("");
     ExpectRefused(bad, patched(bytes.size() - 4, &nan, 4), "non-finite f_rest");
     EXPECT_THROW(ReadSplatHierarchy(dir + "/missing.lod"), core::Open3DError);

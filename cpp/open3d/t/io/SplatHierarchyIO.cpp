@@ -105,13 +105,17 @@ geometry::SplatHierarchy ReadSplatHierarchy(const std::string& filename) {
         fail("child_offsets must run from 0 to the number of children");
     }
     if (inner == 0 && leaves != 1) fail("a hierarchy of several leaves needs inner nodes");
-    std::vector<uint8_t> parents(leaves + inner, 0);
+    // Every node's child count is checked before any child is read: a count that fits
+    // 2..8 can still run past the children when a later offset steps back.
     for (int64_t k = 0; k < inner; ++k) {
         const int64_t count = h.child_offsets[k + 1] - h.child_offsets[k];
         if (count < 2 || count > kMaxChildren) {
             fail("inner node " + std::to_string(k) + " has " + std::to_string(count) +
                  " children (2..8)");
         }
+    }
+    std::vector<uint8_t> parents(leaves + inner, 0);
+    for (int64_t k = 0; k < inner; ++k) {
         for (int64_t c = h.child_offsets[k]; c < h.child_offsets[k + 1]; ++c) {
             const int64_t child = h.children[c];
             if (child < 0 || child >= leaves + k) {
