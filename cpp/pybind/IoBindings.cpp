@@ -1,4 +1,5 @@
-// t.io: read_point_cloud / write_point_cloud in every format the library knows.
+// t.io: read_point_cloud / write_point_cloud in every format the library knows, and the paged
+// file a renderer streams (write_splat_pages).
 #include <pybind11/stl.h>
 
 #include <memory>
@@ -7,7 +8,9 @@
 #include "Bindings.h"
 #include "PyPointCloud.h"
 #include "open3d/core/Exception.h"
+#include "open3d/t/geometry/SplatHierarchy.h"
 #include "open3d/t/io/PointCloudIO.h"
+#include "open3d/t/io/SplatPageFile.h"
 
 namespace py = pybind11;
 
@@ -51,6 +54,20 @@ void BindIo(py::module_& m) {
         py::arg("filename"), py::arg("pointcloud"), py::arg("ply_format") = "binary_little_endian",
         "Writes the format the extension names (.ply, .compressed.ply, .splat, .spz, .sog, .glb, "
         ".gltf); the file appears complete or not at all.");
+    m.def(
+        "write_splat_pages",
+        [](const std::string& filename, const PyPointCloud& cloud, int64_t page_capacity) {
+            cloud.cloud.ValidateGaussianSplat();
+            py::gil_scoped_release release;
+            const t::geometry::SplatHierarchy hierarchy =
+                t::geometry::BuildSplatHierarchy(cloud.cloud);
+            t::io::WriteSplatPages(filename, cloud.cloud, hierarchy, page_capacity);
+        },
+        py::arg("filename"), py::arg("pointcloud"), py::arg("page_capacity") = 65536,
+        "Builds the level-of-detail hierarchy of a Gaussian splat cloud and writes it as a paged "
+        "file (.gspages, as gs-convert --pages does) of page_capacity nodes a page, for "
+        "OffscreenRenderer.scene.stream_splats. Raises Open3DError for a cloud without the "
+        "Gaussian attributes or a capacity below 8.");
 }
 
 }  // namespace pybind

@@ -136,6 +136,9 @@ public:
         }
         names_.clear();
     }
+    GaussianSplatRenderer& SplatRenderer() const {
+        return filament_ ? filament_->GetScene()->GetScene().GetSplatRenderer() : *renderer_;
+    }
     void SetBackground(const Eigen::Vector3d& rgb) {
         config_.background = rgb;
         if (filament_) {
@@ -323,7 +326,61 @@ void BindRendering(py::module_& m) {
             "has_geometry",
             [](const SplatScene& s, const std::string& name) { return s.renderer->Has(name); },
             py::arg("name"))
-        .def("clear_geometry", [](SplatScene& s) { s.renderer->Clear(); })
+        .def(
+            "clear_geometry", [](SplatScene& s) { s.renderer->Clear(); },
+            "Removes every geometry and ends a stream")
+        .def(
+            "stream_splats",
+            [](SplatScene& s, const std::string& path, const py::object& gpu_budget,
+               int64_t splat_budget, int64_t reads_per_step) {
+                visualization::rendering::SplatStreamOptions options;
+                options.gpu_budget =
+                    py::isinstance<py::str>(gpu_budget)
+                        ? visualization::rendering::ParseByteSize(gpu_budget.cast<std::string>())
+                        : gpu_budget.cast<uint64_t>();
+                options.splat_budget = splat_budget;
+                options.reads_per_step = reads_per_step;
+                s.renderer->SplatRenderer().StreamSplats(path, options);
+            },
+            py::arg("path"), py::arg("gpu_budget") = 0, py::arg("splat_budget") = 0,
+            py::arg("reads_per_step") = 16,
+            "Streams a paged file (write_splat_pages, gs-convert --pages) as the splat scene "
+            "(docs/streaming.md): its pages are read on a worker thread into a GPU pool of "
+            "gpu_budget bytes (an int, or a str such as '512M' or '2G'; 0: 1 GiB, or what the "
+            "device holds in one scene where that is less) for the view of each "
+            "render; each render shows the pages read since the one before. splat_budget: nodes "
+            "a cut may draw (0: what the pool holds). Raises Open3DError while splat clouds are "
+            "held, for a refused file, or with the cpu backend (only vulkan streams).")
+        .def(
+            "stop_streaming",
+            [](SplatScene& s) { return s.renderer->SplatRenderer().StopStreaming(); },
+            "Ends the stream and frees its pool; False when there was none")
+        .def_property_readonly(
+            "stream_progress",
+            [](const SplatScene& s) -> py::object {
+                const auto p = s.renderer->SplatRenderer().GetStreamProgress();
+                if (!p) return py::none();
+                py::dict d;
+                d["path"] = p->path;
+                d["file_pages"] = p->file_pages;
+                d["pool_pages"] = p->pool_pages;
+                d["resident_pages"] = p->resident_pages;
+                d["pages_read"] = p->pages_read;
+                d["bytes_read"] = p->bytes_read;
+                d["evictions"] = p->evictions;
+                d["nodes_drawn"] = p->nodes_drawn;
+                d["pages_wanted"] = p->pages_wanted;
+                d["starved"] = p->starved;
+                d["settled"] = p->settled;
+                d["error"] = p->error;
+                d["text"] = visualization::rendering::FormatStreamProgress(*p);
+                return d;
+            },
+            "None when not streaming; else a dict as of the last render: file_pages, pool_pages, "
+            "resident_pages, pages_read, bytes_read, evictions, nodes_drawn (by the newest cut), "
+            "pages_wanted (pages that cut lacks), starved (the pool is full for this view), "
+            "settled (nothing more will change for this view: the last render showed it all), "
+            "error, and text (the viewer panel's line)")
         .def_property_readonly("geometry_names",
                                [](const SplatScene& s) { return s.renderer->Names(); })
         .def(

@@ -17,6 +17,7 @@
 #include "open3d/core/Timer.h"
 #include "open3d/t/geometry/PointCloudStatistics.h"
 #include "open3d/t/io/PointCloudIO.h"
+#include "open3d/t/io/SplatPageFile.h"
 #include "open3d/visualization/rendering/filament/FilamentEngine.h"
 #include "open3d/visualization/rendering/gaussian_splat/DefaultScene.h"
 #include "open3d/visualization/visualizer/BackgroundCloudReader.h"
@@ -48,17 +49,66 @@ struct Options {
     double spin_degrees = 0.0;
     bool continuous = false;
     double interactive_frame_ms = 100.0;
+    std::string gpu_budget = "auto";
 };
+
+bool IsPagedFile(const std::string& path) {
+    return std::filesystem::path(path).extension() == ".gspages";
+}
+
+// The red sphere mesh at `center` (--sphere-radius overrides `radius`) unless --no-sphere.
+void AddSphere(vis::Visualizer& viewer, const Eigen::Vector3d& center, double radius,
+               const Options& opt) {
+    if (opt.no_sphere) return;
+    if (opt.sphere_radius > 0.0) radius = opt.sphere_radius;
+    t::geometry::TriangleMesh sphere = t::geometry::TriangleMesh::CreateSphere(radius, 40);
+    sphere.Translate(center);
+    rendering::MaterialRecord red;
+    red.shader = rendering::kShaderDefaultLit;
+    red.base_color = Eigen::Vector4f(1.0f, 0.0f, 0.0f, 1.0f);
+    viewer.AddGeometry("sphere", sphere, red);
+}
+
+// Empties the viewer: the stream, then every named geometry.
+void ClearScene(vis::Visualizer& viewer) {
+    viewer.StopStreaming();
+    for (const std::string& old : std::vector<std::string>(viewer.GetGeometryNames())) {
+        viewer.RemoveGeometry(old);
+    }
+}
+
+// Streams a paged file (gs-convert --pages) into a GPU pool of --gpu-budget bytes as the
+// scene, with the sphere at the centre of its bounds (0.05 x their diagonal).
+void StreamScene(vis::Visualizer& viewer, const std::string& path, const Options& opt) {
+    rendering::SplatStreamOptions stream;
+    stream.gpu_budget = opt.gpu_budget == "auto" ? 0 : rendering::ParseByteSize(opt.gpu_budget);
+    // What can be refused is checked before the shown scene goes: the file's header and
+    // page table, the budget against its pages, the backend.
+    if (viewer.GetBackendName() != "vulkan") {
+        core::ThrowError("streaming {} needs the vulkan backend, not {}", path,
+                         viewer.GetBackendName());
+    }
+    rendering::StreamPoolPages(
+        t::io::SplatPageFile(path), stream.gpu_budget,
+        viewer.GetScene().GetScene().GetSplatRenderer().GetBackend().MaxSceneSplats());
+    ClearScene(viewer);
+    viewer.StreamSplats(path, stream);
+    Eigen::Vector3d lo, hi;
+    viewer.GetScene().GetScene().GetSplatRenderer().GetBounds(lo, hi);
+    AddSphere(viewer, 0.5 * (lo + hi), 0.05 * (hi - lo).norm(), opt);
+    const auto progress = viewer.GetStreamProgress();
+    std::printf("GaussianSplat: streaming %s: %lld pages into a pool of %lld (--gpu-budget %s)\n",
+                path.c_str(), static_cast<long long>(progress->file_pages),
+                static_cast<long long>(progress->pool_pages), opt.gpu_budget.c_str());
+    std::fflush(stdout);
+}
 
 // Puts `cloud` into the viewer as the scene (replacing the one shown, if any) with the red
 // sphere at its centre unless --no-sphere.
 void ShowScene(vis::Visualizer& viewer, const t::geometry::PointCloud& cloud,
                const std::string& name, bool default_scene, const Options& opt) {
-    for (const std::string& old : std::vector<std::string>(viewer.GetGeometryNames())) {
-        viewer.RemoveGeometry(old);
-    }
+    ClearScene(viewer);
     viewer.AddGeometry(name, cloud);
-    if (opt.no_sphere) return;
     Eigen::Vector3d center;
     double radius = 0.0;
     if (default_scene) {
@@ -68,13 +118,7 @@ void ShowScene(vis::Visualizer& viewer, const t::geometry::PointCloud& cloud,
         center = t::geometry::ComputeMedianCenter(cloud);
         radius = 0.3 * t::geometry::ComputeDistanceQuantile(cloud, center, 0.8);
     }
-    if (opt.sphere_radius > 0.0) radius = opt.sphere_radius;
-    t::geometry::TriangleMesh sphere = t::geometry::TriangleMesh::CreateSphere(radius, 40);
-    sphere.Translate(center);
-    rendering::MaterialRecord red;
-    red.shader = rendering::kShaderDefaultLit;
-    red.base_color = Eigen::Vector4f(1.0f, 0.0f, 0.0f, 1.0f);
-    viewer.AddGeometry("sphere", sphere, red);
+    AddSphere(viewer, center, radius, opt);
 }
 
 int Run(const Options& opt) {
@@ -127,8 +171,11 @@ int Run(const Options& opt) {
         shown_s = now;
         return true;
     };
+    const bool streamed = !default_scene && IsPagedFile(opt.input);
     if (default_scene) {
         cloud = rendering::CreateDefaultGaussianSplatScene();
+    } else if (streamed) {
+        StreamScene(viewer, opt.input, opt);
     } else {
         reader.Start(opt.input);
         std::printf("GaussianSplat: loading %s\n", opt.input.c_str());
@@ -142,11 +189,13 @@ int Run(const Options& opt) {
         cloud = std::move(*loaded);
         viewer.SetStatus("");
     }
-    std::printf("GaussianSplat: scene %s, %lld splats, SH degree %d, loaded in %.1f ms\n",
-                default_scene ? "built-in default" : opt.input.c_str(),
-                static_cast<long long>(cloud.NumPoints()), cloud.GaussianSplatGetSHOrder(),
-                core::MillisecondsSince(start));
-    ShowScene(viewer, cloud, name, default_scene, opt);
+    if (!streamed) {
+        std::printf("GaussianSplat: scene %s, %lld splats, SH degree %d, loaded in %.1f ms\n",
+                    default_scene ? "built-in default" : opt.input.c_str(),
+                    static_cast<long long>(cloud.NumPoints()), cloud.GaussianSplatGetSHOrder(),
+                    core::MillisecondsSince(start));
+        ShowScene(viewer, cloud, name, default_scene, opt);
+    }
     if (start_camera) {
         viewer.SetCamera(*start_camera);
     } else if (default_scene) {
@@ -163,6 +212,11 @@ int Run(const Options& opt) {
     // Another file (dropped on the window or typed into the panel) is read on a worker
     // thread: the viewer keeps drawing the current scene and shows the read's progress.
     viewer.SetOpenCallback([&](const std::vector<std::string>& paths) {
+        if (IsPagedFile(paths.front())) {  // errors show in the panel; the scene stays
+            StreamScene(viewer, paths.front(), opt);
+            viewer.ResetCamera();
+            return;
+        }
         reader.Start(paths.front());
         viewer.SetStatus(reader.Describe());
     });
@@ -201,6 +255,9 @@ int Run(const Options& opt) {
         viewer.RequestScreenshot();
         viewer.RenderFrame();
     }
+    if (const auto progress = viewer.GetStreamProgress()) {
+        std::printf("GaussianSplat: %s\n", rendering::FormatStreamProgress(*progress).c_str());
+    }
     std::printf("GaussianSplat: %dx%d, %s\n", viewer.GetWidth(), viewer.GetHeight(),
                 vis::FormatSummary(viewer.GetFrameStatistics().Summarize()).c_str());
     const rendering::RenderStats& s = viewer.GetLastFrame().splat_stats;
@@ -225,6 +282,9 @@ int main(int argc, char** argv) {
         "without one, the built-in default scene, and adds a red sphere mesh to\n"
         "show depth compositing. The file is read while the window shows the progress; drop\n"
         "another file on the window (or type its path into the panel) to open it instead.\n"
+        "A paged file (.gspages, from gs-convert --pages) is streamed instead: a coarse\n"
+        "picture at once, finer pages read into a GPU pool of --gpu-budget bytes while the\n"
+        "viewer stays interactive, the progress in the panel and at exit.\n"
         "Needs an X server (run under `xvfb-run -a` without a display).\n"
         "\n"
         "Mouse: left drag orbits, right/middle/shift+left drag pans, wheel zooms.\n"
@@ -292,6 +352,11 @@ int main(int argc, char** argv) {
                    "time exceeded this are drawn at 1/2 or 1/4 of each side and scaled up; "
                    "the full-size frame follows when the motion stops (0: always full size)")
         ->check(CLI::NonNegativeNumber)
+        ->capture_default_str();
+    app.add_option("--gpu-budget", opt.gpu_budget,
+                   "GPU memory for a streamed .gspages scene's pool (K, M, G, T: powers of "
+                   "1024); the pool holds whole pages, at least one. auto: 1G, or as many "
+                   "pages as the device holds in one scene where that is less")
         ->capture_default_str();
     app.add_option("--spin", opt.spin_degrees,
                    "Orbit the camera by this many degrees every frame, drawing continuously "

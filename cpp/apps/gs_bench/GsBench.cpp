@@ -29,6 +29,7 @@
 #include "open3d/t/io/OutputFiles.h"
 #include "open3d/t/io/PointCloudIO.h"
 #include "open3d/visualization/rendering/gaussian_splat/GaussianSplatBackend.h"
+#include "open3d/visualization/rendering/gaussian_splat/SplatStreamSession.h"
 #include "open3d/visualization/rendering/gaussian_splat/cpu/CpuBackend.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/GaussianSplatVulkanBackend.h"
 
@@ -560,7 +561,7 @@ int Run(const Options& opt) {
             const rendering::RenderConfig config = TimedConfig(opt);
             bench::StreamBenchOptions stream;
             stream.path = opt.stream;
-            stream.gpu_budget = bench::ParseBytes(opt.gpu_budget);
+            stream.gpu_budget = visualization::rendering::ParseByteSize(opt.gpu_budget);
             stream.splat_budget =
                 opt.stream_budget.empty() ? 0 : bench::ParseBudgets(opt.stream_budget).at(0);
             stream.page_capacity = opt.page_capacity;

@@ -13,7 +13,7 @@
 #include "open3d/core/Timer.h"
 #include "open3d/t/geometry/ImageMetrics.h"
 #include "open3d/t/io/SplatPageFile.h"
-#include "open3d/visualization/rendering/gaussian_splat/GaussianSplatDataPacking.h"
+#include "open3d/visualization/rendering/gaussian_splat/SplatStreamSession.h"
 #include "open3d/visualization/rendering/gaussian_splat/SplatStreamer.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/GaussianSplatVulkanBackend.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/VulkanBackendRegistry.h"
@@ -22,28 +22,6 @@ namespace open3d {
 namespace bench {
 
 namespace rendering = visualization::rendering;
-
-uint64_t ParseBytes(const std::string& text) {
-    char* end = nullptr;
-    const double value = std::strtod(text.c_str(), &end);
-    double unit = 1.0;
-    const std::string suffix = end ? std::string(end) : "";
-    if (suffix == "K" || suffix == "k")
-        unit = 1024.0;
-    else if (suffix == "M")
-        unit = 1024.0 * 1024.0;
-    else if (suffix == "G")
-        unit = 1024.0 * 1024.0 * 1024.0;
-    else if (suffix == "T")
-        unit = 1024.0 * 1024.0 * 1024.0 * 1024.0;
-    else if (!suffix.empty())
-        unit = -1.0;
-    if (text.empty() || end == text.c_str() || unit < 0 || !(value > 0) ||
-        !std::isfinite(value * unit) || value * unit > 1.8e19) {
-        core::ThrowError("'{}' is not a size in bytes (for example 2G, 512M, 1.5G, 123456)", text);
-    }
-    return static_cast<uint64_t>(value * unit);
-}
 
 void RunStreamBench(const t::geometry::PointCloud& scene,
                     const t::geometry::SplatHierarchy& hierarchy,
@@ -63,18 +41,8 @@ void RunStreamBench(const t::geometry::PointCloud& scene,
 
     const auto start = std::chrono::steady_clock::now();
     const t::io::SplatPageFile file(options.path);
-    // Pool slots from the budget: the bytes a packed splat takes on the GPU (positions,
-    // shape and SH words, its visibility bit).
-    const double bytes_per_splat =
-        rendering::PackedSplatLayout(file.ShDegree(), rendering::SplatPrecision::kExact)
-            .BytesPerSplat() +
-        1.0 / 8.0;
-    const int64_t pool_pages = static_cast<int64_t>(
-        double(options.gpu_budget) / (bytes_per_splat * double(file.PageCapacity())));
-    if (pool_pages < 1) {
-        core::ThrowError("--gpu-budget {} bytes holds no page of {} splats ({:.0f} bytes each)",
-                         options.gpu_budget, file.PageCapacity(), bytes_per_splat);
-    }
+    const double bytes_per_splat = rendering::StreamPoolBytesPerSplat(file.ShDegree());
+    const int64_t pool_pages = rendering::StreamPoolPages(file, options.gpu_budget);
     const int64_t pool_splats = pool_pages * file.PageCapacity();
     const int64_t budget = options.splat_budget > 0 ? options.splat_budget : pool_splats;
     rendering::SplatStreamer streamer(file, pool_pages, budget);

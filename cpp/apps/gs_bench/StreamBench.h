@@ -24,10 +24,6 @@ struct StreamBenchOptions {
     int64_t reads_per_step = 0;  ///< pages read per step
 };
 
-/// Bytes from "2G", "512M", "1.5G", "123456" (K, M, G, T are powers of 1024). Throws
-/// core::Open3DError naming the text when it is not one.
-uint64_t ParseBytes(const std::string& text);
-
 /// Writes `scene` (with `hierarchy`) as pages to options.path, streams it for `camera` into
 /// a new Vulkan backend and prints the steps and a summary line starting "stream".
 void RunStreamBench(const t::geometry::PointCloud& scene,

@@ -110,8 +110,8 @@ TEST(SplatHierarchyFile, MalformedFilesAreRefusedNamingTheField) {
     // The documented two-level file with offsets {0, 6, 5} for its 5 children: node 0's
     // count (6) fits 2..8 but runs past the children, node 1's is -1. Reading node 0's
     // children before checking node 1 read past the array (fuzz_splat_hierarchy_reader).
-    std::vector<uint8_t> two_levels = tests::ReadFileBytes(
-            std::string(OPEN3D_TEST_SOURCE_DIR) + "/fuzz/seeds/two_levels_sh1.lod");
+    std::vector<uint8_t> two_levels = tests::ReadFileBytes(std::string(OPEN3D_TEST_SOURCE_DIR) +
+                                                           "/fuzz/seeds/two_levels_sh1.lod");
     const int64_t past_the_end = 6;
     std::memcpy(two_levels.data() + 40 + 8, &past_the_end, 8);
     ExpectRefused(bad, two_levels, "inner node 1 has -1 children");

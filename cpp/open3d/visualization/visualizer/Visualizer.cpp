@@ -116,6 +116,21 @@ void Visualizer::UpdateGeometry(const std::string& name, const t::geometry::Tria
     PostRedraw();
 }
 
+void Visualizer::StreamSplats(const std::string& path,
+                              const rendering::SplatStreamOptions& options) {
+    scene_->GetScene().GetSplatRenderer().StreamSplats(path, options);
+    PostRedraw();
+}
+
+bool Visualizer::StopStreaming() {
+    PostRedraw();
+    return scene_->GetScene().GetSplatRenderer().StopStreaming();
+}
+
+std::optional<rendering::SplatStreamProgress> Visualizer::GetStreamProgress() const {
+    return scene_->GetScene().GetSplatRenderer().GetStreamProgress();
+}
+
 bool Visualizer::RemoveGeometry(const std::string& name) {
     if (!scene_->RemoveGeometry(name)) return false;
     names_.erase(std::find(names_.begin(), names_.end(), name));
@@ -336,6 +351,16 @@ void Visualizer::Run(const RunOptions& options) {
         if (options.poll) options.poll();
         // A reduced frame while the camera moved is refined once it stops.
         if (last_divisor_ > 1 && !IsCameraMoving()) PostRedraw();
+        // Pages that arrived show in the next frame (within the 0.1 s an idle loop sleeps),
+        // and so does a new progress line (the last step taken, the stream settled).
+        if (scene_->GetScene().GetSplatRenderer().HasStreamNews()) PostRedraw();
+        if (const auto progress = GetStreamProgress()) {
+            std::string line = rendering::FormatStreamProgress(*progress);
+            if (line != stream_line_) {
+                stream_line_ = std::move(line);
+                PostRedraw();
+            }
+        }
         if (fb_width_ <= 0 || fb_height_ <= 0 || !(options.continuous || redraw_frames_ > 0)) {
             // Minimised or idle: sleep until input. The gap is not a frame time.
             last_present_s_ = -1.0;

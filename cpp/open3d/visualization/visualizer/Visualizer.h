@@ -110,6 +110,17 @@ public:
     void ShowGeometry(const std::string& name, bool show);
     bool HasGeometry(const std::string& name) const;
     bool IsGeometryVisible(const std::string& name) const;
+    /// Streams a paged splat file (.gspages, written by gs-convert --pages) as the splat
+    /// scene, in place of any earlier stream (docs/streaming.md "In the renderer and the
+    /// viewer"): a coarse cut shows at once, finer pages arrive from a worker thread while
+    /// the viewer stays interactive, and the panel shows the progress. Meshes stay; splat
+    /// clouds cannot be added meanwhile. Throws core::Open3DError (nothing changes) while
+    /// splat clouds are shown, for a refused file or options, or without the Vulkan backend.
+    void StreamSplats(const std::string& path, const rendering::SplatStreamOptions& options = {});
+    /// Ends the stream; false when there was none.
+    bool StopStreaming();
+    /// Where the stream stands (the panel's "Streaming" line); empty when not streaming.
+    std::optional<rendering::SplatStreamProgress> GetStreamProgress() const;
     /// In the order they were added (the panel's order; keys 1-9 toggle the first nine).
     const std::vector<std::string>& GetGeometryNames() const { return names_; }
 
@@ -278,6 +289,7 @@ private:
     rendering::FilamentRenderer* renderer_ = nullptr;
     std::unique_ptr<VisualizerWindow> window_;
     std::unique_ptr<rendering::Open3DScene> scene_;
+    std::string stream_line_;  // the streaming progress line of the last redraw it asked for
     std::unique_ptr<ImGuiOverlay> overlay_;
     ViewControl view_control_;
     std::vector<std::string> names_;

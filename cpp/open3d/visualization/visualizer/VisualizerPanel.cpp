@@ -103,6 +103,12 @@ void Visualizer::BuildPanel() {
         ImGui::TextWrapped("%s", status_.c_str());
         if (status_warning_) ImGui::PopStyleColor();
     }
+    if (const auto progress = GetStreamProgress()) {
+        const bool warn = progress->starved || !progress->error.empty();
+        if (warn) ImGui::PushStyleColor(ImGuiCol_Text, kWarning);
+        ImGui::TextWrapped("%s", rendering::FormatStreamProgress(*progress).c_str());
+        if (warn) ImGui::PopStyleColor();
+    }
     if (open_callback_) {
         ImGui::SetNextItemWidth(ImGui::GetFontSize() * 16.0f);
         const bool enter =

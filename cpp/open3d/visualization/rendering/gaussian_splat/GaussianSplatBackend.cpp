@@ -33,6 +33,17 @@ Registry& GetRegistry() {
 
 }  // namespace
 
+void GaussianSplatBackend::SetScenePool(int64_t, int, const Eigen::Vector3d&,
+                                        const Eigen::Vector3d&) {
+    core::ThrowError("the '{}' splat backend cannot stream a paged scene (the vulkan backend can)",
+                     GetName());
+}
+
+void GaussianSplatBackend::ApplyStreamStep(const SplatStreamStep&) {
+    core::ThrowError("the '{}' splat backend cannot stream a paged scene (the vulkan backend can)",
+                     GetName());
+}
+
 RenderOutput GaussianSplatBackend::Render(const camera::PinholeCamera& camera,
                                           const RenderConfig& config,
                                           const CompositeInputs& inputs) {

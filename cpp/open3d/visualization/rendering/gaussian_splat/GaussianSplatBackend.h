@@ -4,7 +4,10 @@
 // Backends are made by name ("cpu", "placeholder"; "vulkan" is registered by its layer).
 #pragma once
 
+#include <Eigen/Core>
+
 #include <functional>
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -18,6 +21,8 @@
 namespace open3d {
 namespace visualization {
 namespace rendering {
+
+struct SplatStreamStep;
 
 /// Images of one frame, all camera.height x camera.width.
 struct RenderOutput {
@@ -114,6 +119,18 @@ public:
         (void)mask;
         return false;
     }
+
+    /// Streaming (docs/streaming.md): a scene of `capacity` splat slots of SH degree
+    /// `sh_degree`, every one hidden, filled by ApplyStreamStep; `center_min` .. `center_max`
+    /// bound every centre that will be written. Backends without a pool (the default) throw
+    /// core::Open3DError naming themselves.
+    virtual void SetScenePool(int64_t capacity, int sh_degree, const Eigen::Vector3d& center_min,
+                              const Eigen::Vector3d& center_max);
+    /// Writes a SplatStreamer step's pages into the pool and shows its cut.
+    virtual void ApplyStreamStep(const SplatStreamStep& step);
+    /// The most splats a scene or pool may hold on this backend's device (what one storage
+    /// binding spans); the largest int64_t where nothing but memory bounds it.
+    virtual int64_t MaxSceneSplats() const { return std::numeric_limits<int64_t>::max(); }
 
     /// Both stages with the images read back. GPU backends may record and submit both in one
     /// go (the Vulkan backend does unless `inputs` has a scene depth); the result equals

@@ -48,6 +48,12 @@ GaussianSplatRenderer::~GaussianSplatRenderer() = default;
 void GaussianSplatRenderer::AddCloud(const std::string& name,
                                      const t::geometry::PointCloud& cloud) {
     if (HasCloud(name)) core::ThrowError("GaussianSplatRenderer: a cloud named '{}' exists", name);
+    if (stream_) {
+        core::ThrowError(
+            "GaussianSplatRenderer: cannot add cloud '{}' while '{}' streams (a stream is the "
+            "whole splat scene; StopStreaming first)",
+            name, stream_->File().GetFilename());
+    }
     cloud.ValidateGaussianSplat();
     clouds_.emplace(name, Cloud{cloud, 0, true});
     merged_dirty_ = true;
@@ -94,11 +100,46 @@ std::vector<std::string> GaussianSplatRenderer::GetCloudNames() const {
 }
 
 void GaussianSplatRenderer::Clear() {
+    StopStreaming();
     if (!clouds_.empty()) merged_dirty_ = true;
     clouds_.clear();
 }
 
+void GaussianSplatRenderer::StreamSplats(const std::string& path,
+                                         const SplatStreamOptions& options) {
+    if (!clouds_.empty()) {
+        core::ThrowError(
+            "GaussianSplatRenderer: cannot stream '{}' beside {} cloud(s) (a stream is the whole "
+            "splat scene; remove them first)",
+            path, clouds_.size());
+    }
+    auto stream = std::make_unique<SplatStreamSession>(path, options, backend_->MaxSceneSplats());
+    const t::io::SplatPageFile& file = stream->File();
+    // Throws for a backend without a pool; the old stream (if any) goes on meanwhile.
+    backend_->SetScenePool(stream->PoolSplats(), file.ShDegree(), file.CenterMin(),
+                           file.CenterMax());
+    stream_ = std::move(stream);
+    merged_dirty_ = mask_dirty_ = false;
+    has_current_view_ = false;
+}
+
+bool GaussianSplatRenderer::StopStreaming() {
+    if (!stream_) return false;
+    stream_.reset();
+    backend_->ReleaseResources();
+    has_current_view_ = false;
+    return true;
+}
+
+std::optional<SplatStreamProgress> GaussianSplatRenderer::GetStreamProgress() const {
+    if (!stream_) return std::nullopt;
+    return stream_->Progress();
+}
+
+bool GaussianSplatRenderer::HasStreamNews() const { return stream_ && stream_->HasNews(); }
+
 bool GaussianSplatRenderer::HasVisibleSplats() const {
+    if (stream_) return true;
     for (const auto& [name, cloud] : clouds_) {
         if (cloud.visible && NumSplats(cloud.cloud) > 0) return true;
     }
@@ -107,6 +148,11 @@ bool GaussianSplatRenderer::HasVisibleSplats() const {
 
 bool GaussianSplatRenderer::GetBounds(Eigen::Vector3d& min_bound,
                                       Eigen::Vector3d& max_bound) const {
+    if (stream_) {
+        min_bound = stream_->File().CenterMin();
+        max_bound = stream_->File().CenterMax();
+        return true;
+    }
     bool any = false;
     for (const auto& [name, cloud] : clouds_) {
         const core::Tensor& p = cloud.cloud.GetPointPositions();
@@ -134,6 +180,13 @@ std::vector<uint32_t> GaussianSplatRenderer::VisibilityMask() const {
 }
 
 void GaussianSplatRenderer::Prepare() {
+    if (stream_) {
+        if (std::optional<SplatStreamStep> step = stream_->Take()) {
+            backend_->ApplyStreamStep(*step);
+            has_current_view_ = false;  // the backend's sorted entries are of the old cut
+        }
+        return;
+    }
     if (merged_dirty_) {
         std::vector<const t::geometry::PointCloud*> parts;
         int64_t first = 0;
@@ -174,6 +227,7 @@ void GaussianSplatRenderer::RenderGeometryStage(uint64_t view_id,
                                                 const camera::PinholeCamera& camera,
                                                 const RenderConfig& config) {
     views_[view_id] = ViewState{camera, config};
+    if (stream_) stream_->SetView(camera);
     backend_->RenderGeometryStage(camera, config);
     ++counters_.geometry_stages;
     current_view_ = view_id;

@@ -15,6 +15,7 @@
 #include <cstdint>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -22,6 +23,7 @@
 #include "open3d/t/geometry/PointCloud.h"
 #include "open3d/visualization/rendering/gaussian_splat/GaussianSplatBackend.h"
 #include "open3d/visualization/rendering/gaussian_splat/RenderConfig.h"
+#include "open3d/visualization/rendering/gaussian_splat/SplatStreamSession.h"
 
 namespace open3d {
 namespace visualization {
@@ -46,10 +48,11 @@ public:
     GaussianSplatBackend& GetBackend() const { return *backend_; }
     std::string GetBackendName() const { return backend_->GetName(); }
 
-    /// Adds a Gaussian cloud. Throws core::Open3DError when the name is taken or the cloud
-    /// lacks the Gaussian attributes (nothing changes then).
+    /// Adds a Gaussian cloud. Throws core::Open3DError when the name is taken, the cloud
+    /// lacks the Gaussian attributes or a stream runs (nothing changes then).
     void AddCloud(const std::string& name, const t::geometry::PointCloud& cloud);
     /// Replaces a cloud, keeping its visibility. Throws when the name is unknown.
+    /// Clear() also ends a stream.
     void UpdateCloud(const std::string& name, const t::geometry::PointCloud& cloud);
     bool RemoveCloud(const std::string& name);
     /// Throws when the name is unknown.
@@ -59,9 +62,25 @@ public:
     std::vector<std::string> GetCloudNames() const;
     void Clear();
 
-    /// Some visible cloud has splats: the stages must run.
+    /// Streams a paged splat file (.gspages, gs-convert --pages) instead of clouds
+    /// (docs/streaming.md "In the renderer and the viewer"): the backend holds a pool of
+    /// options.gpu_budget bytes; every geometry stage gives the streaming worker its view, and
+    /// every Prepare shows the pages read since. Throws core::Open3DError (nothing changes)
+    /// while clouds are held, for a refused file or options, or when the backend cannot hold
+    /// a pool (only "vulkan" can). A stream replaces an earlier one.
+    void StreamSplats(const std::string& path, const SplatStreamOptions& options = {});
+    /// Ends the stream and frees its pool; false when there was none.
+    bool StopStreaming();
+    bool IsStreaming() const { return stream_ != nullptr; }
+    /// Where the stream stands as of the last Prepare; empty when not streaming.
+    std::optional<SplatStreamProgress> GetStreamProgress() const;
+    /// A streaming step waits for the next Prepare: the next frame's picture differs.
+    bool HasStreamNews() const;
+
+    /// Some visible cloud has splats, or a stream runs: the stages must run.
     bool HasVisibleSplats() const;
-    /// Bounds of the visible splat centres; false when there are none.
+    /// Bounds of the visible splat centres (of the streamed file's centres while streaming);
+    /// false when there are none.
     bool GetBounds(Eigen::Vector3d& min_bound, Eigen::Vector3d& max_bound) const;
 
     /// Uploads the merged scene or the visibility mask when they changed.
@@ -105,6 +124,7 @@ private:
     std::unique_ptr<GaussianSplatBackend> backend_;
     std::map<std::string, Cloud> clouds_;
     std::map<uint64_t, ViewState> views_;
+    std::unique_ptr<SplatStreamSession> stream_;
     bool has_current_view_ = false;
     uint64_t current_view_ = 0;     // whose sorted entries the backend holds
     bool merged_dirty_ = false;     // clouds added, removed or replaced

@@ -57,11 +57,21 @@ bool SplatStreamWorker::Idle() const {
     return resting_;
 }
 
+bool SplatStreamWorker::Pending() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return pending_.has_value();
+}
+
+std::string SplatStreamWorker::Error() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return error_;
+}
+
 void SplatStreamWorker::Run() {
     std::unique_lock<std::mutex> lock(mutex_);
     while (true) {
         wake_.wait(lock, [&] {
-            return stop_ || (!resting_ && view_ &&
+            return stop_ || (error_.empty() && !resting_ && view_ &&
                              (!pending_ || pending_->writes.size() < kMaxPendingWrites));
         });
         if (stop_) return;
@@ -72,9 +82,11 @@ void SplatStreamWorker::Run() {
         try {
             step = streamer_.Step(view, reads_per_step_);
         } catch (const std::exception& e) {
-            // A page the file refuses: the picture stays as it is; the error is logged once.
+            // A page the file refuses: the picture stays as it is, the error is logged and kept,
+            // and the worker steps no more.
             lock.lock();
             resting_ = true;
+            error_ = e.what();
             core::LogWarning("streaming stopped: {}", e.what());
             continue;
         }

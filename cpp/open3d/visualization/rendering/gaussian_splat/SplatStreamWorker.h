@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <mutex>
 #include <optional>
+#include <string>
 #include <thread>
 
 #include "open3d/visualization/rendering/gaussian_splat/SplatStreamer.h"
@@ -37,6 +38,10 @@ public:
     std::optional<SplatStreamStep> Take();
     /// Whether the worker rests: its last step, for the newest view, needs nothing more.
     bool Idle() const;
+    /// Whether a step waits to be taken.
+    bool Pending() const;
+    /// Why streaming stopped (a page the file refused), empty while it has not.
+    std::string Error() const;
 
 private:
     void Run();
@@ -50,6 +55,7 @@ private:
     bool resting_ = true;
     bool stop_ = false;
     std::optional<SplatStreamStep> pending_;
+    std::string error_;
     std::thread thread_;
 };
 

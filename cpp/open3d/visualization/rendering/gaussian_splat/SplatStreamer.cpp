@@ -273,6 +273,10 @@ SplatStreamStep SplatStreamer::Step(const t::geometry::SplatCutView& view, int64
         step.visibility[s / 32] |= 1u << (s % 32);
         ++step.cut_nodes;
     }
+    step.resident_pages = ResidentPages();
+    step.pages_read = pages_read_;
+    step.bytes_read = bytes_read_;
+    step.evictions = evictions_;
     return step;
 }
 

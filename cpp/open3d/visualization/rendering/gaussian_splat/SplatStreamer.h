@@ -45,6 +45,12 @@ struct SplatStreamStep {
     double read_ms = 0.0;  ///< host time of reading and checking the pages
     /// A wanted page found no slot: every slot holds a page this view's cut uses.
     bool starved = false;
+    /// The streamer's totals after this step (ResidentPages, PagesRead, BytesRead,
+    /// Evictions), for a thread that must not ask the streamer while it steps.
+    int64_t resident_pages = 0;
+    int64_t pages_read = 0;
+    uint64_t bytes_read = 0;
+    int64_t evictions = 0;
 };
 
 class SplatStreamer {

@@ -209,6 +209,10 @@ void GaussianSplatVulkanBackend::WriteSceneSplatRanges(
     geometry_.valid = false;  // the geometry stage's output is stale
 }
 
+int64_t GaussianSplatVulkanBackend::MaxSceneSplats() const {
+    return static_cast<int64_t>(context_->GetDeviceInfo().max_storage_buffer_range / 16);
+}
+
 void GaussianSplatVulkanBackend::ApplyStreamStep(const SplatStreamStep& step) {
     std::vector<std::pair<int64_t, const t::geometry::PointCloud*>> ranges;
     for (const SplatStreamStep::PageWrite& write : step.writes) {

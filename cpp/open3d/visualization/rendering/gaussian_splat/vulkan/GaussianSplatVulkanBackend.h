@@ -147,7 +147,7 @@ public:
     /// range starts from `center_min` .. `center_max`, the bounds of every centre that will
     /// be written. Throws for a capacity outside 1 .. 2^32 - 1 or a degree outside 0..3.
     void SetScenePool(int64_t capacity, int sh_degree, const Eigen::Vector3d& center_min,
-                      const Eigen::Vector3d& center_max);
+                      const Eigen::Vector3d& center_max) override;
     /// Writes `splats` (valid, of the scene's SH degree) over splats [first, first + n) of the
     /// scene, on the GPU and in the copy kept for re-packing, after the frames that read the
     /// scene complete. The visibility mask is unchanged. Throws for a range outside the scene,
@@ -155,7 +155,10 @@ public:
     void WriteSceneSplats(int64_t first, const t::geometry::PointCloud& splats);
 
     /// Writes a SplatStreamer step's pages into the pool and shows its cut.
-    void ApplyStreamStep(const SplatStreamStep& step);
+    void ApplyStreamStep(const SplatStreamStep& step) override;
+    /// The positions (16 bytes a splat) are one storage binding: maxStorageBufferRange / 16
+    /// (8.4M splats on lavapipe's 128 MiB, 268M on a 4 GiB range).
+    int64_t MaxSceneSplats() const override;
 
     /// Replaces the visibility mask: bit i of word i / 32 shows splat i ([ceil(N / 32)]).
     void SetVisibility(const std::vector<uint32_t>& mask);
