@@ -192,6 +192,11 @@ public:
         if (filament_) {
             core::ThrowError("render_batch: batches are for splat-only renderers (meshes=False)");
         }
+        if (renderer_->IsStreaming()) {
+            // A batch draws the pool as it stands and gives the stream no view.
+            core::ThrowError(
+                "render_batch: not while a stream runs (render_to_image streams for its view)");
+        }
         std::vector<camera::PinholeCamera> sized;
         for (const camera::PinholeCamera& c : cameras) sized.push_back(Sized(c));
         RequireVisibleSplats();
@@ -334,10 +339,20 @@ void BindRendering(py::module_& m) {
             [](SplatScene& s, const std::string& path, const py::object& gpu_budget,
                int64_t splat_budget, int64_t reads_per_step) {
                 visualization::rendering::SplatStreamOptions options;
-                options.gpu_budget =
-                    py::isinstance<py::str>(gpu_budget)
-                        ? visualization::rendering::ParseByteSize(gpu_budget.cast<std::string>())
-                        : gpu_budget.cast<uint64_t>();
+                if (py::isinstance<py::str>(gpu_budget)) {
+                    const std::string text = gpu_budget.cast<std::string>();
+                    options.gpu_budget =
+                        text == "auto" ? 0 : visualization::rendering::ParseByteSize(text);
+                } else if (py::isinstance<py::int_>(gpu_budget) &&
+                           !py::isinstance<py::bool_>(gpu_budget) &&
+                           gpu_budget.cast<py::int_>() >= py::int_(0)) {
+                    options.gpu_budget = gpu_budget.cast<uint64_t>();
+                } else {
+                    core::ThrowError(
+                        "stream_splats: gpu_budget {} is neither bytes (an int >= 0, 0: the "
+                        "default) nor a size such as '2G' or 'auto'",
+                        py::repr(gpu_budget).cast<std::string>());
+                }
                 options.splat_budget = splat_budget;
                 options.reads_per_step = reads_per_step;
                 s.renderer->SplatRenderer().StreamSplats(path, options);
@@ -346,8 +361,8 @@ void BindRendering(py::module_& m) {
             py::arg("reads_per_step") = 16,
             "Streams a paged file (write_splat_pages, gs-convert --pages) as the splat scene "
             "(docs/streaming.md): its pages are read on a worker thread into a GPU pool of "
-            "gpu_budget bytes (an int, or a str such as '512M' or '2G'; 0: 1 GiB, or what the "
-            "device holds in one scene where that is less) for the view of each "
+            "gpu_budget bytes (an int, or a str such as '512M' or '2G'; 0 or 'auto': 1 GiB, or "
+            "what the device holds in one scene where that is less) for the view of each "
             "render; each render shows the pages read since the one before. splat_budget: nodes "
             "a cut may draw (0: what the pool holds). Raises Open3DError while splat clouds are "
             "held, for a refused file, or with the cpu backend (only vulkan streams).")

@@ -212,7 +212,12 @@ int Run(const Options& opt) {
     // Another file (dropped on the window or typed into the panel) is read on a worker
     // thread: the viewer keeps drawing the current scene and shows the read's progress.
     viewer.SetOpenCallback([&](const std::vector<std::string>& paths) {
-        if (IsPagedFile(paths.front())) {  // errors show in the panel; the scene stays
+        if (IsPagedFile(paths.front())) {
+            // Errors show in the panel; a refused file leaves the scene as it was.
+            if (reader.IsBusy()) {
+                core::ThrowError("{} is still loading; open {} after it", reader.GetPath(),
+                                 paths.front());
+            }
             StreamScene(viewer, paths.front(), opt);
             viewer.ResetCamera();
             return;

@@ -73,8 +73,15 @@ def test_what_cannot_stream_raises(tmp_path):
     r.scene.clear_geometry()
     with pytest.raises(o3d.Open3DError, match="is not a size in bytes"):
         r.scene.stream_splats(path, gpu_budget="lots")
+    for bad in (True, -1, 1.5, None, "0.5"):
+        with pytest.raises(o3d.Open3DError, match="gpu_budget|not a size in bytes"):
+            r.scene.stream_splats(path, gpu_budget=bad)
     r.scene.stream_splats(path, gpu_budget=1 << 20)
     with pytest.raises(o3d.Open3DError, match="StopStreaming first"):
         r.scene.add_geometry("cloud", pcd)
+    looking_along_z(r)
+    with pytest.raises(o3d.Open3DError, match="not while a stream runs"):
+        r.render_batch([r.camera])
+    r.scene.stream_splats(path, gpu_budget="auto")  # replaces the stream
     with pytest.raises(o3d.Open3DError, match="at least 8 nodes"):
         o3d.t.io.write_splat_pages(str(tmp_path / "bad.gspages"), pcd, page_capacity=4)

@@ -18,6 +18,7 @@
 #include "open3d/core/Exception.h"
 #include "open3d/t/geometry/SplatHierarchy.h"
 #include "open3d/t/io/SplatPageFile.h"
+#include "open3d/visualization/rendering/gaussian_splat/SplatStreamSession.h"
 #include "open3d/visualization/rendering/gaussian_splat/SplatStreamWorker.h"
 #include "open3d/visualization/rendering/gaussian_splat/SplatStreamer.h"
 #include "t/io/RandomSplatCloud.h"
@@ -31,6 +32,7 @@ using visualization::rendering::SplatCutViewOf;
 using visualization::rendering::SplatStreamer;
 using visualization::rendering::SplatStreamStep;
 using visualization::rendering::SplatStreamWorker;
+namespace rendering = visualization::rendering;
 
 // Two clusters of `n` splats each, 1000 units apart on x, 20 units in front of cameras at
 // x = 0 and x = 1000 that look down +z: each camera sees one cluster only.
@@ -288,6 +290,75 @@ TEST(SplatStreamWorker, ConvergesOffTheCallersThreadAsTheViewMoves) {
     EXPECT_GT(takes, 3);
     EXPECT_GT(streamer.Evictions(), 0);
     EXPECT_THROW(SplatStreamWorker(streamer, 0), core::Open3DError);
+}
+
+TEST(SplatStreamSession, ByteSizesAndPoolPages) {
+    using rendering::ParseByteSize;
+    EXPECT_EQ(ParseByteSize("2G"), uint64_t(2) << 30);
+    EXPECT_EQ(ParseByteSize("1.5K"), 1536u);
+    EXPECT_EQ(ParseByteSize("123456"), 123456u);
+    // "0.5" would round to 0 bytes, which callers read as the default: refused.
+    for (const char* bad : {"", "lots", "2X", "-1", "0", "0.5", "1e30T"}) {
+        EXPECT_THROW(ParseByteSize(bad), core::Open3DError) << bad;
+    }
+    const Paged paged = WritePaged(500, 64);
+    const t::io::SplatPageFile file(paged.path);
+    ASSERT_GT(file.NumPages(), 5);
+    const double page_bytes = rendering::StreamPoolBytesPerSplat(file.ShDegree()) * 64.0;
+    using rendering::StreamPoolPages;
+    // As many whole pages as the budget holds, never more than the file has.
+    EXPECT_EQ(StreamPoolPages(file, uint64_t(3.5 * page_bytes)), 3);
+    EXPECT_EQ(StreamPoolPages(file, uint64_t(1) << 40), file.NumPages());
+    EXPECT_EQ(StreamPoolPages(file, 0), file.NumPages());  // the default, 1 GiB
+    // A device that holds 197 splats in a scene: the default takes its 3 pages, a budget
+    // above it is refused, one above the file's size asks for no more than the file.
+    EXPECT_EQ(StreamPoolPages(file, 0, 197), 3);
+    const auto expect_error = [](const auto& call, const std::string& part) {
+        try {
+            call();
+            ADD_FAILURE() << "accepted; expected an error with '" << part << "'";
+        } catch (const core::Open3DError& e) {
+            EXPECT_NE(std::string(e.what()).find(part), std::string::npos) << e.what();
+        }
+    };
+    expect_error([&] { StreamPoolPages(file, uint64_t(5 * page_bytes), 197); },
+                 "this device holds at most 197 splats");
+    EXPECT_EQ(StreamPoolPages(file, uint64_t(1) << 40, 64 * file.NumPages()), file.NumPages());
+    expect_error([&] { StreamPoolPages(file, uint64_t(0.5 * page_bytes)); }, "holds no page");
+    expect_error([&] { StreamPoolPages(file, 0, 63); }, "not one page of 64");
+}
+
+TEST(SplatStreamSession, APageRefusedMidStreamSettlesWithItsError) {
+    const Paged paged = WritePaged(500, 64);
+    {
+        // Every page but the root's ends in a NaN: the header and the page table stay valid,
+        // the second page read is refused.
+        std::vector<uint8_t> bytes = ReadFileBytes(paged.path);
+        const t::io::SplatPageFile file(paged.path);
+        for (int64_t p = 1; p < file.NumPages(); ++p) {
+            const uint64_t end = file.Page(p).offset + file.PageBytes(p);
+            std::fill(bytes.begin() + end - 4, bytes.begin() + end, uint8_t(0xFF));
+        }
+        WriteFileBytes(paged.path, bytes);
+    }
+    rendering::SplatStreamSession session(paged.path, {});
+    EXPECT_FALSE(session.Progress().settled);  // no view yet
+    session.SetView(CameraAt(0.0));
+    const auto start = std::chrono::steady_clock::now();
+    while (!session.Progress().settled &&
+           std::chrono::steady_clock::now() - start < std::chrono::seconds(20)) {
+        session.Take();
+        std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
+    rendering::SplatStreamProgress p = session.Progress();
+    ASSERT_TRUE(p.settled);
+    EXPECT_NE(p.error.find(paged.path), std::string::npos) << p.error;
+    EXPECT_NE(rendering::FormatStreamProgress(p).find("; stopped: "), std::string::npos);
+    EXPECT_EQ(p.resident_pages, 1);  // the root's page, read before the refusal
+    // The worker steps no more: a new view does not unsettle it.
+    session.SetView(CameraAt(1000.0));
+    EXPECT_TRUE(session.Progress().settled);
+    EXPECT_FALSE(session.HasNews());
 }
 
 }  // namespace

@@ -113,12 +113,19 @@ void GaussianSplatRenderer::StreamSplats(const std::string& path,
             "splat scene; remove them first)",
             path, clouds_.size());
     }
+    // A refused file or budget leaves an earlier stream running; past this point it ends.
     auto stream = std::make_unique<SplatStreamSession>(path, options, backend_->MaxSceneSplats());
+    StopStreaming();
     const t::io::SplatPageFile& file = stream->File();
-    // Throws for a backend without a pool; the old stream (if any) goes on meanwhile.
-    backend_->SetScenePool(stream->PoolSplats(), file.ShDegree(), file.CenterMin(),
-                           file.CenterMax());
+    try {
+        backend_->SetScenePool(stream->PoolSplats(), file.ShDegree(), file.CenterMin(),
+                               file.CenterMax());
+    } catch (...) {
+        backend_->ReleaseResources();  // a pool half made (device memory) is no scene
+        throw;
+    }
     stream_ = std::move(stream);
+    stream_view_.reset();
     merged_dirty_ = mask_dirty_ = false;
     has_current_view_ = false;
 }
@@ -126,6 +133,7 @@ void GaussianSplatRenderer::StreamSplats(const std::string& path,
 bool GaussianSplatRenderer::StopStreaming() {
     if (!stream_) return false;
     stream_.reset();
+    stream_view_.reset();
     backend_->ReleaseResources();
     has_current_view_ = false;
     return true;
@@ -227,7 +235,12 @@ void GaussianSplatRenderer::RenderGeometryStage(uint64_t view_id,
                                                 const camera::PinholeCamera& camera,
                                                 const RenderConfig& config) {
     views_[view_id] = ViewState{camera, config};
-    if (stream_) stream_->SetView(camera);
+    // The stream follows one view (the first drawn since it started, until released): views
+    // taking turns would cut from the root every step and never let the worker rest.
+    if (stream_) {
+        if (!stream_view_) stream_view_ = view_id;
+        if (*stream_view_ == view_id) stream_->SetView(camera);
+    }
     backend_->RenderGeometryStage(camera, config);
     ++counters_.geometry_stages;
     current_view_ = view_id;
@@ -254,6 +267,7 @@ void GaussianSplatRenderer::RenderCompositeStage(uint64_t view_id, RenderOutput&
 
 void GaussianSplatRenderer::ReleaseView(uint64_t view_id) {
     views_.erase(view_id);
+    if (stream_view_ == view_id) stream_view_.reset();
     if (has_current_view_ && current_view_ == view_id) has_current_view_ = false;
 }
 

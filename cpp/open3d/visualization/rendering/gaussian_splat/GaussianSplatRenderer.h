@@ -64,10 +64,11 @@ public:
 
     /// Streams a paged splat file (.gspages, gs-convert --pages) instead of clouds
     /// (docs/streaming.md "In the renderer and the viewer"): the backend holds a pool of
-    /// options.gpu_budget bytes; every geometry stage gives the streaming worker its view, and
-    /// every Prepare shows the pages read since. Throws core::Open3DError (nothing changes)
-    /// while clouds are held, for a refused file or options, or when the backend cannot hold
-    /// a pool (only "vulkan" can). A stream replaces an earlier one.
+    /// options.gpu_budget bytes; the geometry stages of one view (the first drawn since, until
+    /// released) give the streaming worker that view, and every Prepare shows the pages read
+    /// since. A stream replaces an earlier one. Throws core::Open3DError while clouds are held
+    /// or for a refused file or options (nothing changes then), or when the backend cannot
+    /// hold the pool (only "vulkan" can; an earlier stream has ended then).
     void StreamSplats(const std::string& path, const SplatStreamOptions& options = {});
     /// Ends the stream and frees its pool; false when there was none.
     bool StopStreaming();
@@ -125,6 +126,7 @@ private:
     std::map<std::string, Cloud> clouds_;
     std::map<uint64_t, ViewState> views_;
     std::unique_ptr<SplatStreamSession> stream_;
+    std::optional<uint64_t> stream_view_;  // the view the stream follows
     bool has_current_view_ = false;
     uint64_t current_view_ = 0;     // whose sorted entries the backend holds
     bool merged_dirty_ = false;     // clouds added, removed or replaced

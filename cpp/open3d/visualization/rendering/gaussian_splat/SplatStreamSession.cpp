@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 
@@ -31,7 +32,7 @@ std::string FormatStreamProgress(const SplatStreamProgress& p) {
     std::string line = fmt::format(
         "Streaming: {} of {} pages in the pool of {}, {:.2f} GB read, {} splats drawn",
         p.resident_pages, p.file_pages, p.pool_pages, p.bytes_read / 1e9, Count(p.nodes_drawn));
-    if (!p.error.empty()) return line + "; stopped: " + p.error;
+    if (!p.error.empty()) return line + "; stopped: " + p.error;  // (settled)
     if (p.starved) return line + ", pool full";
     if (p.settled && p.pages_wanted == 0) return line + ", complete";
     if (p.pages_wanted > 0) line += fmt::format(", {} pages wanted", p.pages_wanted);
@@ -48,7 +49,7 @@ uint64_t ParseByteSize(const std::string& text) {
     if (suffix == "M") unit = 1024.0 * 1024.0;
     if (suffix == "G") unit = 1024.0 * 1024.0 * 1024.0;
     if (suffix == "T") unit = 1024.0 * 1024.0 * 1024.0 * 1024.0;
-    if (text.empty() || end == text.c_str() || unit < 0 || !(value > 0) ||
+    if (text.empty() || end == text.c_str() || unit < 0 || !(value * unit >= 1.0) ||
         !std::isfinite(value * unit) || value * unit > 1.8e19) {
         core::ThrowError("'{}' is not a size in bytes (for example 2G, 512M, 1.5G, 123456)", text);
     }
@@ -59,8 +60,7 @@ double StreamPoolBytesPerSplat(int sh_degree) {
     return PackedSplatLayout(sh_degree, SplatPrecision::kExact).BytesPerSplat() + 1.0 / 8.0;
 }
 
-int64_t StreamPoolPages(const t::io::SplatPageFile& file, uint64_t gpu_budget,
-                        int64_t max_splats) {
+int64_t StreamPoolPages(const t::io::SplatPageFile& file, uint64_t gpu_budget, int64_t max_splats) {
     const double per_splat = StreamPoolBytesPerSplat(file.ShDegree());
     const int64_t capacity = file.PageCapacity();
     const int64_t most = max_splats / capacity;  // pages the backend holds
@@ -69,7 +69,9 @@ int64_t StreamPoolPages(const t::io::SplatPageFile& file, uint64_t gpu_budget,
                          max_splats, capacity);
     }
     const double budget = gpu_budget > 0 ? double(gpu_budget) : double(uint64_t(1) << 30);
-    int64_t pages = static_cast<int64_t>(budget / (per_splat * double(capacity)));
+    // Every page has a slot at most: a budget above the file's size asks for no more.
+    const int64_t pages =
+        std::min(static_cast<int64_t>(budget / (per_splat * double(capacity))), file.NumPages());
     if (pages > most) {
         if (gpu_budget > 0) {
             core::ThrowError(
@@ -79,9 +81,8 @@ int64_t StreamPoolPages(const t::io::SplatPageFile& file, uint64_t gpu_budget,
                 gpu_budget, pages * capacity, max_splats, double(most * capacity) * per_splat,
                 capacity);
         }
-        pages = most;
+        return most;
     }
-    if (pages > file.NumPages()) return file.NumPages();  // every page has a slot
     if (pages < 1) {
         core::ThrowError(
             "a GPU budget of {} bytes holds no page of {} splats ({:.0f} bytes a splat): at "
@@ -142,9 +143,10 @@ std::optional<SplatStreamStep> SplatStreamSession::Take() {
 SplatStreamProgress SplatStreamSession::Progress() const {
     SplatStreamProgress p = progress_;
     // Before the first view nothing was streamed. Resting is asked first: a resting worker
-    // makes no step, so nothing can become pending after.
-    p.settled = view_.has_value() && worker_.Idle() && !worker_.Pending();
+    // makes no step, so nothing can become pending after. A worker stopped by an error steps
+    // no more whatever the view (it is not resting after a new view).
     p.error = worker_.Error();
+    p.settled = view_.has_value() && (!p.error.empty() || worker_.Idle()) && !worker_.Pending();
     return p;
 }
 

@@ -20,8 +20,8 @@ namespace rendering {
 
 struct SplatStreamOptions {
     /// GPU memory of the pool in bytes (packed exact splats and their visibility bits): the
-    /// pool holds as many whole pages as fit (at least one, at most the file's). 0: 1 GiB, or as many pages as
-    /// the backend holds in one scene where that is less (lavapipe: 8.4M splats).
+    /// pool holds as many whole pages as fit (at least one, at most the file's). 0: 1 GiB, or as
+    /// many pages as the backend holds in one scene where that is less (lavapipe: 8.4M splats).
     uint64_t gpu_budget = 0;
     /// Nodes a cut may draw; 0: as many as the pool holds (a budget that cannot bind).
     int64_t splat_budget = 0;
@@ -41,14 +41,15 @@ struct SplatStreamProgress {
     int64_t nodes_drawn = 0;   ///< by the newest cut
     int64_t pages_wanted = 0;  ///< pages the newest cut would open into and lacks
     bool starved = false;      ///< a wanted page found no slot: the pool is full for this view
-    /// Nothing more will change for the newest view: the worker rests and its last step has
-    /// been taken (shown by the frame that took it).
+    /// Nothing more will change for the newest view: the worker rests (or stopped on an
+    /// error) and its last step has been taken (shown by the frame that took it).
     bool settled = false;
     std::string error;  ///< why streaming stopped (a page the file refused), else empty
 };
 
-/// One line for a panel or a log: "Streaming: 12 / 487 pages in the pool of 49, 0.21 GB
-/// read, 1.2M splats drawn, 30 pages wanted" (or "... complete" / "... pool full").
+/// One line for a panel or a log: "Streaming: 12 of 487 pages in the pool of 49, 0.21 GB
+/// read, 1.2M splats drawn, 30 pages wanted" (or "..., complete", "..., pool full",
+/// "...; stopped: WHY").
 std::string FormatStreamProgress(const SplatStreamProgress& progress);
 
 /// Bytes from "2G", "512M", "1.5G", "123456" (K, M, G, T are powers of 1024). Throws

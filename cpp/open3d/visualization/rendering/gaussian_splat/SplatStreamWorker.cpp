@@ -80,7 +80,8 @@ void SplatStreamWorker::Run() {
         lock.unlock();
         SplatStreamStep step;
         try {
-            step = streamer_.Step(view, reads_per_step_);
+            // The first step reads the root's page alone: the first picture as early as can be.
+            step = streamer_.Step(view, streamer_.PagesRead() == 0 ? 0 : reads_per_step_);
         } catch (const std::exception& e) {
             // A page the file refuses: the picture stays as it is, the error is logged and kept,
             // and the worker steps no more.

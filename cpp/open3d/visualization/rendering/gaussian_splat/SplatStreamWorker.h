@@ -21,7 +21,8 @@ namespace rendering {
 class SplatStreamWorker {
 public:
     /// Steps `streamer` (which only this worker may use until it is destroyed) with up to
-    /// `reads_per_step` page reads a step. It starts idle: SetView gives it a view.
+    /// `reads_per_step` page reads a step (the first step reads the root's page alone). It
+    /// starts idle: SetView gives it a view.
     SplatStreamWorker(SplatStreamer& streamer, int64_t reads_per_step);
     /// Stops after the step in progress and joins the thread.
     ~SplatStreamWorker();

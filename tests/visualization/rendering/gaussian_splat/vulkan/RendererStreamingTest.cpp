@@ -107,7 +107,7 @@ TEST_F(RendererStreaming, FramesConvergeToTheWholeScenesImageAsTheViewMoves) {
         EXPECT_FALSE(p.starved);
         EXPECT_TRUE(p.error.empty());
         EXPECT_NE(FormatStreamProgress(p).find("complete"), std::string::npos)
-                << FormatStreamProgress(p);
+            << FormatStreamProgress(p);
         const RenderOutput whole = plain->Render(cam, {});
         EXPECT_EQ(streamed.stats.num_visible, whole.stats.num_visible);
         EXPECT_EQ(t::geometry::ComputeMaxAbsError(streamed.color, whole.color), 0.0);
@@ -116,11 +116,18 @@ TEST_F(RendererStreaming, FramesConvergeToTheWholeScenesImageAsTheViewMoves) {
     EXPECT_GT(p.evictions, 0);
     EXPECT_GT(p.pages_read, need_a + need_b);
     EXPECT_LE(p.resident_pages, pool);
-    // Frames of a settled view change nothing and ask the worker for nothing.
+    // Frames of a settled view change nothing and ask the worker for nothing, and a second
+    // view drawn in between (as a viewer's offscreen render) does not take the stream
+    // along: the stream follows the first view.
+    renderer.RenderGeometryStage(1, b, {});
     int frames = 0;
     DrawUntilSettled(renderer, a, frames);
     EXPECT_EQ(frames, 1);
     EXPECT_FALSE(renderer.HasStreamNews());
+    // Once that view is released, the next view drawn leads.
+    renderer.ReleaseView(0);
+    const RenderOutput led = DrawUntilSettled(renderer, b, frames);
+    EXPECT_EQ(t::geometry::ComputeMaxAbsError(led.color, plain->Render(b, {}).color), 0.0);
 }
 
 TEST_F(RendererStreaming, RefusalsLeaveTheRendererAsItWas) {
@@ -144,14 +151,17 @@ TEST_F(RendererStreaming, RefusalsLeaveTheRendererAsItWas) {
     SplatStreamOptions tiny;
     tiny.gpu_budget = 1000;  // not one page of 64 splats
     expect_error([&] { renderer.StreamSplats(paged, tiny); }, "holds no page");
-    SplatStreamOptions huge;
-    huge.gpu_budget = uint64_t(1) << 40;  // more than one binding spans on lavapipe or an H200
-    expect_error([&] { renderer.StreamSplats(paged, huge); }, "this device holds at most");
     expect_error([&] { renderer.StreamSplats(dir + "/missing.gspages"); }, "missing");
     EXPECT_FALSE(renderer.IsStreaming());
-    SplatStreamOptions small;  // the default pool (8.4M splats on lavapipe) takes seconds here
-    small.gpu_budget = uint64_t(1) << 20;
-    renderer.StreamSplats(paged, small);
+    // A budget above what one binding spans on lavapipe or an H200, but a file of a few
+    // pages: a slot per page, no more (the device limit itself: SplatStreamSession tests).
+    SplatStreamOptions huge;
+    huge.gpu_budget = uint64_t(1) << 40;
+    renderer.StreamSplats(paged, huge);
+    EXPECT_EQ(renderer.GetStreamProgress()->pool_pages, renderer.GetStreamProgress()->file_pages);
+    // A refused file leaves the stream running.
+    expect_error([&] { renderer.StreamSplats(dir + "/missing.gspages"); }, "missing");
+    EXPECT_TRUE(renderer.IsStreaming());
     expect_error([&] { renderer.AddCloud("cloud", scene); }, "StopStreaming first");
     EXPECT_FALSE(renderer.HasCloud("cloud"));
     EXPECT_TRUE(renderer.StopStreaming());
@@ -159,7 +169,7 @@ TEST_F(RendererStreaming, RefusalsLeaveTheRendererAsItWas) {
     EXPECT_FALSE(renderer.HasVisibleSplats());
     renderer.AddCloud("cloud", scene);  // clouds again after the stream
     renderer.RemoveCloud("cloud");
-    renderer.StreamSplats(paged, small);
+    renderer.StreamSplats(paged);
     renderer.Clear();  // ends the stream too
     EXPECT_FALSE(renderer.IsStreaming());
     // The CPU reference has no pool.
