@@ -8,6 +8,8 @@
 #include <string>
 #include <vector>
 
+#include "open3d/core/Exception.h"
+
 namespace open3d {
 namespace tests {
 
@@ -27,6 +29,17 @@ void WriteFileBytes(const std::string& path, const std::vector<uint8_t>& bytes);
 /// True in CI (environment CI=true): there a test that lacks an X display, a Vulkan device,
 /// a tool or a shared scene fails instead of skipping, so the suite cannot pass by skipping.
 bool SkipsAreFailures();
+
+/// Runs `call`, which must throw core::Open3DError with `part` in its message.
+template <typename Call>
+void ExpectErrorContaining(const Call& call, const std::string& part) {
+    try {
+        call();
+        ADD_FAILURE() << "accepted; expected an error with '" << part << "'";
+    } catch (const core::Open3DError& e) {
+        EXPECT_NE(std::string(e.what()).find(part), std::string::npos) << e.what();
+    }
+}
 
 /// Sets an environment variable for the scope of a test, then restores it (or unsets it).
 class ScopedEnvironment {

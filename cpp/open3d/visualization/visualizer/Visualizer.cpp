@@ -566,6 +566,10 @@ void Draw(const std::vector<DrawObject>& objects, const VisualizerOptions& optio
           const RunOptions& run) {
     Visualizer vis(options);
     for (const DrawObject& object : objects) {
+        if (const auto* stream = std::get_if<StreamedSplats>(&object.geometry)) {
+            vis.StreamSplats(stream->path, stream->options);
+            continue;
+        }
         if (const auto* cloud = std::get_if<t::geometry::PointCloud>(&object.geometry)) {
             if (object.material) {
                 vis.AddGeometry(object.name, *cloud, *object.material);

@@ -329,9 +329,17 @@ private:
 };
 
 /// A geometry for Draw: a splat cloud or a mesh, by name.
+/// A paged splat file (.gspages) for Draw to stream as the splat scene
+/// (Visualizer::StreamSplats).
+struct StreamedSplats {
+    std::string path;
+    rendering::SplatStreamOptions options;
+};
+
 struct DrawObject {
     std::string name;
-    std::variant<t::geometry::PointCloud, t::geometry::TriangleMesh> geometry;
+    /// A stream is always shown (`visible` and `material` are for clouds and meshes).
+    std::variant<t::geometry::PointCloud, t::geometry::TriangleMesh, StreamedSplats> geometry;
     /// How it is drawn (rendering::MaterialRecord); none: point clouds with the Gaussian
     /// attributes are splats, other point clouds points, meshes "defaultUnlit".
     std::optional<rendering::MaterialRecord> material;

@@ -313,19 +313,12 @@ TEST(SplatStreamSession, ByteSizesAndPoolPages) {
     // A device that holds 197 splats in a scene: the default takes its 3 pages, a budget
     // above it is refused, one above the file's size asks for no more than the file.
     EXPECT_EQ(StreamPoolPages(file, 0, 197), 3);
-    const auto expect_error = [](const auto& call, const std::string& part) {
-        try {
-            call();
-            ADD_FAILURE() << "accepted; expected an error with '" << part << "'";
-        } catch (const core::Open3DError& e) {
-            EXPECT_NE(std::string(e.what()).find(part), std::string::npos) << e.what();
-        }
-    };
-    expect_error([&] { StreamPoolPages(file, uint64_t(5 * page_bytes), 197); },
-                 "this device holds at most 197 splats");
+    ExpectErrorContaining([&] { StreamPoolPages(file, uint64_t(5 * page_bytes), 197); },
+                          "this device holds at most 197 splats");
     EXPECT_EQ(StreamPoolPages(file, uint64_t(1) << 40, 64 * file.NumPages()), file.NumPages());
-    expect_error([&] { StreamPoolPages(file, uint64_t(0.5 * page_bytes)); }, "holds no page");
-    expect_error([&] { StreamPoolPages(file, 0, 63); }, "not one page of 64");
+    ExpectErrorContaining([&] { StreamPoolPages(file, uint64_t(0.5 * page_bytes)); },
+                          "holds no page");
+    ExpectErrorContaining([&] { StreamPoolPages(file, 0, 63); }, "not one page of 64");
 }
 
 TEST(SplatStreamSession, APageRefusedMidStreamSettlesWithItsError) {

@@ -18,6 +18,7 @@
 #include "open3d/visualization/rendering/gaussian_splat/SplatStreamSession.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/GaussianSplatVulkanBackend.h"
 #include "t/io/RandomSplatCloud.h"
+#include "visualization/rendering/gaussian_splat/StreamingTestUtility.h"
 #include "visualization/rendering/gaussian_splat/vulkan/VulkanTestFixture.h"
 
 namespace open3d {
@@ -73,13 +74,7 @@ TEST_F(RendererStreaming, FramesConvergeToTheWholeScenesImageAsTheViewMoves) {
     const camera::PinholeCamera a = CameraAt(0.0), b = CameraAt(1000.0);
     // The pages each view needs on its own; the pool holds the larger, not both.
     const t::io::SplatPageFile file(paged);
-    int64_t need_a = 0, need_b = 0;
-    for (const auto& [cam, need] : {std::pair{a, &need_a}, std::pair{b, &need_b}}) {
-        SplatStreamer unlimited(file, file.NumPages(), file.NumLeaves());
-        while (unlimited.Step(SplatCutViewOf(cam), 64).pages_wanted > 0) {
-        }
-        *need = unlimited.ResidentPages();
-    }
+    const int64_t need_a = PagesTheViewNeeds(file, a), need_b = PagesTheViewNeeds(file, b);
     const int64_t pool = std::max(need_a, need_b);
     ASSERT_LT(pool, need_a + need_b - 2);
     SplatStreamOptions options;
@@ -135,23 +130,15 @@ TEST_F(RendererStreaming, RefusalsLeaveTheRendererAsItWas) {
     const std::string dir = TempDir();  // (each call empties the folder)
     const std::string paged = dir + "/small.gspages";
     t::io::WriteSplatPages(paged, scene, t::geometry::BuildSplatHierarchy(scene), 64);
-    const auto expect_error = [](const auto& call, const std::string& part) {
-        try {
-            call();
-            ADD_FAILURE() << "accepted; expected an error with '" << part << "'";
-        } catch (const core::Open3DError& e) {
-            EXPECT_NE(std::string(e.what()).find(part), std::string::npos) << e.what();
-        }
-    };
     GaussianSplatRenderer renderer(MakeBackend());
     renderer.AddCloud("cloud", scene);
-    expect_error([&] { renderer.StreamSplats(paged); }, "remove them first");
+    ExpectErrorContaining([&] { renderer.StreamSplats(paged); }, "remove them first");
     EXPECT_FALSE(renderer.IsStreaming());
     renderer.RemoveCloud("cloud");
     SplatStreamOptions tiny;
     tiny.gpu_budget = 1000;  // not one page of 64 splats
-    expect_error([&] { renderer.StreamSplats(paged, tiny); }, "holds no page");
-    expect_error([&] { renderer.StreamSplats(dir + "/missing.gspages"); }, "missing");
+    ExpectErrorContaining([&] { renderer.StreamSplats(paged, tiny); }, "holds no page");
+    ExpectErrorContaining([&] { renderer.StreamSplats(dir + "/missing.gspages"); }, "missing");
     EXPECT_FALSE(renderer.IsStreaming());
     // A budget above what one binding spans on lavapipe or an H200, but a file of a few
     // pages: a slot per page, no more (the device limit itself: SplatStreamSession tests).
@@ -160,9 +147,9 @@ TEST_F(RendererStreaming, RefusalsLeaveTheRendererAsItWas) {
     renderer.StreamSplats(paged, huge);
     EXPECT_EQ(renderer.GetStreamProgress()->pool_pages, renderer.GetStreamProgress()->file_pages);
     // A refused file leaves the stream running.
-    expect_error([&] { renderer.StreamSplats(dir + "/missing.gspages"); }, "missing");
+    ExpectErrorContaining([&] { renderer.StreamSplats(dir + "/missing.gspages"); }, "missing");
     EXPECT_TRUE(renderer.IsStreaming());
-    expect_error([&] { renderer.AddCloud("cloud", scene); }, "StopStreaming first");
+    ExpectErrorContaining([&] { renderer.AddCloud("cloud", scene); }, "StopStreaming first");
     EXPECT_FALSE(renderer.HasCloud("cloud"));
     EXPECT_TRUE(renderer.StopStreaming());
     EXPECT_FALSE(renderer.StopStreaming());
@@ -174,7 +161,7 @@ TEST_F(RendererStreaming, RefusalsLeaveTheRendererAsItWas) {
     EXPECT_FALSE(renderer.IsStreaming());
     // The CPU reference has no pool.
     GaussianSplatRenderer cpu("cpu");
-    expect_error([&] { cpu.StreamSplats(paged); }, "'cpu' splat backend cannot stream");
+    ExpectErrorContaining([&] { cpu.StreamSplats(paged); }, "'cpu' splat backend cannot stream");
     EXPECT_FALSE(cpu.IsStreaming());
 }
 

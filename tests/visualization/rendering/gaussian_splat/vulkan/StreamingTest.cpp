@@ -18,6 +18,7 @@
 #include "open3d/visualization/rendering/gaussian_splat/cpu/CpuBackend.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/GaussianSplatVulkanBackend.h"
 #include "t/io/RandomSplatCloud.h"
+#include "visualization/rendering/gaussian_splat/StreamingTestUtility.h"
 #include "visualization/rendering/gaussian_splat/vulkan/VulkanTestFixture.h"
 
 namespace open3d {
@@ -66,13 +67,7 @@ TEST_F(Streaming, ATinyPoolConvergesToTheWholeScenesImageAsTheViewMoves) {
     t::io::WriteSplatPages(paged, scene, t::geometry::BuildSplatHierarchy(scene), 1024);
     const t::io::SplatPageFile file(paged);
     // The pages each view needs on its own; the pool holds the larger, not both.
-    int64_t need_a = 0, need_b = 0;
-    for (const auto& [cam, need] : {std::pair{a, &need_a}, std::pair{b, &need_b}}) {
-        SplatStreamer unlimited(file, file.NumPages(), file.NumLeaves());
-        while (unlimited.Step(SplatCutViewOf(cam), 64).pages_wanted > 0) {
-        }
-        *need = unlimited.ResidentPages();
-    }
+    const int64_t need_a = PagesTheViewNeeds(file, a), need_b = PagesTheViewNeeds(file, b);
     const int64_t pool = std::max(need_a, need_b);
     ASSERT_LT(pool, need_a + need_b - 2);
     ASSERT_LT(pool, file.NumPages() * 6 / 10);
