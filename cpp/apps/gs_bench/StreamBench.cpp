@@ -42,7 +42,8 @@ void RunStreamBench(const t::geometry::PointCloud& scene,
     const auto start = std::chrono::steady_clock::now();
     const t::io::SplatPageFile file(options.path);
     const double bytes_per_splat = rendering::StreamPoolBytesPerSplat(file.ShDegree());
-    const int64_t pool_pages = rendering::StreamPoolPages(file, options.gpu_budget);
+    const int64_t pool_pages =
+        rendering::StreamPoolPages(file, options.gpu_budget, backend->MaxSceneSplats());
     const int64_t pool_splats = pool_pages * file.PageCapacity();
     const int64_t budget = options.splat_budget > 0 ? options.splat_budget : pool_splats;
     rendering::SplatStreamer streamer(file, pool_pages, budget);

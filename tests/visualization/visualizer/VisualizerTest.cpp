@@ -570,8 +570,17 @@ TEST_F(VisualizerTest, StreamedSplatsArriveWithoutInput) {
     EXPECT_EQ(frames, 0);
     const t::geometry::Image streamed = vis.RenderToImage();
     EXPECT_THROW(vis.AddGeometry("cloud", cloud), core::Open3DError);
+    // Hidden (the panel's checkbox), the stream draws nothing: the empty scene's picture.
+    vis.ShowStream(false);
+    EXPECT_FALSE(vis.IsStreamVisible());
+    const t::geometry::Image hidden = vis.RenderToImage();
+    EXPECT_GT(MeanAbsDiff(streamed, hidden, 0, 0, 240, 160), 1.0);
+    vis.ShowStream(true);
+    EXPECT_EQ(MeanAbsDiff(streamed, vis.RenderToImage(), 0, 0, 240, 160), 0.0);
     EXPECT_TRUE(vis.StopStreaming());
     EXPECT_FALSE(vis.GetStreamProgress().has_value());
+    EXPECT_THROW(vis.ShowStream(true), core::Open3DError);
+    EXPECT_EQ(MeanAbsDiff(hidden, vis.RenderToImage(), 0, 0, 240, 160), 0.0);
     vis.AddGeometry("cloud", cloud);
     const t::geometry::Image whole = vis.RenderToImage();
     EXPECT_EQ(MeanAbsDiff(streamed, whole, 0, 0, 240, 160), 0.0);

@@ -127,6 +127,15 @@ bool Visualizer::StopStreaming() {
     return scene_->GetScene().GetSplatRenderer().StopStreaming();
 }
 
+void Visualizer::ShowStream(bool show) {
+    scene_->GetScene().GetSplatRenderer().ShowStream(show);
+    PostRedraw();
+}
+
+bool Visualizer::IsStreamVisible() const {
+    return scene_->GetScene().GetSplatRenderer().IsStreamVisible();
+}
+
 std::optional<rendering::SplatStreamProgress> Visualizer::GetStreamProgress() const {
     return scene_->GetScene().GetSplatRenderer().GetStreamProgress();
 }

@@ -119,6 +119,9 @@ public:
     void StreamSplats(const std::string& path, const rendering::SplatStreamOptions& options = {});
     /// Ends the stream; false when there was none.
     bool StopStreaming();
+    /// Hides or shows the stream (the panel's "stream" checkbox); throws when none runs.
+    void ShowStream(bool show);
+    bool IsStreamVisible() const;
     /// Where the stream stands (the panel's "Streaming" line); empty when not streaming.
     std::optional<rendering::SplatStreamProgress> GetStreamProgress() const;
     /// In the order they were added (the panel's order; keys 1-9 toggle the first nine).

@@ -70,6 +70,12 @@ void RenderingSection(Visualizer& vis) {
 }
 
 void ObjectSection(Visualizer& vis) {
+    if (const auto progress = vis.GetStreamProgress()) {
+        bool visible = vis.IsStreamVisible();
+        const std::string label =
+            fmt::format("    stream {}", std::filesystem::path(progress->path).filename().string());
+        if (ImGui::Checkbox(label.c_str(), &visible)) vis.ShowStream(visible);
+    }
     const std::vector<std::string>& names = vis.GetGeometryNames();
     for (size_t i = 0; i < names.size(); ++i) {
         bool visible = vis.IsGeometryVisible(names[i]);
@@ -78,7 +84,7 @@ void ObjectSection(Visualizer& vis) {
             i < 9 ? fmt::format("[{}] {}", i + 1, names[i]) : fmt::format("    {}", names[i]);
         if (ImGui::Checkbox(label.c_str(), &visible)) vis.ShowGeometry(names[i], visible);
     }
-    if (names.empty()) ImGui::TextDisabled("(no geometry)");
+    if (names.empty() && !vis.GetStreamProgress()) ImGui::TextDisabled("(no geometry)");
 }
 
 }  // namespace

@@ -126,6 +126,7 @@ void GaussianSplatRenderer::StreamSplats(const std::string& path,
     }
     stream_ = std::move(stream);
     stream_view_.reset();
+    stream_visible_ = true;
     merged_dirty_ = mask_dirty_ = false;
     has_current_view_ = false;
 }
@@ -139,6 +140,11 @@ bool GaussianSplatRenderer::StopStreaming() {
     return true;
 }
 
+void GaussianSplatRenderer::ShowStream(bool show) {
+    if (!stream_) core::ThrowError("GaussianSplatRenderer: no stream to show or hide");
+    stream_visible_ = show;
+}
+
 std::optional<SplatStreamProgress> GaussianSplatRenderer::GetStreamProgress() const {
     if (!stream_) return std::nullopt;
     return stream_->Progress();
@@ -147,7 +153,7 @@ std::optional<SplatStreamProgress> GaussianSplatRenderer::GetStreamProgress() co
 bool GaussianSplatRenderer::HasStreamNews() const { return stream_ && stream_->HasNews(); }
 
 bool GaussianSplatRenderer::HasVisibleSplats() const {
-    if (stream_) return true;
+    if (stream_) return stream_visible_;
     for (const auto& [name, cloud] : clouds_) {
         if (cloud.visible && NumSplats(cloud.cloud) > 0) return true;
     }
@@ -157,6 +163,7 @@ bool GaussianSplatRenderer::HasVisibleSplats() const {
 bool GaussianSplatRenderer::GetBounds(Eigen::Vector3d& min_bound,
                                       Eigen::Vector3d& max_bound) const {
     if (stream_) {
+        if (!stream_visible_) return false;
         min_bound = stream_->File().CenterMin();
         max_bound = stream_->File().CenterMax();
         return true;

@@ -73,15 +73,19 @@ public:
     /// Ends the stream and frees its pool; false when there was none.
     bool StopStreaming();
     bool IsStreaming() const { return stream_ != nullptr; }
+    /// Hides or shows the stream's splats (a hidden stream draws nothing and is given no
+    /// view). Throws core::Open3DError when no stream runs.
+    void ShowStream(bool show);
+    bool IsStreamVisible() const { return stream_ && stream_visible_; }
     /// Where the stream stands as of the last Prepare; empty when not streaming.
     std::optional<SplatStreamProgress> GetStreamProgress() const;
     /// A streaming step waits for the next Prepare: the next frame's picture differs.
     bool HasStreamNews() const;
 
-    /// Some visible cloud has splats, or a stream runs: the stages must run.
+    /// Some visible cloud has splats, or a shown stream runs: the stages must run.
     bool HasVisibleSplats() const;
-    /// Bounds of the visible splat centres (of the streamed file's centres while streaming);
-    /// false when there are none.
+    /// Bounds of the visible splat centres (of the streamed file's centres while a shown
+    /// stream runs); false when there are none.
     bool GetBounds(Eigen::Vector3d& min_bound, Eigen::Vector3d& max_bound) const;
 
     /// Uploads the merged scene or the visibility mask when they changed.
@@ -127,6 +131,7 @@ private:
     std::map<uint64_t, ViewState> views_;
     std::unique_ptr<SplatStreamSession> stream_;
     std::optional<uint64_t> stream_view_;  // the view the stream follows
+    bool stream_visible_ = true;
     bool has_current_view_ = false;
     uint64_t current_view_ = 0;     // whose sorted entries the backend holds
     bool merged_dirty_ = false;     // clouds added, removed or replaced
