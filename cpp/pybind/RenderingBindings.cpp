@@ -340,9 +340,8 @@ void BindRendering(py::module_& m) {
                int64_t splat_budget, int64_t reads_per_step) {
                 visualization::rendering::SplatStreamOptions options;
                 if (py::isinstance<py::str>(gpu_budget)) {
-                    const std::string text = gpu_budget.cast<std::string>();
                     options.gpu_budget =
-                        text == "auto" ? 0 : visualization::rendering::ParseByteSize(text);
+                        visualization::rendering::ParseGpuBudget(gpu_budget.cast<std::string>());
                 } else if (py::isinstance<py::int_>(gpu_budget) &&
                            !py::isinstance<py::bool_>(gpu_budget) &&
                            gpu_budget.cast<py::int_>() >= py::int_(0)) {

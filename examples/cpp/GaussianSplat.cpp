@@ -81,7 +81,7 @@ void ClearScene(vis::Visualizer& viewer) {
 // scene, with the sphere at the centre of its bounds (0.05 x their diagonal).
 void StreamScene(vis::Visualizer& viewer, const std::string& path, const Options& opt) {
     rendering::SplatStreamOptions stream;
-    stream.gpu_budget = opt.gpu_budget == "auto" ? 0 : rendering::ParseByteSize(opt.gpu_budget);
+    stream.gpu_budget = rendering::ParseGpuBudget(opt.gpu_budget);
     // What can be refused is checked before the shown scene goes: the file's header and
     // page table, the budget against its pages, the backend.
     if (viewer.GetBackendName() != "vulkan") {

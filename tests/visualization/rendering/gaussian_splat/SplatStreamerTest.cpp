@@ -301,6 +301,9 @@ TEST(SplatStreamSession, ByteSizesAndPoolPages) {
     for (const char* bad : {"", "lots", "2X", "-1", "0", "0.5", "1e30T"}) {
         EXPECT_THROW(ParseByteSize(bad), core::Open3DError) << bad;
     }
+    EXPECT_EQ(rendering::ParseGpuBudget("auto"), 0u);  // the default pool
+    EXPECT_EQ(rendering::ParseGpuBudget("512M"), uint64_t(512) << 20);
+    EXPECT_THROW(rendering::ParseGpuBudget("0"), core::Open3DError);
     const Paged paged = WritePaged(500, 64);
     const t::io::SplatPageFile file(paged.path);
     ASSERT_GT(file.NumPages(), 5);

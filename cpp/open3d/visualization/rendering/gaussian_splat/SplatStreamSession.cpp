@@ -56,6 +56,10 @@ uint64_t ParseByteSize(const std::string& text) {
     return static_cast<uint64_t>(value * unit);
 }
 
+uint64_t ParseGpuBudget(const std::string& text) {
+    return text == "auto" ? 0 : ParseByteSize(text);
+}
+
 double StreamPoolBytesPerSplat(int sh_degree) {
     return PackedSplatLayout(sh_degree, SplatPrecision::kExact).BytesPerSplat() + 1.0 / 8.0;
 }
@@ -95,14 +99,13 @@ int64_t StreamPoolPages(const t::io::SplatPageFile& file, uint64_t gpu_budget, i
 
 namespace {
 
-int64_t CutBudget(const t::io::SplatPageFile& file, const SplatStreamOptions& options,
-                  int64_t max_splats) {
+// The cut's budget: options.splat_budget, or 0 for what a pool of `pool_splats` holds.
+int64_t CutBudget(const SplatStreamOptions& options, int64_t pool_splats) {
     if (options.splat_budget < 0) {
         core::ThrowError("streaming: a splat budget of {} (0: as many as the pool holds)",
                          options.splat_budget);
     }
-    if (options.splat_budget > 0) return options.splat_budget;
-    return StreamPoolPages(file, options.gpu_budget, max_splats) * file.PageCapacity();
+    return options.splat_budget > 0 ? options.splat_budget : pool_splats;
 }
 
 }  // namespace
@@ -110,8 +113,8 @@ int64_t CutBudget(const t::io::SplatPageFile& file, const SplatStreamOptions& op
 SplatStreamSession::SplatStreamSession(const std::string& path, const SplatStreamOptions& options,
                                        int64_t max_splats)
     : file_(path),
-      streamer_(file_, StreamPoolPages(file_, options.gpu_budget, max_splats),
-                CutBudget(file_, options, max_splats)),
+      pool_pages_(StreamPoolPages(file_, options.gpu_budget, max_splats)),
+      streamer_(file_, pool_pages_, CutBudget(options, pool_pages_ * file_.PageCapacity())),
       worker_(streamer_, options.reads_per_step) {
     progress_.path = path;
     progress_.file_pages = file_.NumPages();

@@ -55,6 +55,9 @@ std::string FormatStreamProgress(const SplatStreamProgress& progress);
 /// Bytes from "2G", "512M", "1.5G", "123456" (K, M, G, T are powers of 1024). Throws
 /// core::Open3DError naming the text when it is not one.
 uint64_t ParseByteSize(const std::string& text);
+/// SplatStreamOptions::gpu_budget from text: "auto" is 0 (the default pool), anything else
+/// ParseByteSize's bytes.
+uint64_t ParseGpuBudget(const std::string& text);
 
 /// Bytes a splat of SH degree `sh_degree` takes in a pool: its packed exact words and its
 /// visibility bit.
@@ -95,6 +98,7 @@ public:
 
 private:
     t::io::SplatPageFile file_;
+    const int64_t pool_pages_;  // StreamPoolPages, once
     SplatStreamer streamer_;
     SplatStreamWorker worker_;
     std::optional<camera::PinholeCamera> view_;
