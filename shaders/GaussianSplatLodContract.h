@@ -42,7 +42,32 @@ OPEN3D_SHADER_CONST uint kLodPassCounts = 4u;        // per group of 256 nodes: 
 OPEN3D_SHADER_CONST uint kLodPassOffsets = 5u;       // per 256 groups: offsets in the block, total
 OPEN3D_SHADER_CONST uint kLodPassBlockOffsets = 6u;  // one workgroup: block totals -> offsets
 OPEN3D_SHADER_CONST uint kLodPassList = 7u;          // per node: the cut's nodes as a list
-OPEN3D_SHADER_CONST uint kLodNumPasses = 8u;
+// The walk from the root (GaussianLodCut::Search::kFromRoot), in place of the first passes:
+OPEN3D_SHADER_CONST uint kLodPassWalkStart = 8u;  // one invocation: the guess, the root's level
+// Per node of a level: bucket, opens, children; its last workgroup sizes the next level.
+OPEN3D_SHADER_CONST uint kLodPassWalk = 9u;
+OPEN3D_SHADER_CONST uint kLodPassWalkMask = 10u;  // per visited inner node: the cut as bits
+OPEN3D_SHADER_CONST uint kLodNumPasses = 11u;
+
+// The walk's buffer (kLodWalkBinding): kLodWalkHeaderWords words of state, then the inner
+// nodes visited (inner ids, level after level). Every word but kLodWalkPrevious is written
+// before it is read each frame; kLodWalkPrevious carries the view's threshold to its next
+// frame (any value only changes how many nodes the walk visits, never the cut).
+OPEN3D_SHADER_CONST uint kLodWalkGuess = 0u;     // g: the walk opens the nodes above it
+OPEN3D_SHADER_CONST uint kLodWalkPrevious = 1u;  // the threshold of the frame before
+OPEN3D_SHADER_CONST uint kLodWalkBegin = 2u;     // the current level: [begin, end)
+OPEN3D_SHADER_CONST uint kLodWalkEnd = 3u;
+OPEN3D_SHADER_CONST uint kLodWalkCursor = 4u;      // visited nodes appended so far
+OPEN3D_SHADER_CONST uint kLodWalkRound = 5u;       // 0: first walk, 1: the walk again, kLodWalkDone
+OPEN3D_SHADER_CONST uint kLodWalkVisited = 6u;     // nodes visited by the walks before this one
+OPEN3D_SHADER_CONST uint kLodWalkGroupsDone = 7u;  // workgroups of the level that finished
+OPEN3D_SHADER_CONST uint kLodWalkArgs = 8u;        // VkDispatchIndirectCommand of the walk pass
+OPEN3D_SHADER_CONST uint kLodWalkMaskArgs = 12u;   // and of the walk's mask pass
+OPEN3D_SHADER_CONST uint kLodWalkHeaderWords = 16u;
+OPEN3D_SHADER_CONST uint kLodWalkDone = 2u;
+// The walk guesses the previous threshold less a quarter of an octave (sizes 19% apart): a
+// view that zooms in by less than that between frames walks once.
+OPEN3D_SHADER_CONST uint kLodWalkMargin = 16u;
 
 // Descriptor set 0 of the cut's pipelines (one push-descriptor layout).
 OPEN3D_SHADER_CONST uint kLodViewBinding = 0u;        // GaussianViewParams
@@ -61,7 +86,8 @@ OPEN3D_SHADER_CONST uint kLodListBinding = 8u;  // uint[LodListSlots]: node of e
 // uint[nodes - 1]: every inner node's children, inner nodes in order
 // (GaussianLodNode::first_child).
 OPEN3D_SHADER_CONST uint kLodChildrenBinding = 9u;
-OPEN3D_SHADER_CONST uint kLodNumBindings = 10u;
+OPEN3D_SHADER_CONST uint kLodWalkBinding = 10u;  // uint[kLodWalkHeaderWords + inner]: the walk
+OPEN3D_SHADER_CONST uint kLodNumBindings = 11u;
 
 // One node of the hierarchy (16 bytes, std430), in node order: leaves 0..N-1 (the scene's
 // splats), then the inner nodes N..N+K-1, children before parents, the root last.
@@ -78,7 +104,7 @@ struct GaussianLodPushConstants {
     uint num_leaves;
     uint num_inner;
     uint list_slots;  // LodListSlots of the view's budget
-    uint reserved0;
+    uint walk;        // 1: the threshold pass follows the walk from the root (kLodPassWalk*)
 };
 
 // Slots of the cut's node list, known before the cut is: the cut never exceeds the budget
@@ -112,6 +138,7 @@ static_assert(sizeof(GaussianLodPushConstants) == 16);
 static_assert(kLodWorkgroupSize % 32 == 0, "the list pass reads whole words");
 static_assert(offsetof(GaussianLodPushConstants, num_inner) == 4);
 static_assert(offsetof(GaussianLodPushConstants, list_slots) == 8);
+static_assert(offsetof(GaussianLodPushConstants, walk) == 12);
 }  // namespace shader
 }  // namespace rendering
 }  // namespace visualization

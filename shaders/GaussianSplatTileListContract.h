@@ -63,10 +63,11 @@ struct GaussianGeometryStageCounters {
     uint num_splats;  // N: the element count of the exact mode's depth sort
     GaussianScanLevel scan_levels[kScanMaxLevels];
     // Scenes with a level-of-detail hierarchy (gaussian_lod_cut.comp): the nodes of the
-    // view's cut and the size bucket it opens above (kLodOpenAll: every inner node).
+    // view's cut and the size bucket it opens above (kLodOpenAll: every inner node); with
+    // the walk from the root, the inner nodes it visited and how many walks it took (1 or 2).
     uint lod_cut_nodes;
     uint lod_threshold;
-    uint lod_reserved0, lod_reserved1;
+    uint lod_walk_visited, lod_walks;
 };
 
 // Push constants of gaussian_dispatch_args.comp.

@@ -18,6 +18,13 @@
 // - list: each node of the cut writes its id at its rank, so the list is in node order (the
 //   projection's slot order, on which the depth sort's ties depend, is the node order, as
 //   when every node had its own slot).
+// The walk from the root replaces the sizes, buckets and mask passes on large hierarchies
+// (GaussianLodCut::Search::kFromRoot): level after level from the root, it sizes only the
+// nodes whose parent opens above a guess g, the view's previous threshold less
+// kLodWalkMargin, and opens those above g. Every node above any t >= g is then visited and
+// the histogram above g is whole, so the threshold pass finds the same t as over every node
+// when t > g (or g = 0); when the budget would open more than g allows (a view that zoomed
+// in), it walks again from g = 0. The mask then runs over the visited nodes alone.
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_control_flow_attributes : require
 #include "GaussianSplatLodContract.h"
@@ -25,9 +32,7 @@
 layout(local_size_x = kLodWorkgroupSize) in;
 layout(constant_id = kSpecLodPass) const uint kPass = kLodPassBuckets;
 
-layout(push_constant) uniform PushBlock {
-    GaussianLodPushConstants pc;
-};
+layout(push_constant) uniform PushBlock { GaussianLodPushConstants pc; };
 layout(std430, set = 0, binding = kLodViewBinding) readonly buffer ViewBlock {
     GaussianViewParams view;
 };
@@ -38,12 +43,8 @@ layout(std430, set = 0, binding = kLodNodesBinding) readonly buffer NodesBlock {
     GaussianLodNode nodes[];
 };
 // [0, inner): each inner node's effective bucket; [inner, 2 inner): its own.
-layout(std430, set = 0, binding = kLodBucketsBinding) buffer BucketsBlock {
-    uint buckets[];
-};
-layout(std430, set = 0, binding = kLodHistogramBinding) buffer HistogramBlock {
-    uint histogram[];
-};
+layout(std430, set = 0, binding = kLodBucketsBinding) buffer BucketsBlock { uint buckets[]; };
+layout(std430, set = 0, binding = kLodHistogramBinding) buffer HistogramBlock { uint histogram[]; };
 layout(std430, set = 0, binding = kLodCountersBinding) buffer CountersBlock {
     GaussianGeometryStageCounters counters;
 };
@@ -53,11 +54,12 @@ layout(std430, set = 0, binding = kLodVisibilityBinding) buffer VisibilityBlock 
 layout(std430, set = 0, binding = kLodGroupCountsBinding) buffer GroupCountsBlock {
     uint group_counts[];
 };
-layout(std430, set = 0, binding = kLodListBinding) writeonly buffer ListBlock {
-    uint list[];
-};
+layout(std430, set = 0, binding = kLodListBinding) writeonly buffer ListBlock { uint list[]; };
 layout(std430, set = 0, binding = kLodChildrenBinding) readonly buffer ChildrenBlock {
     uint child_ids[];
+};
+layout(std430, set = 0, binding = kLodWalkBinding) buffer WalkBlock {
+    uint walk[];  // kLodWalk* header words, then the visited inner nodes
 };
 
 const uint kBucketsPerInvocation = kLodBuckets / kLodWorkgroupSize;
@@ -65,6 +67,8 @@ shared uint s_histogram[kLodBuckets];
 shared uint s_suffix[kLodWorkgroupSize];
 shared uint s_threshold;
 shared uint s_words[kLodWorkgroupSize / 32u];
+shared uint s_append, s_append_base;
+shared bool s_last_group;
 const uint kWordsPerGroup = kLodWorkgroupSize / 32u;
 
 // Whether the sphere of `radius` about camera-space `c` lies wholly outside one side plane
@@ -121,6 +125,36 @@ bool Opens(uint inner, uint threshold) {
     return threshold == kLodOpenAll || buckets[inner] > threshold;
 }
 
+// Sets the cut's bits that inner node `inner` decides (its effective bucket and its parent's
+// written): its own when its parent opens and it does not, its leaves' when it opens (its
+// inner children decide their own).
+void MarkCut(uint inner, uint threshold) {
+    uint node = pc.num_leaves + inner;
+    GaussianLodNode record = nodes[node];
+    bool opens = Opens(inner, threshold);
+    bool parent_opens =
+        record.parent == kLodNoParent || Opens(record.parent - pc.num_leaves, threshold);
+    if (parent_opens && !opens) atomicOr(visibility[node / 32u], 1u << (node % 32u));
+    if (opens) {
+        for (uint k = 0u; k < record.children; ++k) {
+            uint child = child_ids[record.first_child + k];
+            if (child < pc.num_leaves) atomicOr(visibility[child / 32u], 1u << (child % 32u));
+        }
+    }
+}
+
+// The walk's first level: the root alone.
+void StartWalk() {
+    walk[kLodWalkHeaderWords] = pc.num_inner - 1u;
+    walk[kLodWalkBegin] = 0u;
+    walk[kLodWalkEnd] = 1u;
+    walk[kLodWalkCursor] = 1u;
+    walk[kLodWalkGroupsDone] = 0u;
+    walk[kLodWalkArgs] = 1u;
+    walk[kLodWalkArgs + 1u] = 1u;
+    walk[kLodWalkArgs + 2u] = 1u;
+}
+
 void main() {
     uint id = gl_GlobalInvocationID.x;
     uint lane = gl_LocalInvocationID.x;
@@ -144,6 +178,8 @@ void main() {
             if (s_histogram[b] != 0u) atomicAdd(histogram[b], s_histogram[b]);
         }
     } else if (kPass == kLodPassThreshold) {
+        // After the walk's second round, or after a first round that found t: nothing to do.
+        if (pc.walk != 0u && walk[kLodWalkRound] == kLodWalkDone) return;
         // Lane i owns buckets [16 i, 16 i + 16), read once; the cut when opening above t has
         // 1 + S(t) nodes, S(t) = sum(histogram[b], b > t), falling as t rises. No lane walks
         // the histogram alone: on the H200 a serial loop over its 4096 global words cost
@@ -177,6 +213,41 @@ void main() {
         }
         if (best != kLodBuckets) atomicMin(s_threshold, best);
         barrier();
+        if (pc.walk != 0u) {
+            // The walk's histogram holds the nodes above g only: t is the one over every node
+            // when t > g, or when g = 0 (bucket 0, outside the view, never opens: the host
+            // walks only when the leaves exceed the budget, so not everything fits).
+            uint guess = walk[kLodWalkGuess];
+            uint threshold = s_threshold;
+            if (threshold > guess || guess == 0u) {
+                if (best == threshold) {
+                    counters.lod_threshold = threshold;
+                    counters.lod_cut_nodes = 1u + best_above;
+                }
+                if (lane == 0u) {
+                    uint visited = walk[kLodWalkVisited] + walk[kLodWalkCursor];
+                    counters.lod_walk_visited = visited;
+                    counters.lod_walks = walk[kLodWalkRound] + 1u;
+                    walk[kLodWalkPrevious] = threshold;
+                    walk[kLodWalkRound] = kLodWalkDone;
+                    walk[kLodWalkArgs] = 0u;
+                    walk[kLodWalkMaskArgs] =
+                        (walk[kLodWalkCursor] + kLodWorkgroupSize - 1u) / kLodWorkgroupSize;
+                    walk[kLodWalkMaskArgs + 1u] = 1u;
+                    walk[kLodWalkMaskArgs + 2u] = 1u;
+                }
+            } else {
+                // The budget opens more than g let the walk see: walk again from g = 0 (the
+                // host clears the histogram between the rounds).
+                if (lane == 0u) {
+                    walk[kLodWalkVisited] += walk[kLodWalkCursor];
+                    walk[kLodWalkGuess] = 0u;
+                    walk[kLodWalkRound] = 1u;
+                    StartWalk();
+                }
+            }
+            return;
+        }
         // Everything fits when 1 + the sum over all buckets does: then even the nodes outside
         // the view open and the cut is the leaves.
         if (total < budget) {
@@ -193,23 +264,79 @@ void main() {
         // one invocation per node, looked up each leaf's parent bucket: leaves are in the
         // scene's order, so those reads scattered over the inner nodes' buckets.
         if (id < pc.num_inner) {
-            uint threshold = counters.lod_threshold;
-            uint node = pc.num_leaves + id;
-            GaussianLodNode record = nodes[node];
-            bool opens = Opens(id, threshold);
-            bool parent_opens = record.parent == kLodNoParent ||
-                                Opens(record.parent - pc.num_leaves, threshold);
-            if (parent_opens && !opens) atomicOr(visibility[node / 32u], 1u << (node % 32u));
-            if (opens) {
-                for (uint k = 0u; k < record.children; ++k) {
-                    uint child = child_ids[record.first_child + k];
-                    if (child < pc.num_leaves) {
-                        atomicOr(visibility[child / 32u], 1u << (child % 32u));
-                    }
-                }
-            }
+            MarkCut(id, counters.lod_threshold);
         } else if (pc.num_inner == 0u && id == 0u) {
             atomicOr(visibility[0], 1u);  // a hierarchy of one leaf: the leaf is the cut
+        }
+    } else if (kPass == kLodPassWalkStart) {
+        if (id == 0u) {
+            uint previous = min(walk[kLodWalkPrevious], kLodBuckets - 1u);
+            walk[kLodWalkGuess] = previous > kLodWalkMargin ? previous - kLodWalkMargin : 0u;
+            walk[kLodWalkRound] = 0u;
+            walk[kLodWalkVisited] = 0u;
+            StartWalk();
+        }
+    } else if (kPass == kLodPassWalk) {
+        // One invocation per node of the level; a node's parent (the level before) has its
+        // effective bucket written. The opening nodes' inner children are appended, one
+        // global atomic per workgroup.
+        for (uint b = lane; b < kLodBuckets; b += kLodWorkgroupSize) s_histogram[b] = 0u;
+        if (lane == 0u) s_append = 0u;
+        barrier();
+        uint index = walk[kLodWalkBegin] + id;
+        uint inner = 0u, first_slot = 0u;
+        bool opens = false;
+        GaussianLodNode record;
+        if (index < walk[kLodWalkEnd]) {
+            inner = walk[kLodWalkHeaderWords + index];
+            uint node = pc.num_leaves + inner;
+            record = nodes[node];
+            uint bucket = SizeBucket(node);
+            if (record.parent != kLodNoParent) {
+                bucket = min(bucket, buckets[record.parent - pc.num_leaves]);
+            }
+            buckets[inner] = bucket;
+            opens = bucket > walk[kLodWalkGuess];
+            if (opens) {
+                atomicAdd(s_histogram[bucket], record.children - 1u);
+                uint inner_children = 0u;
+                for (uint k = 0u; k < record.children; ++k) {
+                    if (child_ids[record.first_child + k] >= pc.num_leaves) ++inner_children;
+                }
+                first_slot = atomicAdd(s_append, inner_children);
+            }
+        }
+        barrier();
+        if (lane == 0u && s_append > 0u) s_append_base = atomicAdd(walk[kLodWalkCursor], s_append);
+        barrier();
+        if (opens) {
+            uint slot = kLodWalkHeaderWords + s_append_base + first_slot;
+            for (uint k = 0u; k < record.children; ++k) {
+                uint child = child_ids[record.first_child + k];
+                if (child >= pc.num_leaves) walk[slot++] = child - pc.num_leaves;
+            }
+        }
+        for (uint b = lane; b < kLodBuckets; b += kLodWorkgroupSize) {
+            if (s_histogram[b] != 0u) atomicAdd(histogram[b], s_histogram[b]);
+        }
+        // The level's last workgroup to finish makes the next level of the nodes appended
+        // (the cursor, read atomically: every workgroup added to it before counting itself
+        // done) and sizes its dispatch; a separate one-invocation pass per level cost a
+        // dispatch and a barrier more per level.
+        if (lane == 0u) {
+            s_last_group = atomicAdd(walk[kLodWalkGroupsDone], 1u) + 1u == gl_NumWorkGroups.x;
+        }
+        barrier();
+        if (s_last_group && lane == 0u) {
+            uint begin = walk[kLodWalkEnd], end = atomicAdd(walk[kLodWalkCursor], 0u);
+            walk[kLodWalkBegin] = begin;
+            walk[kLodWalkEnd] = end;
+            walk[kLodWalkGroupsDone] = 0u;
+            walk[kLodWalkArgs] = (end - begin + kLodWorkgroupSize - 1u) / kLodWorkgroupSize;
+        }
+    } else if (kPass == kLodPassWalkMask) {
+        if (id < walk[kLodWalkCursor]) {
+            MarkCut(walk[kLodWalkHeaderWords + id], counters.lod_threshold);
         }
     } else if (kPass == kLodPassCounts) {
         // One invocation per group of kLodWorkgroupSize nodes: its words' bits.
@@ -232,8 +359,7 @@ void main() {
         uint inclusive = InclusivePrefixSum(lane, own);
         if (id < groups) group_counts[id] = inclusive - own;
         if (lane == kLodWorkgroupSize - 1u) {
-            group_counts[LodBlockBase(pc.num_leaves + pc.num_inner) + gl_WorkGroupID.x] =
-                inclusive;
+            group_counts[LodBlockBase(pc.num_leaves + pc.num_inner) + gl_WorkGroupID.x] = inclusive;
         }
     } else if (kPass == kLodPassBlockOffsets) {
         // Lane i sums a run of consecutive block totals, the lanes' sums are scanned in

@@ -11,6 +11,7 @@
 #include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <sstream>
 #include <string>
 #include <tuple>
 #include <utility>
@@ -52,9 +53,10 @@ struct Options {
     std::string depth = "none";
     int batch = 0;
     int frames_in_flight = 2;
-    std::string lod_budgets;        // --lod-budgets, empty: no level-of-detail rows
-    uint64_t max_tile_entries = 0;  // --max-tile-entries, 0: RenderConfig's default
-    std::string stream;             // --stream, empty: no streaming run
+    std::string lod_budgets;              // --lod-budgets, empty: no level-of-detail rows
+    std::string lod_cut_search = "auto";  // --lod-cut-search: comma list
+    uint64_t max_tile_entries = 0;        // --max-tile-entries, 0: RenderConfig's default
+    std::string stream;                   // --stream, empty: no streaming run
     std::string gpu_budget = "2G";
     std::string stream_budget;  // empty: what the pool holds
     int64_t page_capacity = 65536;
@@ -105,9 +107,36 @@ struct Row {
     // render of the whole scene, not the CPU reference.
     int64_t lod_budget = 0;
     double lod_nodes = 0, lod_cut_ms = 0, hierarchy_build_ms = 0;
-    double lod_cut_gpu_ms = 0;  // part of project_ms: the cut's passes on the GPU
-    bool lod_on_gpu = false;    // the cut chosen by the Vulkan backend, not on the CPU
+    double lod_cut_gpu_ms = 0;   // part of project_ms: the cut's passes on the GPU
+    double lod_list_gpu_ms = 0;  // part of lod_cut_gpu_ms: the bits made a list
+    bool lod_on_gpu = false;     // the cut chosen by the Vulkan backend, not on the CPU
+    // The walk from the root (after the timed frames, view 0's): inner nodes sized, walks.
+    int64_t lod_walk_visited = 0;
+    int lod_walks = 0;
 };
+
+// --lod-cut-search's names.
+const std::vector<std::pair<std::string, rendering::LodCutSearch>> kLodCutSearches = {
+    {"auto", rendering::LodCutSearch::kAuto},
+    {"every-node", rendering::LodCutSearch::kEveryNode},
+    {"from-root", rendering::LodCutSearch::kFromRoot},
+};
+
+std::vector<std::pair<std::string, rendering::LodCutSearch>> ParseLodCutSearches(
+    const std::string& text) {
+    std::vector<std::pair<std::string, rendering::LodCutSearch>> out;
+    std::stringstream items(text);
+    for (std::string item; std::getline(items, item, ',');) {
+        const auto found = std::find_if(kLodCutSearches.begin(), kLodCutSearches.end(),
+                                        [&](const auto& s) { return s.first == item; });
+        if (found == kLodCutSearches.end()) {
+            core::ThrowError("--lod-cut-search: '{}' is none of auto, every-node, from-root", item);
+        }
+        out.push_back(*found);
+    }
+    if (out.empty()) core::ThrowError("--lod-cut-search: give at least one search");
+    return out;
+}
 
 std::pair<int, int> ParseResolution(const std::string& text) {
     int w = 0, h = 0;
@@ -224,7 +253,8 @@ TimedFrames RunTimedFrames(rendering::GaussianSplatBackend& backend,
         }
         previous = std::min(previous, median);
     }
-    std::vector<double> project, sort, composite, depth_sort, scan_emit, tile_sort, lod_cut, wall;
+    std::vector<double> project, sort, composite, depth_sort, scan_emit, tile_sort, lod_cut,
+        lod_list, wall;
     std::vector<rendering::RenderStats> stage_stats;
     for (int i = 0; i < frames; ++i) {
         const rendering::RenderStats s = frame();
@@ -236,6 +266,7 @@ TimedFrames RunTimedFrames(rendering::GaussianSplatBackend& backend,
         scan_emit.push_back(s.gpu_scan_emit_ms);
         tile_sort.push_back(s.gpu_tile_sort_ms);
         lod_cut.push_back(s.gpu_lod_cut_ms);
+        lod_list.push_back(s.gpu_lod_list_ms);
         wall.push_back(wall_ms);
     }
     TimedFrames m;
@@ -247,6 +278,7 @@ TimedFrames RunTimedFrames(rendering::GaussianSplatBackend& backend,
     m.gpu.gpu_scan_emit_ms = Median(scan_emit);
     m.gpu.gpu_tile_sort_ms = Median(tile_sort);
     m.gpu.gpu_lod_cut_ms = Median(lod_cut);
+    m.gpu.gpu_lod_list_ms = Median(lod_list);
     m.cpu_frame_ms = Median(wall);
     m.stage_host = MedianHost(stage_stats);
     // The submission path: both stages in one submission (a recording re-submitted), waited for.
@@ -305,6 +337,7 @@ void AddView(Row& row, const TimedFrames& timed, const rendering::RenderStats& f
     row.scan_emit_ms += med.gpu_scan_emit_ms / n;
     row.tile_sort_ms += med.gpu_tile_sort_ms / n;
     row.lod_cut_gpu_ms += med.gpu_lod_cut_ms / n;
+    row.lod_list_gpu_ms += med.gpu_lod_list_ms / n;
     row.cpu_frame_ms += timed.cpu_frame_ms / n;
     row.frame_ms += timed.frame_ms / n;
     row.frame_gpu_ms += timed.frame_gpu_ms / n;
@@ -357,10 +390,15 @@ void PrintTable(const std::vector<Row>& rows) {
         if (r.lod_budget > 0 && r.lod_on_gpu) {
             std::printf(
                 "%-11s level of detail: cut of %.0f nodes (budget %lld) chosen on the GPU in "
-                "%.3f ms (part of project); error against the exact render of all %lld "
-                "splats\n",
+                "%.3f ms (part of project; its list from the bits %.3f ms); error against the "
+                "exact render of all %lld splats\n",
                 "", r.lod_nodes, static_cast<long long>(r.lod_budget), r.lod_cut_gpu_ms,
-                static_cast<long long>(r.splats));
+                r.lod_list_gpu_ms, static_cast<long long>(r.splats));
+            if (r.lod_walks > 0) {
+                std::printf("%-11s the walk from the root sized %lld inner nodes in %d walk%s\n",
+                            "", static_cast<long long>(r.lod_walk_visited), r.lod_walks,
+                            r.lod_walks == 1 ? "" : "s");
+            }
         } else if (r.lod_budget > 0) {
             std::printf(
                 "%-11s level of detail: cut of %.0f nodes (budget %lld) in %.1f ms on the CPU; "
@@ -425,43 +463,54 @@ void AddLodRows(const Options& opt, const std::vector<int64_t>& budgets, const S
         vulkan->SetSceneHierarchy(job.cloud, hierarchy);
     }
     const double n = static_cast<double>(cams.size());
-    for (const int64_t budget : budgets) {
-        Row row;
-        row.scene = job.name;
-        row.resolution = resolution;
-        row.knob = "lod " + bench::BudgetLabel(budget);
-        row.splats = job.cloud.NumPoints();
-        row.lod_budget = budget;
-        row.lod_on_gpu = vulkan != nullptr;
-        row.hierarchy_build_ms = hierarchy_ms;
-        config.lod_budget = static_cast<uint64_t>(budget);
-        for (size_t v = 0; v < cams.size(); ++v) {
-            double scene_nodes = static_cast<double>(hierarchy.NumNodes());
-            if (vulkan == nullptr) {
-                const bench::LodCut cut = bench::CutForView(hierarchy, job.cloud, cams[v], budget);
-                row.lod_nodes += static_cast<double>(cut.nodes) / n;
-                row.lod_cut_ms += cut.cut_ms / n;
-                lod_backend->SetScene(cut.cloud);
-                scene_nodes = static_cast<double>(cut.nodes);
+    const auto searches = ParseLodCutSearches(opt.lod_cut_search);
+    for (const int64_t budget : budgets)
+        for (const auto& [search_name, search] : searches) {
+            Row row;
+            row.scene = job.name;
+            row.resolution = resolution;
+            row.knob = "lod " + bench::BudgetLabel(budget);
+            if (searches.size() > 1) row.knob += " " + search_name;
+            config.lod_cut_search = search;
+            row.splats = job.cloud.NumPoints();
+            row.lod_budget = budget;
+            row.lod_on_gpu = vulkan != nullptr;
+            row.hierarchy_build_ms = hierarchy_ms;
+            config.lod_budget = static_cast<uint64_t>(budget);
+            for (size_t v = 0; v < cams.size(); ++v) {
+                double scene_nodes = static_cast<double>(hierarchy.NumNodes());
+                if (vulkan == nullptr) {
+                    const bench::LodCut cut =
+                        bench::CutForView(hierarchy, job.cloud, cams[v], budget);
+                    row.lod_nodes += static_cast<double>(cut.nodes) / n;
+                    row.lod_cut_ms += cut.cut_ms / n;
+                    lod_backend->SetScene(cut.cloud);
+                    scene_nodes = static_cast<double>(cut.nodes);
+                }
+                const rendering::RenderOutput out = lod_backend->Render(cams[v], config);
+                if (vulkan != nullptr)
+                    row.lod_nodes += static_cast<double>(out.stats.lod_cut_nodes) / n;
+                const TimedFrames timed =
+                    RunTimedFrames(*lod_backend, cams[v], config, opt.repeat, opt.depth);
+                AddView(row, timed, out.stats, cams.size());
+                row.bytes_per_splat +=
+                    static_cast<double>(out.stats.gpu_scene_bytes) / scene_nodes / n;
+                if (vulkan != nullptr) {
+                    const auto [in_flight, with_readback] =
+                        PipelinedMs(opt, *vulkan, {cams[v]}, config);
+                    row.pipelined_ms += in_flight / n;
+                    row.pipelined_readback_ms += with_readback / n;
+                }
+                AddViewError(row, out.color, exact[v]);
+                if (vulkan != nullptr && v == 0) {
+                    const rendering::RenderStats after = lod_backend->Render(cams[v], config).stats;
+                    row.lod_walk_visited = after.lod_walk_visited;
+                    row.lod_walks = after.lod_walks;
+                }
             }
-            const rendering::RenderOutput out = lod_backend->Render(cams[v], config);
-            if (vulkan != nullptr)
-                row.lod_nodes += static_cast<double>(out.stats.lod_cut_nodes) / n;
-            const TimedFrames timed =
-                RunTimedFrames(*lod_backend, cams[v], config, opt.repeat, opt.depth);
-            AddView(row, timed, out.stats, cams.size());
-            row.bytes_per_splat += static_cast<double>(out.stats.gpu_scene_bytes) / scene_nodes / n;
-            if (vulkan != nullptr) {
-                const auto [in_flight, with_readback] =
-                    PipelinedMs(opt, *vulkan, {cams[v]}, config);
-                row.pipelined_ms += in_flight / n;
-                row.pipelined_readback_ms += with_readback / n;
-            }
-            AddViewError(row, out.color, exact[v]);
+            row.gpu_total_ms = row.project_ms + row.sort_ms + row.composite_ms;
+            rows.push_back(row);
         }
-        row.gpu_total_ms = row.project_ms + row.sort_ms + row.composite_ms;
-        rows.push_back(row);
-    }
 }
 
 int Run(const Options& opt) {
@@ -477,6 +526,7 @@ int Run(const Options& opt) {
     }
     const std::vector<int64_t> budgets =
         opt.lod_budgets.empty() ? std::vector<int64_t>{} : bench::ParseBudgets(opt.lod_budgets);
+    ParseLodCutSearches(opt.lod_cut_search);  // refused before the scenes load
     rendering::vulkan::RegisterVulkanBackend();
     std::vector<SceneJob> jobs;
     if (opt.inputs.empty()) core::ThrowError("--input is required (a .ply or .splat scene)");
@@ -732,7 +782,10 @@ int Run(const Options& opt) {
                                      {"nodes", r.lod_nodes},
                                      {"cut_cpu_ms", r.lod_cut_ms},
                                      {"cut_gpu_ms", r.lod_cut_gpu_ms},
+                                     {"list_gpu_ms", r.lod_list_gpu_ms},
                                      {"cut_on_gpu", r.lod_on_gpu},
+                                     {"walk_visited", r.lod_walk_visited},
+                                     {"walks", r.lod_walks},
                                      {"hierarchy_build_ms", r.hierarchy_build_ms},
                                      {"error_against", "exact render of the whole scene"}};
             }
@@ -805,6 +858,11 @@ int main(int argc, char** argv) {
         "columns against the exact render of the whole scene (the hierarchy is built "
         "once per scene; with Vulkan the cut is chosen on the GPU each frame, else on the "
         "CPU; docs/lod.md)");
+    app.add_option("--lod-cut-search", opt.lod_cut_search,
+                   "Vulkan: how the GPU finds the cut, a comma list for one row each: auto, "
+                   "every-node (size every inner node), from-root (walk down from the root "
+                   "from the view's previous threshold); the cut is the same")
+        ->capture_default_str();
     app.add_option("--max-tile-entries", opt.max_tile_entries,
                    "Tile entries a frame may hold before the farthest splats' are dropped "
                    "(RenderConfig::max_tile_entries_total; default 2^26 = 67,108,864; the "

@@ -225,6 +225,7 @@ GeometryStageChoices ChooseGeometryStage(const camera::PinholeCamera& camera,
     choices.tile_bits = SortKeyTileBits(static_cast<uint64_t>(grid.NumTiles()));
     choices.entry_capacity = std::min(config_limit, inputs.entry_capacity);
     choices.entry_capacity_allocated = inputs.entry_capacity;
+    choices.lod_cut_search = config.lod_cut_search;
     return choices;
 }
 

@@ -91,7 +91,8 @@ struct GeometryStageChoices {
     uint32_t tile_bits = 0;   ///< SortKeyTileBits of the frame's tile count
     /// Tile entries used: min(allocated, max_tile_entries_total), below shader::kScanSaturation.
     uint32_t entry_capacity = 0;
-    uint32_t entry_capacity_allocated = 0;  ///< ViewPackingInputs::entry_capacity
+    uint32_t entry_capacity_allocated = 0;              ///< ViewPackingInputs::entry_capacity
+    LodCutSearch lod_cut_search = LodCutSearch::kAuto;  ///< RenderConfig::lod_cut_search
 };
 GeometryStageChoices ChooseGeometryStage(const camera::PinholeCamera& camera,
                                          const RenderConfig& config,

@@ -36,6 +36,16 @@ PackedLodNodes PackLodNodes(const t::geometry::SplatHierarchy& hierarchy) {
                 static_cast<uint32_t>(hierarchy.num_leaves + k);
         }
     }
+    // Parents come after their children (the root last), so a walk down from the end sees
+    // each parent's depth before its children's.
+    std::vector<uint32_t> depth(size_t(hierarchy.NumInner()), 0u);
+    for (int64_t k = hierarchy.NumInner() - 1; k >= 0; --k) {
+        const uint32_t parent = packed.nodes[size_t(hierarchy.num_leaves + k)].parent;
+        if (parent != shader::kLodNoParent) {
+            depth[size_t(k)] = depth[size_t(parent - packed.num_leaves)] + 1;
+        }
+        packed.inner_levels = std::max(packed.inner_levels, depth[size_t(k)] + 1);
+    }
     packed.children.resize(hierarchy.children.size());
     std::transform(hierarchy.children.begin(), hierarchy.children.end(), packed.children.begin(),
                    [](int64_t id) { return static_cast<uint32_t>(id); });

@@ -22,6 +22,9 @@ struct PackedLodNodes {
     /// [num_leaves + num_inner - 1]: the inner nodes' children, inner nodes in order (node k's
     /// from nodes[N + k].first_child on, nodes[N + k].children of them).
     std::vector<uint32_t> children;
+    /// Levels of the tree that hold inner nodes (the root's is level 0; 0 for a hierarchy of
+    /// one leaf): the walk from the root takes one step per level.
+    uint32_t inner_levels = 0;
 };
 
 /// Radius (3 x the largest scale, inner nodes), parent, child count and first child of every

@@ -13,7 +13,7 @@ bool SameGeometryConfig(const RenderConfig& a, const RenderConfig& b) {
            a.antialias == b.antialias && a.max_tiles_per_splat == b.max_tiles_per_splat &&
            a.max_tile_entries_total == b.max_tile_entries_total && a.sort_mode == b.sort_mode &&
            a.depth_order == b.depth_order && a.compact_storage == b.compact_storage &&
-           a.lod_budget == b.lod_budget;
+           a.lod_budget == b.lod_budget && a.lod_cut_search == b.lod_cut_search;
 }
 
 void RenderConfig::Validate() const {

@@ -37,6 +37,22 @@ enum class DepthOrder {
     kCameraRelative,
 };
 
+/// How a GPU backend finds a view's level-of-detail cut (RenderConfig::lod_budget); every
+/// choice gives the same cut, bit for bit (docs/lod.md "The cut on the GPU").
+enum class LodCutSearch {
+    /// kFromRoot for hierarchies of at least kLodWalkMinInner inner nodes, else kEveryNode.
+    kAuto,
+    /// Size every inner node each frame: a fixed cost per node, few dispatches.
+    kEveryNode,
+    /// Walk down from the root, level by level, sizing only the nodes whose parent opens
+    /// above the view's previous threshold (less half an octave): a cost that follows the
+    /// cut, not the hierarchy, and a few dispatches per level of the tree.
+    kFromRoot,
+};
+
+/// LodCutSearch::kAuto walks from the root from this many inner nodes on.
+inline constexpr uint32_t kLodWalkMinInner = 2000000;
+
 struct RenderConfig {
     /// Splats with view-space z <= near_plane are culled (3DGS: 0.2).
     double near_plane = 0.2;
@@ -63,6 +79,8 @@ struct RenderConfig {
     /// SetSceneHierarchy): the most nodes the view's cut may keep; 0 (the default) keeps
     /// every leaf, the exact scene. Ignored for plain scenes.
     uint64_t lod_budget = 0;
+    /// How the cut is found; see LodCutSearch (the cut is the same).
+    LodCutSearch lod_cut_search = LodCutSearch::kAuto;
     /// GPU backends skip the geometry stage when the scene, the camera and this config are
     /// unchanged since the last frame; benchmarks turn it off to time the whole pipeline every
     /// frame.
@@ -88,8 +106,12 @@ struct RenderStats {
     int64_t num_visible = 0;       ///< splats that survived projection (>= 1 tile)
     int64_t num_tile_entries = 0;  ///< (tile, splat) pairs composited
     int64_t lod_cut_nodes = 0;     ///< nodes of the level-of-detail cut (0: no hierarchy)
-    uint32_t error_flags = 0;      ///< kEntriesDropped | kCountsClamped
-    double geometry_ms = 0.0;      ///< project + tile entries + sort
+    /// The walk from the root (LodCutSearch::kFromRoot): inner nodes it sized and walks it
+    /// took (2 when the view's previous threshold was too coarse); 0 and 0 without a walk.
+    int64_t lod_walk_visited = 0;
+    int lod_walks = 0;
+    uint32_t error_flags = 0;  ///< kEntriesDropped | kCountsClamped
+    double geometry_ms = 0.0;  ///< project + tile entries + sort
     double composite_ms = 0.0;
     /// GPU time per pass from timestamp queries (GPU backends only; 0 where not measured).
     double gpu_project_ms = 0.0;    ///< projection (+ dispatch arguments)
@@ -101,6 +123,8 @@ struct RenderStats {
     /// Part of gpu_project_ms: the level-of-detail cut chosen on the GPU (0 without a
     /// hierarchy).
     double gpu_lod_cut_ms = 0.0;
+    /// Part of gpu_lod_cut_ms: the cut's bits made the projection's list.
+    double gpu_lod_list_ms = 0.0;
     /// Host time of the frame in the Vulkan backend: recording commands (0 when a recording
     /// was submitted again), submitting, waiting for the GPU's fence, copying the images out.
     /// A batch reports its totals divided by its views. docs/perf/ has the breakdown.

@@ -101,9 +101,11 @@ private:
     const t::io::SplatPageNode& Node(int64_t id, int64_t page) const {
         return records_[page][id - file_.Page(page).first_node];
     }
-    /// Reads `page` into a free slot or the least recently used slot this step's cut does not
-    /// use; false when there is none.
+    /// Gives `page` a free slot or the least recently used slot this step's cut does not use
+    /// (ReadPages reads it); false when there is none.
     bool Load(int64_t page, SplatStreamStep& step);
+    /// Reads the nodes and splats of step.writes[first_write...] (pages Load gave slots).
+    void ReadPages(SplatStreamStep& step, size_t first_write);
 
     const t::io::SplatPageFile& file_;
     int64_t pool_pages_ = 0;

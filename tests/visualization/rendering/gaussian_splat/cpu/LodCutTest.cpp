@@ -153,6 +153,23 @@ TEST(LodPacking, EveryInnerNodeListsItsChildrenAndEveryChildItsParent) {
     EXPECT_EQ(packed.nodes.back().parent, shader::kLodNoParent);
     EXPECT_EQ(std::count(listed.begin(), listed.end(), 1), total - 1);
     EXPECT_EQ(listed.back(), 0);  // the root
+    // The walk from the root takes a step per level of inner nodes: the deepest inner node's
+    // depth + 1, counted here by following parents up from every inner node.
+    uint32_t levels = 0;
+    for (int64_t id = n; id < total; ++id) {
+        uint32_t depth = 1;
+        for (uint32_t up = packed.nodes[size_t(id)].parent; up != shader::kLodNoParent;
+             up = packed.nodes[up].parent) {
+            ++depth;
+        }
+        levels = std::max(levels, depth);
+    }
+    EXPECT_GT(levels, 2u);
+    EXPECT_EQ(packed.inner_levels, levels);
+    // A hierarchy of one leaf has no inner level.
+    const t::geometry::PointCloud one =
+        t::geometry::ExtractSplatNodes(h, CreateDefaultGaussianSplatScene(), {0});
+    EXPECT_EQ(PackLodNodes(t::geometry::BuildSplatHierarchy(one)).inner_levels, 0u);
 }
 
 }  // namespace

@@ -251,15 +251,22 @@ void GaussianGeometryStage::Record(VkCommandBuffer cmd, const GeometryStageScene
         cut.visibility = buffers.lod_visibility;
         cut.group_counts = buffers.lod_group_counts;
         cut.list = buffers.lod_list;
+        cut.walk = buffers.lod_walk;
         cut.num_leaves = scene.lod_leaves;
         cut.num_inner = scene.lod_inner;
         cut.list_slots = n;
+        // The walk never opens everything: a budget of every leaf sizes every node.
+        const bool walk = scene.lod_inner > 0 && n < scene.lod_leaves &&
+                          (choices.lod_cut_search == LodCutSearch::kFromRoot ||
+                           (choices.lod_cut_search == LodCutSearch::kAuto &&
+                            scene.lod_inner >= kLodWalkMinInner));
+        cut.walk_levels = walk ? scene.lod_inner_levels : 0u;
         if (cut.num_leaves + cut.num_inner != scene.num_splats) {
             core::ThrowError("GaussianGeometryStage: a hierarchy of {} + {} nodes for {} splats",
                              cut.num_leaves, cut.num_inner, scene.num_splats);
         }
         if (timestamps) timestamps->RecordBegin(cmd, TimedPass::kLodCut);
-        lod_cut_.Record(cmd, cut);
+        lod_cut_.Record(cmd, cut, timestamps);
         ComputeBarrier(cmd);
         if (timestamps) timestamps->RecordEnd(cmd, TimedPass::kLodCut);
     }

@@ -69,6 +69,7 @@ struct GeometryStageSceneBuffers {
     BufferRange lod_nodes;     ///< shader::GaussianLodNode [N]
     BufferRange lod_children;  ///< uint32 [N - 1]: the inner nodes' children
     uint32_t lod_leaves = 0, lod_inner = 0;
+    uint32_t lod_inner_levels = 0;  ///< PackedLodNodes::inner_levels
     int packed_sh_degree = 0;
     uint32_t sh_words_per_splat = 0;
     SplatPrecision precision = SplatPrecision::kExact;
@@ -90,7 +91,7 @@ struct GeometryStageViewBuffers {
     /// A hierarchy's cut (GaussianLodCut; unused otherwise): effective size buckets, their
     /// histogram, the cut as bits, their counts per group, and the list of the cut's nodes
     /// the projection reads.
-    BufferRange lod_buckets, lod_histogram, lod_visibility, lod_group_counts, lod_list;
+    BufferRange lod_buckets, lod_histogram, lod_visibility, lod_group_counts, lod_list, lod_walk;
 };
 
 class GaussianGeometryStage {

@@ -200,12 +200,13 @@ void GeometryStageResources::UploadLod(const VulkanContext& context, const Comma
     lod_children_offset_ = children_offset;
     lod_leaves_ = lod.num_leaves;
     lod_inner_ = lod.num_inner;
+    lod_inner_levels_ = lod.inner_levels;
     view_ = GeometryStageViewResources();  // the view needs the cut's buffers
 }
 
 void GeometryStageResources::ClearLod() {
     lod_nodes = Buffer();
-    lod_leaves_ = lod_inner_ = 0;
+    lod_leaves_ = lod_inner_ = lod_inner_levels_ = 0;
 }
 
 void GeometryStageResources::UploadVisibility(const VulkanContext& context, const CommandPool& pool,
@@ -255,12 +256,15 @@ void GeometryStageViewResources::Allocate(const VulkanContext& context, uint32_t
     lod_visibility = Buffer();
     lod_group_counts = Buffer();
     lod_list = Buffer();
+    lod_walk = Buffer();
     if (lod_inner) {
         lod_buckets = make(GaussianLodCut::BucketsBytes(*lod_inner), need.usage);
         lod_histogram = make(GaussianLodCut::HistogramBytes(), need.usage);
         lod_visibility = make(GaussianLodCut::VisibilityBytes(n), need.usage);
         lod_group_counts = make(GaussianLodCut::GroupCountsBytes(n), need.usage);
         lod_list = make(GaussianLodCut::ListBytes(slots), need.usage);
+        lod_walk = make(GaussianLodCut::WalkBytes(*lod_inner),
+                        need.usage | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT);
     }
     // The largest, and the one not bound: made after every bound buffer has passed its check.
     projected = make(need.projected_bytes, need.usage | kAddressed);
@@ -281,6 +285,7 @@ GeometryStageSceneBuffers GeometryStageResources::Scene() const {
         scene.lod_children = lod_nodes.Range(lod_children_offset_);
         scene.lod_leaves = lod_leaves_;
         scene.lod_inner = lod_inner_;
+        scene.lod_inner_levels = lod_inner_levels_;
     }
     scene.num_splats = static_cast<uint32_t>(layout_.num_splats);
     scene.packed_sh_degree = layout_.sh_degree;
@@ -310,6 +315,7 @@ GeometryStageViewBuffers GeometryStageViewResources::Buffers() const {
         view.lod_visibility = lod_visibility.Range();
         view.lod_group_counts = lod_group_counts.Range();
         view.lod_list = lod_list.Range();
+        view.lod_walk = lod_walk.Range();
     }
     return view;
 }

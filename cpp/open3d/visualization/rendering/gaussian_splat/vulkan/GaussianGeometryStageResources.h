@@ -51,7 +51,7 @@ public:
     Buffer view_params, projected, counters, depth_keys, splat_indices, tile_counts, scan;
     Buffer entry_keys, entry_values, keys_alt, values_alt, histogram, sort_params;
     /// Empty without a hierarchy.
-    Buffer lod_buckets, lod_histogram, lod_visibility, lod_group_counts, lod_list;
+    Buffer lod_buckets, lod_histogram, lod_visibility, lod_group_counts, lod_list, lod_walk;
 
 private:
     std::optional<uint32_t> lod_inner_;
@@ -119,7 +119,7 @@ private:
     /// The packing's sizes of `like` for a scene of `num_splats`; drops the view buffers.
     void SetLayout(const PackedGaussianSplats& like, int64_t num_splats);
 
-    uint32_t lod_leaves_ = 0, lod_inner_ = 0;
+    uint32_t lod_leaves_ = 0, lod_inner_ = 0, lod_inner_levels_ = 0;
     VkDeviceSize lod_nodes_bytes_ = 0, lod_children_offset_ = 0;
     PackedGaussianSplats layout_;
     // One view's outputs (projected splats, counters, sorted entries) and scratch.

@@ -26,6 +26,16 @@ void ComputeToCompute(VkCommandBuffer cmd) {
                         VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
 }
 
+// The walk's passes write the arguments of the indirect dispatches that follow them.
+void ComputeToComputeAndIndirect(VkCommandBuffer cmd) {
+    RecordMemoryBarrier(
+        cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+        VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT | VK_ACCESS_2_SHADER_STORAGE_READ_BIT,
+        VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_DRAW_INDIRECT_BIT,
+        VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT |
+            VK_ACCESS_2_INDIRECT_COMMAND_READ_BIT);
+}
+
 }  // namespace
 
 GaussianLodCut::GaussianLodCut(const VulkanContext& context) : context_(context) {
@@ -36,7 +46,9 @@ GaussianLodCut::GaussianLodCut(const VulkanContext& context) : context_(context)
         "gaussian_lod_cut (sizes)",         "gaussian_lod_cut (buckets)",
         "gaussian_lod_cut (threshold)",     "gaussian_lod_cut (mask)",
         "gaussian_lod_cut (counts)",        "gaussian_lod_cut (offsets)",
-        "gaussian_lod_cut (block offsets)", "gaussian_lod_cut (list)"};
+        "gaussian_lod_cut (block offsets)", "gaussian_lod_cut (list)",
+        "gaussian_lod_cut (walk start)",    "gaussian_lod_cut (walk)",
+        "gaussian_lod_cut (walk mask)"};
     for (uint32_t pass = 0; pass < kLodNumPasses; ++pass) {
         const VkSpecializationMapEntry entry{kSpecLodPass, 0, sizeof(uint32_t)};
         const VkSpecializationInfo info{1, &entry, sizeof(uint32_t), &pass};
@@ -63,16 +75,21 @@ VkDeviceSize GaussianLodCut::ListBytes(uint32_t num_leaves) {
     return VkDeviceSize(std::max(num_leaves, 1u)) * 4;
 }
 
+VkDeviceSize GaussianLodCut::WalkBytes(uint32_t num_inner) {
+    // Each round appends an inner node at most once (a tree), the root included.
+    return (VkDeviceSize(kLodWalkHeaderWords) + std::max(num_inner, 1u)) * 4;
+}
+
 void GaussianLodCut::PushBindings(VkCommandBuffer cmd, const LodCutBuffers& buffers) const {
     const std::array<const BufferRange*, kLodNumBindings> ranges{
         &buffers.view_params, &buffers.positions, &buffers.nodes,      &buffers.buckets,
         &buffers.histogram,   &buffers.counters,  &buffers.visibility, &buffers.group_counts,
-        &buffers.list,        &buffers.children};
+        &buffers.list,        &buffers.children,  &buffers.walk};
     static_assert(kLodViewBinding == 0 && kLodPositionsBinding == 1 && kLodNodesBinding == 2 &&
                       kLodBucketsBinding == 3 && kLodHistogramBinding == 4 &&
                       kLodCountersBinding == 5 && kLodVisibilityBinding == 6 &&
                       kLodGroupCountsBinding == 7 && kLodListBinding == 8 &&
-                      kLodChildrenBinding == 9,
+                      kLodChildrenBinding == 9 && kLodWalkBinding == 10,
                   "ranges above are listed in binding order");
     std::array<VkDescriptorBufferInfo, kLodNumBindings> infos{};
     std::array<VkWriteDescriptorSet, kLodNumBindings> writes{};
@@ -92,8 +109,53 @@ void GaussianLodCut::PushBindings(VkCommandBuffer cmd, const LodCutBuffers& buff
                                        0, kLodNumBindings, writes.data());
 }
 
-void GaussianLodCut::Record(VkCommandBuffer cmd, const LodCutBuffers& buffers) const {
+void GaussianLodCut::Dispatch(VkCommandBuffer cmd, uint32_t pass, uint32_t groups) const {
+    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, passes_[pass].Get());
+    vkCmdDispatch(cmd, groups, 1, 1);
+}
+
+void GaussianLodCut::RecordWalk(VkCommandBuffer cmd, const LodCutBuffers& buffers) const {
+    const auto walk_indirect = [&](uint32_t pass, uint32_t args_word) {
+        vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, passes_[pass].Get());
+        vkCmdDispatchIndirect(cmd, buffers.walk.buffer,
+                              buffers.walk.offset + VkDeviceSize(args_word) * 4);
+    };
+    Dispatch(cmd, kLodPassWalkStart, 1);
+    // Two rounds are recorded; a first round that finds the threshold turns the second's
+    // dispatches to zero workgroups (kLodWalkDone).
+    for (int round = 0; round < 2; ++round) {
+        for (uint32_t level = 0; level < buffers.walk_levels; ++level) {
+            ComputeToComputeAndIndirect(cmd);
+            walk_indirect(kLodPassWalk, kLodWalkArgs);
+        }
+        ComputeToComputeAndIndirect(cmd);
+        Dispatch(cmd, kLodPassThreshold, 1);
+        if (round == 0) {
+            // The second round's histogram starts from zero; after a first round that found
+            // the threshold nothing reads it again.
+            RecordMemoryBarrier(
+                cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
+                VK_PIPELINE_STAGE_2_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT);
+            vkCmdFillBuffer(cmd, buffers.histogram.buffer, buffers.histogram.offset,
+                            HistogramBytes(), 0u);
+            RecordMemoryBarrier(
+                cmd, VK_PIPELINE_STAGE_2_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
+        }
+    }
+    ComputeToComputeAndIndirect(cmd);
+    walk_indirect(kLodPassWalkMask, kLodWalkMaskArgs);
+}
+
+void GaussianLodCut::Record(VkCommandBuffer cmd, const LodCutBuffers& buffers,
+                            const GpuTimestamps* timestamps) const {
     const uint32_t nodes = buffers.num_leaves + buffers.num_inner;
+    const bool walk = buffers.walk_levels > 0;
+    if (walk && (buffers.num_inner == 0 || buffers.list_slots >= buffers.num_leaves)) {
+        core::ThrowError("GaussianLodCut: a walk needs inner nodes and a budget below the leaves");
+    }
     vkCmdFillBuffer(cmd, buffers.histogram.buffer, buffers.histogram.offset, HistogramBytes(), 0u);
     vkCmdFillBuffer(cmd, buffers.visibility.buffer, buffers.visibility.offset,
                     VisibilityBytes(nodes), 0u);
@@ -102,22 +164,33 @@ void GaussianLodCut::Record(VkCommandBuffer cmd, const LodCutBuffers& buffers) c
                         VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
     PushBindings(cmd, buffers);
     const GaussianLodPushConstants push{buffers.num_leaves, buffers.num_inner, buffers.list_slots,
-                                        0u};
+                                        walk ? 1u : 0u};
     vkCmdPushConstants(cmd, pipeline_layout_.Get(), VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(push),
                        &push);
     // A hierarchy of one splat has no inner node: the sizes and buckets passes do nothing,
     // the histogram stays zero and the threshold pass opens everything (the one leaf).
     const uint32_t inner_groups = std::max(DivCeil(buffers.num_inner, kLodWorkgroupSize), 1u);
-    const uint32_t node_groups = std::max(DivCeil(nodes, kLodWorkgroupSize), 1u);
-    const uint32_t blocks = std::max(LodBlocks(nodes), 1u);
-    const uint32_t count_groups = std::max(DivCeil(LodGroups(nodes), kLodWorkgroupSize), 1u);
-    const uint32_t groups[kLodNumPasses] = {inner_groups, inner_groups, 1u, inner_groups,
-                                            count_groups, blocks,       1u, node_groups};
-    for (uint32_t pass = 0; pass < kLodNumPasses; ++pass) {
-        if (pass > 0) ComputeToCompute(cmd);
-        vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, passes_[pass].Get());
-        vkCmdDispatch(cmd, groups[pass], 1, 1);
+    if (walk) {
+        RecordWalk(cmd, buffers);
+    } else {
+        const uint32_t first_passes[] = {kLodPassSizes, kLodPassBuckets, kLodPassThreshold,
+                                         kLodPassMask};
+        for (const uint32_t pass : first_passes) {
+            if (pass != kLodPassSizes) ComputeToCompute(cmd);
+            Dispatch(cmd, pass, pass == kLodPassThreshold ? 1u : inner_groups);
+        }
     }
+    // The mask becomes the list in node order.
+    ComputeToCompute(cmd);
+    if (timestamps) timestamps->RecordBegin(cmd, TimedPass::kLodCutList);
+    Dispatch(cmd, kLodPassCounts, std::max(DivCeil(LodGroups(nodes), kLodWorkgroupSize), 1u));
+    ComputeToCompute(cmd);
+    Dispatch(cmd, kLodPassOffsets, std::max(LodBlocks(nodes), 1u));
+    ComputeToCompute(cmd);
+    Dispatch(cmd, kLodPassBlockOffsets, 1u);
+    ComputeToCompute(cmd);
+    Dispatch(cmd, kLodPassList, std::max(DivCeil(nodes, kLodWorkgroupSize), 1u));
+    if (timestamps) timestamps->RecordEnd(cmd, TimedPass::kLodCutList);
 }
 
 }  // namespace vulkan

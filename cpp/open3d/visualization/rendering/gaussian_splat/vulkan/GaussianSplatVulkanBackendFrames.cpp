@@ -33,7 +33,8 @@ bool SameChoices(const GeometryStageChoices& a, const GeometryStageChoices& b) {
     return a.num_splats == b.num_splats && a.sh_degree == b.sh_degree &&
            a.antialias == b.antialias && a.packed_key == b.packed_key &&
            a.tile_bits == b.tile_bits && a.entry_capacity == b.entry_capacity &&
-           a.entry_capacity_allocated == b.entry_capacity_allocated;
+           a.entry_capacity_allocated == b.entry_capacity_allocated &&
+           a.lod_cut_search == b.lod_cut_search;
 }
 
 bool SameOptions(const BatchOptions& a, const BatchOptions& b) {
@@ -694,6 +695,8 @@ std::vector<RenderOutput> GaussianSplatVulkanBackend::WaitBatch(uint64_t ticket)
         s.num_splats = geometry_stage_resources_.Layout().num_splats;
         s.num_visible = c.visible_count;
         s.lod_cut_nodes = geometry_stage_resources_.HasLod() ? c.lod_cut_nodes : 0;
+        s.lod_walk_visited = geometry_stage_resources_.HasLod() ? c.lod_walk_visited : 0;
+        s.lod_walks = geometry_stage_resources_.HasLod() ? int(c.lod_walks) : 0;
         s.num_tile_entries = c.entry_count;
         s.error_flags = c.error_flags;
         s.gpu_scene_bytes = static_cast<int64_t>(geometry_stage_resources_.SceneBytes());
@@ -742,6 +745,7 @@ std::vector<RenderOutput> GaussianSplatVulkanBackend::WaitBatch(uint64_t ticket)
         s.gpu_scan_emit_ms = at(TimedPass::kScanEmit);
         s.gpu_tile_sort_ms = at(TimedPass::kTileSort);
         s.gpu_lod_cut_ms = geometry_stage_resources_.HasLod() ? at(TimedPass::kLodCut) : 0.0;
+        s.gpu_lod_list_ms = geometry_stage_resources_.HasLod() ? at(TimedPass::kLodCutList) : 0.0;
         s.gpu_composite_ms = at(TimedPass::kComposite);
     }
     const double readback_ms = core::MillisecondsSince(readback_start);

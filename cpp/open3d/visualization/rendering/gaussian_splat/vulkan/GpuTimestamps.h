@@ -26,10 +26,11 @@ enum class TimedPass : uint32_t {
     kDepthMerge,
     // Parts of kSort, for profiling (GaussianGeometryStage::Record times them when given
     // timestamps).
-    kDepthSort,  ///< the depth sort of the visible list
-    kScanEmit,   ///< tile-count scan, capacity check and entry emission
-    kTileSort,   ///< the stable sort of the entries by tile
-    kLodCut,     ///< part of kProject: a hierarchy's cut (GaussianLodCut), before the projection
+    kDepthSort,   ///< the depth sort of the visible list
+    kScanEmit,    ///< tile-count scan, capacity check and entry emission
+    kTileSort,    ///< the stable sort of the entries by tile
+    kLodCut,      ///< part of kProject: a hierarchy's cut (GaussianLodCut), before the projection
+    kLodCutList,  ///< part of kLodCut: the cut's bits made a list (counts, offsets, list)
     kCount
 };
 
