@@ -49,18 +49,15 @@ OPEN3D_SHADER_CONST uint kLodPassWalk = 9u;
 OPEN3D_SHADER_CONST uint kLodPassWalkMask = 10u;  // per visited inner node: the cut as bits
 OPEN3D_SHADER_CONST uint kLodNumPasses = 11u;
 
-// The walk's buffer (kLodWalkBinding): kLodWalkHeaderWords words of state, then the inner
-// nodes visited (inner ids, level after level). Every word but kLodWalkPrevious is written
-// before it is read each frame; kLodWalkPrevious carries the view's threshold to its next
-// frame (any value only changes how many nodes the walk visits, never the cut).
-OPEN3D_SHADER_CONST uint kLodWalkGuess = 0u;     // g: the walk opens the nodes above it
-OPEN3D_SHADER_CONST uint kLodWalkPrevious = 1u;  // the threshold of the frame before
-OPEN3D_SHADER_CONST uint kLodWalkBegin = 2u;     // the current level: [begin, end)
-OPEN3D_SHADER_CONST uint kLodWalkEnd = 3u;
-OPEN3D_SHADER_CONST uint kLodWalkCursor = 4u;      // visited nodes appended so far
-OPEN3D_SHADER_CONST uint kLodWalkRound = 5u;       // 0: first walk, 1: the walk again, kLodWalkDone
-OPEN3D_SHADER_CONST uint kLodWalkVisited = 6u;     // nodes visited by the walks before this one
-OPEN3D_SHADER_CONST uint kLodWalkGroupsDone = 7u;  // workgroups of the level that finished
+// The walk's buffer (kLodWalkBinding): kLodWalkHeaderWords words of state, each written
+// before it is read in a frame, then the inner nodes visited (inner ids, level after level).
+OPEN3D_SHADER_CONST uint kLodWalkGuess = 0u;  // g: the walk opens the nodes above it
+OPEN3D_SHADER_CONST uint kLodWalkBegin = 1u;  // the current level: [begin, end)
+OPEN3D_SHADER_CONST uint kLodWalkEnd = 2u;
+OPEN3D_SHADER_CONST uint kLodWalkCursor = 3u;      // visited nodes appended so far
+OPEN3D_SHADER_CONST uint kLodWalkRound = 4u;       // 0: first walk, 1: the walk again, kLodWalkDone
+OPEN3D_SHADER_CONST uint kLodWalkVisited = 5u;     // nodes visited by the walks before this one
+OPEN3D_SHADER_CONST uint kLodWalkGroupsDone = 6u;  // workgroups of the level that finished
 OPEN3D_SHADER_CONST uint kLodWalkArgs = 8u;        // VkDispatchIndirectCommand of the walk pass
 OPEN3D_SHADER_CONST uint kLodWalkMaskArgs = 12u;   // and of the walk's mask pass
 OPEN3D_SHADER_CONST uint kLodWalkHeaderWords = 16u;
@@ -87,7 +84,11 @@ OPEN3D_SHADER_CONST uint kLodListBinding = 8u;  // uint[LodListSlots]: node of e
 // (GaussianLodNode::first_child).
 OPEN3D_SHADER_CONST uint kLodChildrenBinding = 9u;
 OPEN3D_SHADER_CONST uint kLodWalkBinding = 10u;  // uint[kLodWalkHeaderWords + inner]: the walk
-OPEN3D_SHADER_CONST uint kLodNumBindings = 11u;
+// uint[1], zero at upload: the last threshold the walk found, for the next frame's guess. One
+// per scene, shared by the frame slots and views: frames in flight may read it while another
+// writes it, and any value is a valid guess (it changes the nodes walked, never the cut).
+OPEN3D_SHADER_CONST uint kLodPreviousBinding = 11u;
+OPEN3D_SHADER_CONST uint kLodNumBindings = 12u;
 
 // One node of the hierarchy (16 bytes, std430), in node order: leaves 0..N-1 (the scene's
 // splats), then the inner nodes N..N+K-1, children before parents, the root last.
@@ -114,6 +115,13 @@ struct GaussianLodPushConstants {
 OPEN3D_SHADER_FUNC uint LodListSlots(uint num_leaves, uint lod_budget) {
     uint budget = lod_budget > 1u ? lod_budget : 1u;
     return num_leaves < budget ? num_leaves : budget;
+}
+
+// Nodes of a level each invocation of the walk pass sizes, and the workgroups for a level.
+OPEN3D_SHADER_CONST uint kLodWalkNodesPerInvocation = 4u;
+OPEN3D_SHADER_FUNC uint LodWalkGroups(uint level_nodes) {
+    uint per_group = kLodWorkgroupSize * kLodWalkNodesPerInvocation;
+    return (level_nodes + per_group - 1u) / per_group;
 }
 
 OPEN3D_SHADER_FUNC uint LodGroups(uint num_nodes) {

@@ -252,6 +252,7 @@ void GaussianGeometryStage::Record(VkCommandBuffer cmd, const GeometryStageScene
         cut.group_counts = buffers.lod_group_counts;
         cut.list = buffers.lod_list;
         cut.walk = buffers.lod_walk;
+        cut.previous = scene.lod_previous;
         cut.num_leaves = scene.lod_leaves;
         cut.num_inner = scene.lod_inner;
         cut.list_slots = n;

@@ -68,6 +68,7 @@ struct GeometryStageSceneBuffers {
     bool lod = false;
     BufferRange lod_nodes;     ///< shader::GaussianLodNode [N]
     BufferRange lod_children;  ///< uint32 [N - 1]: the inner nodes' children
+    BufferRange lod_previous;  ///< uint32 [1]: the cut's walk's last threshold
     uint32_t lod_leaves = 0, lod_inner = 0;
     uint32_t lod_inner_levels = 0;  ///< PackedLodNodes::inner_levels
     int packed_sh_degree = 0;

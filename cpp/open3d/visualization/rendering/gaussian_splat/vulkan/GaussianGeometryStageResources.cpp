@@ -188,16 +188,20 @@ void GeometryStageResources::UploadLod(const VulkanContext& context, const Comma
         std::max<VkDeviceSize>(context.GetDeviceInfo().min_storage_buffer_offset_alignment, 16);
     const VkDeviceSize children_offset = (node_bytes + alignment - 1) / alignment * alignment;
     const VkDeviceSize children_bytes = std::max<VkDeviceSize>(lod.children.size() * 4, 4);
+    // Then one word the cut's walk writes (its last threshold), zero from the staging memory.
+    const VkDeviceSize previous_offset =
+        (children_offset + children_bytes + alignment - 1) / alignment * alignment;
     RequireStorageBinding(context, "hierarchy nodes", node_bytes, lod.nodes.size());
     RequireStorageBinding(context, "hierarchy children", children_bytes, lod.nodes.size());
-    lod_nodes =
-        UploadStorageBuffer(context, pool, children_offset + children_bytes, [&](uint8_t* staging) {
-            std::memcpy(staging, lod.nodes.data(), node_bytes);
-            if (lod.children.empty()) return;  // one leaf
-            std::memcpy(staging + children_offset, lod.children.data(), lod.children.size() * 4);
-        });
+    lod_nodes = UploadStorageBuffer(context, pool, previous_offset + 4, [&](uint8_t* staging) {
+        std::memcpy(staging, lod.nodes.data(), node_bytes);
+        if (lod.children.empty()) return;  // one leaf
+        std::memcpy(staging + children_offset, lod.children.data(), lod.children.size() * 4);
+    });
     lod_nodes_bytes_ = node_bytes;
     lod_children_offset_ = children_offset;
+    lod_children_bytes_ = children_bytes;
+    lod_previous_offset_ = previous_offset;
     lod_leaves_ = lod.num_leaves;
     lod_inner_ = lod.num_inner;
     lod_inner_levels_ = lod.inner_levels;
@@ -282,7 +286,8 @@ GeometryStageSceneBuffers GeometryStageResources::Scene() const {
     scene.lod = HasLod();
     if (scene.lod) {
         scene.lod_nodes = lod_nodes.Range(0, lod_nodes_bytes_);
-        scene.lod_children = lod_nodes.Range(lod_children_offset_);
+        scene.lod_children = lod_nodes.Range(lod_children_offset_, lod_children_bytes_);
+        scene.lod_previous = lod_nodes.Range(lod_previous_offset_, 4);
         scene.lod_leaves = lod_leaves_;
         scene.lod_inner = lod_inner_;
         scene.lod_inner_levels = lod_inner_levels_;

@@ -120,7 +120,8 @@ private:
     void SetLayout(const PackedGaussianSplats& like, int64_t num_splats);
 
     uint32_t lod_leaves_ = 0, lod_inner_ = 0, lod_inner_levels_ = 0;
-    VkDeviceSize lod_nodes_bytes_ = 0, lod_children_offset_ = 0;
+    VkDeviceSize lod_nodes_bytes_ = 0, lod_children_offset_ = 0, lod_children_bytes_ = 0;
+    VkDeviceSize lod_previous_offset_ = 0;
     PackedGaussianSplats layout_;
     // One view's outputs (projected splats, counters, sorted entries) and scratch.
     GeometryStageViewResources view_;

@@ -84,13 +84,13 @@ void GaussianLodCut::PushBindings(VkCommandBuffer cmd, const LodCutBuffers& buff
     const std::array<const BufferRange*, kLodNumBindings> ranges{
         &buffers.view_params, &buffers.positions, &buffers.nodes,      &buffers.buckets,
         &buffers.histogram,   &buffers.counters,  &buffers.visibility, &buffers.group_counts,
-        &buffers.list,        &buffers.children,  &buffers.walk};
-    static_assert(kLodViewBinding == 0 && kLodPositionsBinding == 1 && kLodNodesBinding == 2 &&
-                      kLodBucketsBinding == 3 && kLodHistogramBinding == 4 &&
-                      kLodCountersBinding == 5 && kLodVisibilityBinding == 6 &&
-                      kLodGroupCountsBinding == 7 && kLodListBinding == 8 &&
-                      kLodChildrenBinding == 9 && kLodWalkBinding == 10,
-                  "ranges above are listed in binding order");
+        &buffers.list,        &buffers.children,  &buffers.walk,       &buffers.previous};
+    static_assert(
+        kLodViewBinding == 0 && kLodPositionsBinding == 1 && kLodNodesBinding == 2 &&
+            kLodBucketsBinding == 3 && kLodHistogramBinding == 4 && kLodCountersBinding == 5 &&
+            kLodVisibilityBinding == 6 && kLodGroupCountsBinding == 7 && kLodListBinding == 8 &&
+            kLodChildrenBinding == 9 && kLodWalkBinding == 10 && kLodPreviousBinding == 11,
+        "ranges above are listed in binding order");
     std::array<VkDescriptorBufferInfo, kLodNumBindings> infos{};
     std::array<VkWriteDescriptorSet, kLodNumBindings> writes{};
     for (uint32_t i = 0; i < kLodNumBindings; ++i) {
@@ -189,7 +189,7 @@ void GaussianLodCut::Record(VkCommandBuffer cmd, const LodCutBuffers& buffers,
     ComputeToCompute(cmd);
     Dispatch(cmd, kLodPassBlockOffsets, 1u);
     ComputeToCompute(cmd);
-    Dispatch(cmd, kLodPassList, std::max(DivCeil(nodes, kLodWorkgroupSize), 1u));
+    Dispatch(cmd, kLodPassList, std::max(DivCeil(DivCeil(nodes, 32), kLodWorkgroupSize), 1u));
     if (timestamps) timestamps->RecordEnd(cmd, TimedPass::kLodCutList);
 }
 

@@ -36,9 +36,10 @@ struct LodCutBuffers {
     BufferRange visibility;    ///< uint32 [ceil(nodes / 32)]: the cut as bits
     BufferRange group_counts;  ///< uint32 [GroupCountsBytes / 4]
     BufferRange list;          ///< uint32 [list_slots], written: the cut's nodes
-    /// uint32 [WalkBytes / 4]: the walk's state (kept from frame to frame: the view's
-    /// previous threshold) and visited nodes; also read by indirect dispatches.
+    /// uint32 [WalkBytes / 4]: the walk's state and visited nodes; also read by indirect
+    /// dispatches.
     BufferRange walk;
+    BufferRange previous;  ///< uint32 [1], per scene: the walk's last threshold
     uint32_t num_leaves = 0;
     uint32_t num_inner = 0;
     uint32_t list_slots = 0;  ///< shader::LodListSlots of the view's budget
