@@ -10,6 +10,20 @@ namespace open3d {
 namespace visualization {
 namespace rendering {
 
+bool WalksLodCut(LodCutSearch search, uint32_t num_inner, uint32_t num_leaves,
+                 uint32_t list_slots) {
+    if (num_inner == 0 || list_slots >= num_leaves) return false;
+    switch (search) {
+        case LodCutSearch::kEveryNode:
+            return false;
+        case LodCutSearch::kFromRoot:
+            return true;
+        case LodCutSearch::kAuto:
+            return num_inner >= kLodWalkMinInner && list_slots <= num_inner / 4;
+    }
+    return false;
+}
+
 PackedLodNodes PackLodNodes(const t::geometry::SplatHierarchy& hierarchy) {
     const int64_t total = hierarchy.NumNodes();
     if (total <= 0 || total >= int64_t(shader::kLodNoParent)) {

@@ -40,7 +40,8 @@ enum class DepthOrder {
 /// How a GPU backend finds a view's level-of-detail cut (RenderConfig::lod_budget); every
 /// choice gives the same cut, bit for bit (docs/lod.md "The cut on the GPU").
 enum class LodCutSearch {
-    /// kFromRoot for hierarchies of at least kLodWalkMinInner inner nodes, else kEveryNode.
+    /// kFromRoot where it measured faster (WalksLodCut: at least kLodWalkMinInner inner
+    /// nodes and a budget of at most a quarter of them), else kEveryNode.
     kAuto,
     /// Size every inner node each frame: a fixed cost per node, few dispatches.
     kEveryNode,

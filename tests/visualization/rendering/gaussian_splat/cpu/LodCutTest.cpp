@@ -122,6 +122,19 @@ TEST(LodCutMirror, NodesOutsideTheViewOpenLast) {
     EXPECT_LT(behind.nodes.size() * 10, in_view.nodes.size());
 }
 
+TEST(LodPacking, TheCutWalksFromTheRootWhereItIsAskedOrMeasuredFaster) {
+    const uint32_t big = kLodWalkMinInner, leaves = 2 * big;
+    // Asked for: walks, unless the slots hold every leaf or there is no inner node.
+    EXPECT_TRUE(WalksLodCut(LodCutSearch::kFromRoot, 10, 21, 20));
+    EXPECT_FALSE(WalksLodCut(LodCutSearch::kFromRoot, 10, 21, 21));
+    EXPECT_FALSE(WalksLodCut(LodCutSearch::kFromRoot, 0, 1, 1));
+    EXPECT_FALSE(WalksLodCut(LodCutSearch::kEveryNode, big, leaves, 1000));
+    // kAuto: large hierarchies, budgets up to a quarter of the inner nodes.
+    EXPECT_TRUE(WalksLodCut(LodCutSearch::kAuto, big, leaves, big / 4));
+    EXPECT_FALSE(WalksLodCut(LodCutSearch::kAuto, big, leaves, big / 4 + 1));
+    EXPECT_FALSE(WalksLodCut(LodCutSearch::kAuto, big - 1, leaves, 1000));
+}
+
 TEST(LodPacking, EveryInnerNodeListsItsChildrenAndEveryChildItsParent) {
     // The GPU cut's mask pass reaches a leaf only through its parent's entry in the packed
     // children (GaussianLodNode::first_child, children): each node must be listed once, by

@@ -160,7 +160,7 @@ TEST_F(LodCut, TheWalkFromTheRootFindsTheCutOfEveryNode) {
         }
     }
     EXPECT_GE(two_walks, 2);  // 1000 -> 8000 and 1 -> 2000 at least open far more
-    // LodCutSearch::kAuto sizes every node below kLodWalkMinInner inner nodes.
+    // LodCutSearch::kAuto sizes every node below kLodWalkMinInner inner nodes (WalksLodCut).
     ASSERT_LT(inner, int64_t(kLodWalkMinInner));
     RenderConfig config;
     config.lod_budget = 1000;

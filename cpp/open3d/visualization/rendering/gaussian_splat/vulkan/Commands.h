@@ -99,6 +99,10 @@ void RecordMemoryBarrier(VkCommandBuffer cmd, VkPipelineStageFlags2 src_stages,
                          VkAccessFlags2 src_access, VkPipelineStageFlags2 dst_stages,
                          VkAccessFlags2 dst_access);
 
+/// Compute writes before everything a later dispatch may read: storage data and the
+/// arguments of indirect dispatches.
+void RecordComputeToComputeAndIndirect(VkCommandBuffer cmd);
+
 }  // namespace vulkan
 }  // namespace rendering
 }  // namespace visualization

@@ -6,6 +6,7 @@
 #include <utility>
 
 #include "open3d/core/Exception.h"
+#include "open3d/visualization/rendering/gaussian_splat/GaussianSplatLodPacking.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/Commands.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/ComputePipeline.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/EmbeddedShaders.h"
@@ -31,14 +32,7 @@ VkDeviceSize Words(uint64_t n) { return VkDeviceSize(std::max<uint64_t>(n, 1)) *
 uint32_t DivCeil(uint64_t a, uint64_t b) { return static_cast<uint32_t>((a + b - 1) / b); }
 
 // Everything a geometry stage dispatch may read next: storage data and indirect arguments.
-void ComputeBarrier(VkCommandBuffer cmd) {
-    RecordMemoryBarrier(
-        cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
-        VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT | VK_ACCESS_2_SHADER_STORAGE_READ_BIT,
-        VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_DRAW_INDIRECT_BIT,
-        VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT |
-            VK_ACCESS_2_INDIRECT_COMMAND_READ_BIT);
-}
+void ComputeBarrier(VkCommandBuffer cmd) { RecordComputeToComputeAndIndirect(cmd); }
 
 }  // namespace
 
@@ -256,11 +250,7 @@ void GaussianGeometryStage::Record(VkCommandBuffer cmd, const GeometryStageScene
         cut.num_leaves = scene.lod_leaves;
         cut.num_inner = scene.lod_inner;
         cut.list_slots = n;
-        // The walk never opens everything: a budget of every leaf sizes every node.
-        const bool walk = scene.lod_inner > 0 && n < scene.lod_leaves &&
-                          (choices.lod_cut_search == LodCutSearch::kFromRoot ||
-                           (choices.lod_cut_search == LodCutSearch::kAuto &&
-                            scene.lod_inner >= kLodWalkMinInner));
+        const bool walk = WalksLodCut(choices.lod_cut_search, scene.lod_inner, scene.lod_leaves, n);
         cut.walk_levels = walk ? scene.lod_inner_levels : 0u;
         if (cut.num_leaves + cut.num_inner != scene.num_splats) {
             core::ThrowError("GaussianGeometryStage: a hierarchy of {} + {} nodes for {} splats",

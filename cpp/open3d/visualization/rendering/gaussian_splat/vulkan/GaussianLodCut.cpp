@@ -27,14 +27,7 @@ void ComputeToCompute(VkCommandBuffer cmd) {
 }
 
 // The walk's passes write the arguments of the indirect dispatches that follow them.
-void ComputeToComputeAndIndirect(VkCommandBuffer cmd) {
-    RecordMemoryBarrier(
-        cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
-        VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT | VK_ACCESS_2_SHADER_STORAGE_READ_BIT,
-        VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_DRAW_INDIRECT_BIT,
-        VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT |
-            VK_ACCESS_2_INDIRECT_COMMAND_READ_BIT);
-}
+void ComputeToComputeAndIndirect(VkCommandBuffer cmd) { RecordComputeToComputeAndIndirect(cmd); }
 
 }  // namespace
 
