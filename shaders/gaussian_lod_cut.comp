@@ -15,10 +15,9 @@
 // - counts: per group of 256 nodes, how many of them are in the cut;
 // - offsets: per block of 256 groups, the counts' exclusive prefix sums and the block's total;
 // - block offsets: one workgroup turns the blocks' totals into exclusive prefix sums;
-// - list: per word of 32 nodes, each of the cut's writes its id at its rank, so the list is in node
-// order (the
-//   projection's slot order, on which the depth sort's ties depend, is the node order, as
-//   when every node had its own slot).
+// - list: per word of 32 nodes, each node of the cut writes its id at its rank, so the list
+//   is in node order (the projection's slot order, on which the depth sort's ties depend, is
+//   the node order, as when every node had its own slot).
 // The walk from the root replaces the sizes, buckets and mask passes on large hierarchies
 // (LodCutSearch::kFromRoot): level after level from the root, it sizes only the nodes
 // whose parent opens above a guess g, the scene's previous threshold less
@@ -33,7 +32,9 @@
 layout(local_size_x = kLodWorkgroupSize) in;
 layout(constant_id = kSpecLodPass) const uint kPass = kLodPassBuckets;
 
-layout(push_constant) uniform PushBlock { GaussianLodPushConstants pc; };
+layout(push_constant) uniform PushBlock {
+    GaussianLodPushConstants pc;
+};
 layout(std430, set = 0, binding = kLodViewBinding) readonly buffer ViewBlock {
     GaussianViewParams view;
 };
@@ -44,8 +45,12 @@ layout(std430, set = 0, binding = kLodNodesBinding) readonly buffer NodesBlock {
     GaussianLodNode nodes[];
 };
 // [0, inner): each inner node's effective bucket; [inner, 2 inner): its own.
-layout(std430, set = 0, binding = kLodBucketsBinding) buffer BucketsBlock { uint buckets[]; };
-layout(std430, set = 0, binding = kLodHistogramBinding) buffer HistogramBlock { uint histogram[]; };
+layout(std430, set = 0, binding = kLodBucketsBinding) buffer BucketsBlock {
+    uint buckets[];
+};
+layout(std430, set = 0, binding = kLodHistogramBinding) buffer HistogramBlock {
+    uint histogram[];
+};
 layout(std430, set = 0, binding = kLodCountersBinding) buffer CountersBlock {
     GaussianGeometryStageCounters counters;
 };
@@ -55,7 +60,9 @@ layout(std430, set = 0, binding = kLodVisibilityBinding) buffer VisibilityBlock 
 layout(std430, set = 0, binding = kLodGroupCountsBinding) buffer GroupCountsBlock {
     uint group_counts[];
 };
-layout(std430, set = 0, binding = kLodListBinding) writeonly buffer ListBlock { uint list[]; };
+layout(std430, set = 0, binding = kLodListBinding) writeonly buffer ListBlock {
+    uint list[];
+};
 layout(std430, set = 0, binding = kLodChildrenBinding) readonly buffer ChildrenBlock {
     uint child_ids[];
 };
@@ -370,7 +377,8 @@ void main() {
         uint inclusive = InclusivePrefixSum(lane, own);
         if (id < groups) group_counts[id] = inclusive - own;
         if (lane == kLodWorkgroupSize - 1u) {
-            group_counts[LodBlockBase(pc.num_leaves + pc.num_inner) + gl_WorkGroupID.x] = inclusive;
+            group_counts[LodBlockBase(pc.num_leaves + pc.num_inner) + gl_WorkGroupID.x] =
+                inclusive;
         }
     } else if (kPass == kLodPassBlockOffsets) {
         // Lane i sums a run of consecutive block totals, the lanes' sums are scanned in
