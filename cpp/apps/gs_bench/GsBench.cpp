@@ -464,53 +464,60 @@ void AddLodRows(const Options& opt, const std::vector<int64_t>& budgets, const S
     }
     const double n = static_cast<double>(cams.size());
     const auto searches = ParseLodCutSearches(opt.lod_cut_search);
-    for (const int64_t budget : budgets)
-        for (const auto& [search_name, search] : searches) {
-            Row row;
-            row.scene = job.name;
-            row.resolution = resolution;
-            row.knob = "lod " + bench::BudgetLabel(budget);
-            if (searches.size() > 1) row.knob += " " + search_name;
-            config.lod_cut_search = search;
-            row.splats = job.cloud.NumPoints();
-            row.lod_budget = budget;
-            row.lod_on_gpu = vulkan != nullptr;
-            row.hierarchy_build_ms = hierarchy_ms;
-            config.lod_budget = static_cast<uint64_t>(budget);
-            for (size_t v = 0; v < cams.size(); ++v) {
-                double scene_nodes = static_cast<double>(hierarchy.NumNodes());
-                if (vulkan == nullptr) {
-                    const bench::LodCut cut =
-                        bench::CutForView(hierarchy, job.cloud, cams[v], budget);
-                    row.lod_nodes += static_cast<double>(cut.nodes) / n;
-                    row.lod_cut_ms += cut.cut_ms / n;
-                    lod_backend->SetScene(cut.cloud);
-                    scene_nodes = static_cast<double>(cut.nodes);
-                }
-                const rendering::RenderOutput out = lod_backend->Render(cams[v], config);
-                if (vulkan != nullptr)
-                    row.lod_nodes += static_cast<double>(out.stats.lod_cut_nodes) / n;
-                const TimedFrames timed =
-                    RunTimedFrames(*lod_backend, cams[v], config, opt.repeat, opt.depth);
-                AddView(row, timed, out.stats, cams.size());
-                row.bytes_per_splat +=
-                    static_cast<double>(out.stats.gpu_scene_bytes) / scene_nodes / n;
-                if (vulkan != nullptr) {
-                    const auto [in_flight, with_readback] =
-                        PipelinedMs(opt, *vulkan, {cams[v]}, config);
-                    row.pipelined_ms += in_flight / n;
-                    row.pipelined_readback_ms += with_readback / n;
-                }
-                AddViewError(row, out.color, exact[v]);
-                if (vulkan != nullptr && v == 0) {
-                    const rendering::RenderStats after = lod_backend->Render(cams[v], config).stats;
-                    row.lod_walk_visited = after.lod_walk_visited;
-                    row.lod_walks = after.lod_walks;
-                }
+    // A row per budget and search, budgets first.
+    struct LodRow {
+        int64_t budget;
+        std::string search_name;
+        rendering::LodCutSearch search;
+    };
+    std::vector<LodRow> lod_rows;
+    for (const int64_t budget : budgets) {
+        for (const auto& [name, search] : searches) lod_rows.push_back({budget, name, search});
+    }
+    for (const auto& [budget, search_name, search] : lod_rows) {
+        Row row;
+        row.scene = job.name;
+        row.resolution = resolution;
+        row.knob = "lod " + bench::BudgetLabel(budget);
+        if (searches.size() > 1) row.knob += " " + search_name;
+        config.lod_cut_search = search;
+        row.splats = job.cloud.NumPoints();
+        row.lod_budget = budget;
+        row.lod_on_gpu = vulkan != nullptr;
+        row.hierarchy_build_ms = hierarchy_ms;
+        config.lod_budget = static_cast<uint64_t>(budget);
+        for (size_t v = 0; v < cams.size(); ++v) {
+            double scene_nodes = static_cast<double>(hierarchy.NumNodes());
+            if (vulkan == nullptr) {
+                const bench::LodCut cut = bench::CutForView(hierarchy, job.cloud, cams[v], budget);
+                row.lod_nodes += static_cast<double>(cut.nodes) / n;
+                row.lod_cut_ms += cut.cut_ms / n;
+                lod_backend->SetScene(cut.cloud);
+                scene_nodes = static_cast<double>(cut.nodes);
             }
-            row.gpu_total_ms = row.project_ms + row.sort_ms + row.composite_ms;
-            rows.push_back(row);
+            const rendering::RenderOutput out = lod_backend->Render(cams[v], config);
+            if (vulkan != nullptr)
+                row.lod_nodes += static_cast<double>(out.stats.lod_cut_nodes) / n;
+            const TimedFrames timed =
+                RunTimedFrames(*lod_backend, cams[v], config, opt.repeat, opt.depth);
+            AddView(row, timed, out.stats, cams.size());
+            row.bytes_per_splat += static_cast<double>(out.stats.gpu_scene_bytes) / scene_nodes / n;
+            if (vulkan != nullptr) {
+                const auto [in_flight, with_readback] =
+                    PipelinedMs(opt, *vulkan, {cams[v]}, config);
+                row.pipelined_ms += in_flight / n;
+                row.pipelined_readback_ms += with_readback / n;
+            }
+            AddViewError(row, out.color, exact[v]);
+            if (vulkan != nullptr && v == 0) {
+                const rendering::RenderStats after = lod_backend->Render(cams[v], config).stats;
+                row.lod_walk_visited = after.lod_walk_visited;
+                row.lod_walks = after.lod_walks;
+            }
         }
+        row.gpu_total_ms = row.project_ms + row.sort_ms + row.composite_ms;
+        rows.push_back(row);
+    }
 }
 
 int Run(const Options& opt) {

@@ -46,7 +46,7 @@ enum class LodCutSearch {
     /// Size every inner node each frame: a fixed cost per node, few dispatches.
     kEveryNode,
     /// Walk down from the root, level by level, sizing only the nodes whose parent opens
-    /// above the view's previous threshold (less half an octave): a cost that follows the
+    /// above the scene's previous threshold (less a quarter octave): a cost that follows the
     /// cut, not the hierarchy, and a few dispatches per level of the tree.
     kFromRoot,
 };

@@ -26,9 +26,6 @@ void ComputeToCompute(VkCommandBuffer cmd) {
                         VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
 }
 
-// The walk's passes write the arguments of the indirect dispatches that follow them.
-void ComputeToComputeAndIndirect(VkCommandBuffer cmd) { RecordComputeToComputeAndIndirect(cmd); }
-
 }  // namespace
 
 GaussianLodCut::GaussianLodCut(const VulkanContext& context) : context_(context) {
@@ -116,12 +113,13 @@ void GaussianLodCut::RecordWalk(VkCommandBuffer cmd, const LodCutBuffers& buffer
     Dispatch(cmd, kLodPassWalkStart, 1);
     // Two rounds are recorded; a first round that finds the threshold turns the second's
     // dispatches to zero workgroups (kLodWalkDone).
+    // The walk's passes write the arguments of the indirect dispatches that follow them.
     for (int round = 0; round < 2; ++round) {
         for (uint32_t level = 0; level < buffers.walk_levels; ++level) {
-            ComputeToComputeAndIndirect(cmd);
+            RecordComputeToComputeAndIndirect(cmd);
             walk_indirect(kLodPassWalk, kLodWalkArgs);
         }
-        ComputeToComputeAndIndirect(cmd);
+        RecordComputeToComputeAndIndirect(cmd);
         Dispatch(cmd, kLodPassThreshold, 1);
         if (round == 0) {
             // The second round's histogram starts from zero; after a first round that found
@@ -138,7 +136,7 @@ void GaussianLodCut::RecordWalk(VkCommandBuffer cmd, const LodCutBuffers& buffer
                 VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
         }
     }
-    ComputeToComputeAndIndirect(cmd);
+    RecordComputeToComputeAndIndirect(cmd);
     walk_indirect(kLodPassWalkMask, kLodWalkMaskArgs);
 }
 
