@@ -24,6 +24,17 @@ camera::PinholeCamera ScaleViewTo(const camera::PinholeCamera& view, int width, 
     return cam;
 }
 
+camera::PinholeCamera SupersampledView(const camera::PinholeCamera& view, int s) {
+    camera::PinholeCamera cam = view;
+    cam.width = view.width * s;
+    cam.height = view.height * s;
+    cam.fx = view.fx * s;
+    cam.fy = view.fy * s;
+    cam.cx = s * (view.cx + 0.5) - 0.5;
+    cam.cy = s * (view.cy + 0.5) - 0.5;
+    return cam;
+}
+
 t::geometry::PointCloud MakeGridScene(const t::geometry::PointCloud& tile, int k, double* spacing) {
     if (k < 1) core::ThrowError("--grid needs K >= 1, got {}", k);
     tile.ValidateGaussianSplat();

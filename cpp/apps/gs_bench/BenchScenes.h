@@ -14,6 +14,11 @@ namespace bench {
 /// centre ((W - 1) / 2, (H - 1) / 2). Unlike Resized(), the horizontal extent follows W.
 camera::PinholeCamera ScaleViewTo(const camera::PinholeCamera& view, int width, int height);
 
+/// `view` with s x s pixels in place of each of its pixels: focal lengths times s and the
+/// principal point where pixel (x, y)'s block of s x s is pixel (x, y) of `view`
+/// (c' = s (c + 0.5) - 0.5). Image::BoxDownsample(s) of its render is back at `view`'s size.
+camera::PinholeCamera SupersampledView(const camera::PinholeCamera& view, int s);
+
 /// K x K copies of `tile` (e.g. playbot_125k) offset by multiples of
 /// s = 1.1 * max(extent_x, extent_z) of its bounding box along x and z, centred on it.
 /// Returns s through `spacing`.

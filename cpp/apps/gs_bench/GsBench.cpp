@@ -55,6 +55,7 @@ struct Options {
     int frames_in_flight = 2;
     std::string lod_budgets;              // --lod-budgets, empty: no level-of-detail rows
     std::string lod_cut_search = "auto";  // --lod-cut-search: comma list
+    int lod_supersample = 0;              // --lod-supersample, 0: no filtered reference
     uint64_t max_tile_entries = 0;        // --max-tile-entries, 0: RenderConfig's default
     std::string stream;                   // --stream, empty: no streaming run
     std::string gpu_budget = "2G";
@@ -113,6 +114,10 @@ struct Row {
     // The walk from the root (after the timed frames, view 0's): inner nodes sized, walks.
     int64_t lod_walk_visited = 0;
     int lod_walks = 0;
+    // --lod-supersample S: PSNR (worst view) of the cut and of the exact render against the
+    // exact render at S x S times the pixels, box-filtered to the row's size.
+    int lod_supersample = 0;
+    double lod_filtered_psnr = 0, exact_filtered_psnr = 0;
 };
 
 // --lod-cut-search's names.
@@ -406,6 +411,13 @@ void PrintTable(const std::vector<Row>& rows) {
                 "", r.lod_nodes, static_cast<long long>(r.lod_budget), r.lod_cut_ms,
                 static_cast<long long>(r.splats));
         }
+        if (r.lod_supersample > 0) {
+            std::printf(
+                "%-11s against the exact render at %dx%d supersampling, box-filtered: PSNR "
+                "%.2f dB (the exact render itself: %.2f dB)\n",
+                "", r.lod_supersample, r.lod_supersample, r.lod_filtered_psnr,
+                r.exact_filtered_psnr);
+        }
         if (r.pipelined_ms > 0) {
             std::printf(
                 "%-11s wall ms/frame: one submission %.3f (GPU: passes %.3f, submission %.3f), "
@@ -454,8 +466,18 @@ void AddLodRows(const Options& opt, const std::vector<int64_t>& budgets, const S
                 std::vector<Row>& rows) {
     // The default knob: exact order, float32 storage.
     rendering::RenderConfig config = TimedConfig(opt);
-    std::vector<t::geometry::Image> exact;
-    for (const auto& cam : cams) exact.push_back(backend.Render(cam, config).color);
+    std::vector<t::geometry::Image> exact, filtered;
+    std::vector<double> exact_filtered_psnr;
+    for (const auto& cam : cams) {
+        exact.push_back(backend.Render(cam, config).color);
+        if (opt.lod_supersample > 0) {
+            const int s = opt.lod_supersample;
+            filtered.push_back(
+                backend.Render(bench::SupersampledView(cam, s), config).color.BoxDownsample(s));
+            exact_filtered_psnr.push_back(
+                t::geometry::ComputePSNR(exact.back(), filtered.back(), 1.0));
+        }
+    }
     auto lod_backend = rendering::CreateGaussianSplatBackend(opt.backend);
     auto* vulkan = dynamic_cast<rendering::vulkan::GaussianSplatVulkanBackend*>(lod_backend.get());
     if (vulkan != nullptr) {
@@ -509,6 +531,14 @@ void AddLodRows(const Options& opt, const std::vector<int64_t>& budgets, const S
                 row.pipelined_readback_ms += with_readback / n;
             }
             AddViewError(row, out.color, exact[v]);
+            if (opt.lod_supersample > 0) {
+                const double psnr = t::geometry::ComputePSNR(out.color, filtered[v], 1.0);
+                row.lod_filtered_psnr = v == 0 ? psnr : std::min(row.lod_filtered_psnr, psnr);
+                row.exact_filtered_psnr =
+                    v == 0 ? exact_filtered_psnr[v]
+                           : std::min(row.exact_filtered_psnr, exact_filtered_psnr[v]);
+                row.lod_supersample = opt.lod_supersample;
+            }
             if (vulkan != nullptr && v == 0) {
                 const rendering::RenderStats after = lod_backend->Render(cams[v], config).stats;
                 row.lod_walk_visited = after.lod_walk_visited;
@@ -534,6 +564,9 @@ int Run(const Options& opt) {
     const std::vector<int64_t> budgets =
         opt.lod_budgets.empty() ? std::vector<int64_t>{} : bench::ParseBudgets(opt.lod_budgets);
     ParseLodCutSearches(opt.lod_cut_search);  // refused before the scenes load
+    if (opt.lod_supersample > 0 && budgets.empty()) {
+        core::ThrowError("--lod-supersample compares the --lod-budgets rows: give --lod-budgets");
+    }
     rendering::vulkan::RegisterVulkanBackend();
     std::vector<SceneJob> jobs;
     if (opt.inputs.empty()) core::ThrowError("--input is required (a .ply or .splat scene)");
@@ -795,6 +828,11 @@ int Run(const Options& opt) {
                                      {"walks", r.lod_walks},
                                      {"hierarchy_build_ms", r.hierarchy_build_ms},
                                      {"error_against", "exact render of the whole scene"}};
+                if (r.lod_supersample > 0) {
+                    out.back()["lod"]["supersample"] = r.lod_supersample;
+                    out.back()["lod"]["psnr_db_against_filtered"] = r.lod_filtered_psnr;
+                    out.back()["lod"]["exact_psnr_db_against_filtered"] = r.exact_filtered_psnr;
+                }
             }
             if (r.has_error) {
                 out.back()["psnr_db_worst_view"] = r.psnr;
@@ -865,6 +903,11 @@ int main(int argc, char** argv) {
         "columns against the exact render of the whole scene (the hierarchy is built "
         "once per scene; with Vulkan the cut is chosen on the GPU each frame, else on the "
         "CPU; docs/lod.md)");
+    app.add_option("--lod-supersample", opt.lod_supersample,
+                   "--lod-budgets rows also compare the cut and the exact render with the "
+                   "exact render at S x S times the pixels, box-filtered to the row's size "
+                   "(what the view's splats look like with less aliasing; docs/lod.md)")
+        ->check(CLI::Range(2, 8));
     app.add_option("--lod-cut-search", opt.lod_cut_search,
                    "Vulkan: how the GPU finds the cut, a comma list for one row each: auto, "
                    "every-node (size every inner node), from-root (walk down from the root "

@@ -34,6 +34,32 @@ TEST(Image, ShapeAccessAndConversions) {
     EXPECT_EQ(u8.ToFloat(1.0 / 255).At<float>(0, 0, 0), 1.0f);
 }
 
+TEST(Image, BoxDownsampleAveragesBlocks) {
+    // 4 x 6 pixels, 2 channels: value = 10 y + x (+ 100 in channel 1).
+    Image img(4, 6, 2, core::Dtype::Float32);
+    for (int64_t y = 0; y < 4; ++y) {
+        for (int64_t x = 0; x < 6; ++x) {
+            img.At<float>(y, x, 0) = float(10 * y + x);
+            img.At<float>(y, x, 1) = float(100 + 10 * y + x);
+        }
+    }
+    const Image half = img.BoxDownsample(2);
+    ASSERT_EQ(half.GetRows(), 2);
+    ASSERT_EQ(half.GetCols(), 3);
+    ASSERT_EQ(half.GetChannels(), 2);
+    // Block (bx, by) holds 10 (2 by + {0, 1}) + 2 bx + {0, 1}: mean 20 by + 2 bx + 5.5.
+    for (int64_t by = 0; by < 2; ++by) {
+        for (int64_t bx = 0; bx < 3; ++bx) {
+            EXPECT_EQ(half.At<float>(by, bx, 0), float(20 * by + 2 * bx + 5.5));
+            EXPECT_EQ(half.At<float>(by, bx, 1), float(100 + 20 * by + 2 * bx + 5.5));
+        }
+    }
+    EXPECT_EQ(img.BoxDownsample(1), img);
+    EXPECT_THROW(img.BoxDownsample(4), core::Open3DError);  // 6 columns
+    EXPECT_THROW(img.BoxDownsample(0), core::Open3DError);
+    EXPECT_THROW(img.ToUInt8().BoxDownsample(2), core::Open3DError);
+}
+
 TEST(ImageMetrics, KnownValues) {
     Image a(4, 5, 1, core::Dtype::Float32), b(4, 5, 1, core::Dtype::Float32);
     for (int64_t i = 0; i < 20; ++i) b.Data<float>()[i] = 0.1f;

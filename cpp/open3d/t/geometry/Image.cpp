@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include "open3d/core/Exception.h"
 
@@ -82,6 +83,33 @@ Image Image::SelectChannels(int64_t first, int64_t count) const {
     const int64_t c_in = GetChannels();
     for (int64_t p = 0; p < NumPixels(); ++p) {
         std::copy_n(src + (p * c_in + first) * elem, count * elem, dst + p * count * elem);
+    }
+    return out;
+}
+
+Image Image::BoxDownsample(int64_t factor) const {
+    if (factor < 1 || GetRows() % factor != 0 || GetCols() % factor != 0) {
+        core::ThrowError("Image::BoxDownsample: a factor of {} does not divide {} x {} pixels",
+                         factor, GetCols(), GetRows());
+    }
+    if (GetDtype() != core::Dtype::Float32) {
+        core::ThrowError("Image::BoxDownsample: takes a Float32 image");
+    }
+    const int64_t rows = GetRows() / factor, cols = GetCols() / factor, c = GetChannels();
+    Image out(rows, cols, c, core::Dtype::Float32);
+    // Summed in double: a block of 8 x 8 float32 values keeps every bit of their mean.
+    std::vector<double> sum(static_cast<size_t>(cols * c));
+    for (int64_t y = 0; y < rows; ++y) {
+        std::fill(sum.begin(), sum.end(), 0.0);
+        for (int64_t dy = 0; dy < factor; ++dy) {
+            const float* row = Data<float>() + (y * factor + dy) * GetCols() * c;
+            for (int64_t x = 0; x < GetCols(); ++x) {
+                for (int64_t k = 0; k < c; ++k) sum[(x / factor) * c + k] += row[x * c + k];
+            }
+        }
+        const double scale = 1.0 / static_cast<double>(factor * factor);
+        float* out_row = out.Data<float>() + y * cols * c;
+        for (int64_t i = 0; i < cols * c; ++i) out_row[i] = static_cast<float>(sum[i] * scale);
     }
     return out;
 }

@@ -57,6 +57,10 @@ public:
     Image ToFloat(double scale = 1.0) const;
     /// Copy of channels [first, first + count).
     Image SelectChannels(int64_t first, int64_t count) const;
+    /// Float32 image of rows / factor x cols / factor pixels, each the mean of a factor x
+    /// factor block (a render at factor times the size, box-filtered to this one). Throws
+    /// for a factor < 1, sizes it does not divide, or a dtype other than Float32.
+    Image BoxDownsample(int64_t factor) const;
 
     bool operator==(const Image& other) const { return data_ == other.data_; }
 
