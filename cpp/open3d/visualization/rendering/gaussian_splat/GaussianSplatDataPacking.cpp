@@ -65,20 +65,21 @@ uint64_t PackedGaussianSplats::BytesPerSplat() const {
 
 namespace {
 
-// Appends `values` as fp32 bits (exact) or fp16 pairs (compact, zero-padded to a word).
-void AppendWords(const double* values, int count, SplatPrecision precision,
-                 std::vector<uint32_t>& out) {
+// Writes `values` as fp32 bits (exact) or fp16 pairs (compact, zero-padded to a word) at
+// `out`; returns the word after them.
+uint32_t* WriteWords(const double* values, int count, SplatPrecision precision, uint32_t* out) {
     if (precision == SplatPrecision::kExact) {
         for (int k = 0; k < count; ++k) {
-            out.push_back(std::bit_cast<uint32_t>(static_cast<float>(values[k])));
+            *out++ = std::bit_cast<uint32_t>(static_cast<float>(values[k]));
         }
-        return;
+        return out;
     }
     for (int k = 0; k < count; k += 2) {
         const uint32_t lo = FloatToHalf(static_cast<float>(values[k]));
         const uint32_t hi = k + 1 < count ? FloatToHalf(static_cast<float>(values[k + 1])) : 0u;
-        out.push_back(lo | (hi << 16));
+        *out++ = lo | (hi << 16);
     }
+    return out;
 }
 
 uint32_t WordsFor(int values, SplatPrecision precision) {
@@ -107,25 +108,39 @@ PackedGaussianSplats PackGaussianSplatAttrs(const t::geometry::PointCloud& cloud
         core::ThrowError("PackGaussianSplatAttrs: {} splats, at most 2^32 - 1 fit a splat index",
                          n);
     }
-
     PackedGaussianSplats packed =
         PackedSplatLayout(std::clamp(max_sh_degree, 0, a.sh_degree), precision);
     packed.num_splats = n;
-    const int rest_values = 3 * t::geometry::NumSHRestCoeffs(packed.sh_degree);
+    packed.positions.resize(4 * n);
+    packed.shape.resize(packed.shape_words_per_splat * n);
+    packed.sh.resize(packed.sh_words_per_splat * n);
+    PackGaussianSplatAttrsInto(cloud, packed,
+                               {packed.positions.data(), packed.shape.data(), packed.sh.data()},
+                               packed.center_min, packed.center_max);
+    packed.visibility.assign((n + 31) / 32, 0u);
+    SetSplatVisibility(packed.visibility, 0, n, true);
+    return packed;
+}
 
-    packed.positions.reserve(4 * n);
-    packed.shape.reserve(packed.shape_words_per_splat * n);
-    packed.sh.reserve(packed.sh_words_per_splat * n);
+void PackGaussianSplatAttrsInto(const t::geometry::PointCloud& cloud,
+                                const PackedGaussianSplats& layout, PackedSplatSpans out,
+                                Eigen::Vector3d& center_min, Eigen::Vector3d& center_max) {
+    const t::geometry::GaussianSplatArrays a = cloud.GetGaussianSplatArrays();  // validates
+    if (a.sh_degree < layout.sh_degree) {
+        core::ThrowError("packing splats of SH degree {} at degree {}", a.sh_degree,
+                         layout.sh_degree);
+    }
+    const int rest_values = 3 * t::geometry::NumSHRestCoeffs(layout.sh_degree);
     std::vector<double> values(std::max(10, rest_values));
-    for (int64_t i = 0; i < n; ++i) {
-        for (int c = 0; c < 3; ++c) packed.positions.push_back(a.positions[3 * i + c]);
+    for (int64_t i = 0; i < a.num_points; ++i) {
+        for (int c = 0; c < 3; ++c) *out.positions++ = a.positions[3 * i + c];
         const Eigen::Vector3d center(a.positions[3 * i], a.positions[3 * i + 1],
                                      a.positions[3 * i + 2]);
-        packed.center_min = packed.center_min.cwiseMin(center);
-        packed.center_max = packed.center_max.cwiseMax(center);
+        center_min = center_min.cwiseMin(center);
+        center_max = center_max.cwiseMax(center);
         // The sigmoid in double, rounded once: within half an ulp of the reference's value.
         const double logit = a.opacity[i];
-        packed.positions.push_back(static_cast<float>(1.0 / (1.0 + std::exp(-logit))));
+        *out.positions++ = static_cast<float>(1.0 / (1.0 + std::exp(-logit)));
 
         for (int c = 0; c < 3; ++c) values[c] = a.scale[3 * i + c];
         const float* q = a.rot + 4 * i;
@@ -135,18 +150,15 @@ PackedGaussianSplats PackGaussianSplatAttrs(const t::geometry::PointCloud& cloud
         // identity, as Eigen's does for the CPU reference.
         for (int c = 0; c < 4; ++c) values[3 + c] = norm > 0.0 ? q[c] / norm : 0.0;
         for (int c = 0; c < 3; ++c) values[7 + c] = a.f_dc[3 * i + c];
-        AppendWords(values.data(), 10, precision, packed.shape);
+        out.shape = WriteWords(values.data(), 10, layout.precision, out.shape);
 
         if (rest_values > 0) {
             // The scene's [Nc, 3] block starts with the packed degree's coefficients.
             const float* rest = a.f_rest + i * a.num_rest * 3;
             for (int k = 0; k < rest_values; ++k) values[k] = rest[k];
-            AppendWords(values.data(), rest_values, precision, packed.sh);
+            out.sh = WriteWords(values.data(), rest_values, layout.precision, out.sh);
         }
     }
-    packed.visibility.assign((n + 31) / 32, 0u);
-    SetSplatVisibility(packed.visibility, 0, n, true);
-    return packed;
 }
 
 void SetSplatVisibility(std::vector<uint32_t>& mask, int64_t begin, int64_t end, bool visible) {

@@ -63,6 +63,21 @@ PackedGaussianSplats PackGaussianSplatAttrs(const t::geometry::PointCloud& cloud
                                             SplatPrecision precision = SplatPrecision::kExact,
                                             int max_sh_degree = 3);
 
+/// Where PackGaussianSplatAttrsInto writes a cloud's n splats: [n, 4] floats, [n, shape
+/// words] and [n, sh words] of the layout (a mapped staging buffer, say).
+struct PackedSplatSpans {
+    float* positions = nullptr;
+    uint32_t* shape = nullptr;
+    uint32_t* sh = nullptr;  ///< unused at SH degree 0
+};
+
+/// Packs a valid cloud's splats as PackGaussianSplatAttrs does, at `layout`'s precision and
+/// SH degree (at most the cloud's), into `out`, and widens center_min / center_max to hold
+/// their centres. Throws core::Open3DError for an invalid cloud or one of a lower degree.
+void PackGaussianSplatAttrsInto(const t::geometry::PointCloud& cloud,
+                                const PackedGaussianSplats& layout, PackedSplatSpans out,
+                                Eigen::Vector3d& center_min, Eigen::Vector3d& center_max);
+
 /// Sets (visible = true) or clears the bits of splats [begin, end) in a visibility mask.
 void SetSplatVisibility(std::vector<uint32_t>& mask, int64_t begin, int64_t end, bool visible);
 

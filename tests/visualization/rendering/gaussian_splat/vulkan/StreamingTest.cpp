@@ -147,6 +147,38 @@ TEST_F(Streaming, ManySmallPagesRenderAsOnePage) {
     EXPECT_GE(Psnr(small, cpu::RenderReference(scene, cam, {})), 90.0);
 }
 
+TEST_F(Streaming, WritesIntoAPlainSceneDrawAsTheSceneWrittenWhole) {
+    // Writes of 50, then 200, then 50 splats: the staging kept between writes grows and is
+    // then reused for less. Random splats: no two share a view depth, so equal scenes give
+    // equal images bit for bit.
+    using t::io::RandomCloud;
+    const auto p = RandomCloud(500, 1, 1), q = RandomCloud(200, 1, 2), r = RandomCloud(250, 1, 3),
+               u = RandomCloud(50, 1, 4);
+    const auto q2 = RandomCloud(200, 1, 5), u2 = RandomCloud(50, 1, 6), u3 = RandomCloud(50, 1, 7);
+    camera::PinholeCamera cam;
+    cam.width = cam.height = 64;
+    cam.fx = cam.fy = 50.0;
+    cam.cx = cam.cy = 31.5;
+    cam.world_to_camera(2, 3) = 40.0;
+    auto written = MakeBackend();
+    written->SetScene(MergeGaussianSplatClouds({&p, &q, &r, &u}));
+    written->WriteSceneSplats(950, u2);
+    written->WriteSceneSplats(500, q2);
+    written->WriteSceneSplats(950, u3);
+    auto whole = MakeBackend();
+    whole->SetScene(MergeGaussianSplatClouds({&p, &q2, &r, &u3}));
+    RenderConfig compact;
+    compact.compact_storage = true;
+    // The compact frame re-packs the written scene from its host copy, which must follow.
+    for (const RenderConfig& config : {RenderConfig{}, compact}) {
+        const RenderOutput a = written->Render(cam, config), b = whole->Render(cam, config);
+        EXPECT_GT(a.stats.num_visible, 500);
+        EXPECT_EQ(a.stats.num_visible, b.stats.num_visible);
+        EXPECT_EQ(t::geometry::ComputeMaxAbsError(a.color, b.color), 0.0);
+        EXPECT_EQ(t::geometry::ComputeMaxAbsError(a.depth_expected, b.depth_expected), 0.0);
+    }
+}
+
 TEST_F(Streaming, WritesOutsideThePoolOrOfAnotherDegreeAreRefused) {
     auto backend = MakeBackend();
     backend->SetScenePool(100, 1, Eigen::Vector3d::Zero(), Eigen::Vector3d::Ones());

@@ -3,8 +3,10 @@
 #include <algorithm>
 #include <cstdint>
 #include <cstring>
+#include <limits>
 
 #include "open3d/core/Exception.h"
+#include "open3d/core/ParallelFor.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/VulkanContext.h"
 
 namespace open3d {
@@ -98,6 +100,7 @@ void GeometryStageResources::SetLayout(const PackedGaussianSplats& like, int64_t
     layout_.center_max = like.center_max;
     // The per-view buffers are sized for a splat count: a new scene needs new ones.
     view_ = GeometryStageViewResources();
+    write_staging_ = Buffer();
 }
 
 void GeometryStageResources::AllocateScene(const VulkanContext& context, const CommandPool& pool,
@@ -127,50 +130,75 @@ void GeometryStageResources::AllocateScene(const VulkanContext& context, const C
 
 void GeometryStageResources::WriteSplats(
     const VulkanContext& context, const CommandPool& pool,
-    const std::vector<std::pair<int64_t, PackedGaussianSplats>>& parts) {
+    const std::vector<std::pair<int64_t, const t::geometry::PointCloud*>>& parts) {
+    // Each part's place in the staging buffer: its positions, shape and SH words in turn.
+    struct Place {
+        VkDeviceSize positions = 0, shape = 0, sh = 0;
+        Eigen::Vector3d center_min =
+            Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+        Eigen::Vector3d center_max = -center_min;
+    };
+    std::vector<Place> places(parts.size());
     VkDeviceSize total = 0;
-    for (const auto& [first, part] : parts) {
-        if (part.precision != layout_.precision || part.sh_degree != layout_.sh_degree ||
-            part.shape_words_per_splat != layout_.shape_words_per_splat ||
-            part.sh_words_per_splat != layout_.sh_words_per_splat) {
-            core::ThrowError("writing splats packed at SH degree {} into a scene packed at {}",
-                             part.sh_degree, layout_.sh_degree);
+    for (size_t i = 0; i < parts.size(); ++i) {
+        const auto& [first, cloud] = parts[i];
+        const int64_t n = cloud->NumPoints();
+        if (cloud->GetGaussianSplatArrays().sh_degree != layout_.sh_degree) {
+            core::ThrowError("writing splats of SH degree {} into a scene packed at {}",
+                             cloud->GetGaussianSplatArrays().sh_degree, layout_.sh_degree);
         }
-        if (first < 0 || part.num_splats < 0 || first + part.num_splats > layout_.num_splats) {
-            core::ThrowError("writing splats [{}, {}) into a scene of {} splats", first,
-                             first + part.num_splats, layout_.num_splats);
+        if (first < 0 || first + n > layout_.num_splats) {
+            core::ThrowError("writing splats [{}, {}) into a scene of {} splats", first, first + n,
+                             layout_.num_splats);
         }
-        total += (part.positions.size() + part.shape.size() + part.sh.size()) * 4;
+        const VkDeviceSize splats = static_cast<VkDeviceSize>(n);
+        places[i].positions = total;
+        total += splats * 4 * sizeof(float);
+        places[i].shape = total;
+        total += splats * layout_.shape_words_per_splat * 4;
+        places[i].sh = total;
+        total += splats * layout_.sh_words_per_splat * 4;
     }
     if (total == 0) return;
-    // One staging buffer and one submission for every part: a streaming step writes many
-    // pages at once.
-    Buffer staging(context, total, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, MemoryUsage::kHostUpload);
-    auto* bytes = static_cast<uint8_t*>(staging.GetMapped());
+    if (!write_staging_ || write_staging_.GetSize() < total) {
+        write_staging_ = Buffer();  // the old one goes first: host memory is the limit
+        write_staging_ =
+            Buffer(context, total, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, MemoryUsage::kHostUpload);
+    }
+    auto* bytes = static_cast<uint8_t*>(write_staging_.GetMapped());
+    // A part per task: a streaming step writes 16 pages of 65,536 splats by default.
+    core::ParallelFor(
+        static_cast<int64_t>(parts.size()),
+        [&](int64_t i) {
+            Place& place = places[size_t(i)];
+            PackGaussianSplatAttrsInto(*parts[size_t(i)].second, layout_,
+                                       {reinterpret_cast<float*>(bytes + place.positions),
+                                        reinterpret_cast<uint32_t*>(bytes + place.shape),
+                                        reinterpret_cast<uint32_t*>(bytes + place.sh)},
+                                       place.center_min, place.center_max);
+        },
+        1);
     std::vector<VkBufferCopy> to_positions, to_shape, to_sh;
-    VkDeviceSize at = 0;
-    const auto stage = [&](const void* data, VkDeviceSize size, VkDeviceSize dst,
-                           std::vector<VkBufferCopy>& regions) {
-        if (size == 0) return;
-        std::memcpy(bytes + at, data, size);
-        regions.push_back({at, dst, size});
-        at += size;
-    };
-    for (const auto& [first, part] : parts) {
-        const VkDeviceSize splat = static_cast<VkDeviceSize>(first);
-        stage(part.positions.data(), part.positions.size() * 4, splat * 4 * sizeof(float),
-              to_positions);
-        stage(part.shape.data(), part.shape.size() * 4, splat * part.shape_words_per_splat * 4,
-              to_shape);
-        stage(part.sh.data(), part.sh.size() * 4, splat * part.sh_words_per_splat * 4, to_sh);
-        layout_.center_min = layout_.center_min.cwiseMin(part.center_min);
-        layout_.center_max = layout_.center_max.cwiseMax(part.center_max);
+    for (size_t i = 0; i < parts.size(); ++i) {
+        const VkDeviceSize first = static_cast<VkDeviceSize>(parts[i].first);
+        const VkDeviceSize n = static_cast<VkDeviceSize>(parts[i].second->NumPoints());
+        if (n == 0) continue;
+        to_positions.push_back(
+            {places[i].positions, first * 4 * sizeof(float), n * 4 * sizeof(float)});
+        to_shape.push_back({places[i].shape, first * layout_.shape_words_per_splat * 4,
+                            n * layout_.shape_words_per_splat * 4});
+        if (layout_.sh_words_per_splat > 0) {
+            to_sh.push_back({places[i].sh, first * layout_.sh_words_per_splat * 4,
+                             n * layout_.sh_words_per_splat * 4});
+        }
+        layout_.center_min = layout_.center_min.cwiseMin(places[i].center_min);
+        layout_.center_max = layout_.center_max.cwiseMax(places[i].center_max);
     }
     SubmitAndWait(context, pool, [&](VkCommandBuffer cmd) {
         for (const auto& [buffer, regions] :
              {std::pair{&positions, &to_positions}, {&shape, &to_shape}, {&sh, &to_sh}}) {
             if (regions->empty()) continue;
-            vkCmdCopyBuffer(cmd, staging.Get(), buffer->Get(), uint32_t(regions->size()),
+            vkCmdCopyBuffer(cmd, write_staging_.Get(), buffer->Get(), uint32_t(regions->size()),
                             regions->data());
         }
     });

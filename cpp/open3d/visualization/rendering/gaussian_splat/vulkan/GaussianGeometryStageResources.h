@@ -70,12 +70,14 @@ public:
     /// written later (WriteSplats).
     void AllocateScene(const VulkanContext& context, const CommandPool& pool,
                        const PackedGaussianSplats& like, int64_t capacity);
-    /// Writes each part (first splat, splats packed like the scene) over splats
-    /// [first, first + num_splats) of the scene in one submission, and widens the centre
+    /// Writes each part (first splat, a valid cloud of the scene's SH degree) over splats
+    /// [first, first + its splats) of the scene in one submission, and widens the centre
     /// bounds the depth range comes from to hold their centres (the streaming pool's page
-    /// writes). The visibility mask is not touched.
+    /// writes). The parts are packed in parallel straight into a staging buffer kept for the
+    /// next call (a step's pages: no packed copy, no fresh host memory to fault in). The
+    /// visibility mask is not touched.
     void WriteSplats(const VulkanContext& context, const CommandPool& pool,
-                     const std::vector<std::pair<int64_t, PackedGaussianSplats>>& parts);
+                     const std::vector<std::pair<int64_t, const t::geometry::PointCloud*>>& parts);
     /// Uploads the nodes of the hierarchy the scene's splats are (GaussianSplatLodPacking.h);
     /// ClearLod forgets them (a plain scene).
     void UploadLod(const VulkanContext& context, const CommandPool& pool,
@@ -123,6 +125,8 @@ private:
     VkDeviceSize lod_nodes_bytes_ = 0, lod_children_offset_ = 0, lod_children_bytes_ = 0;
     VkDeviceSize lod_previous_offset_ = 0;
     PackedGaussianSplats layout_;
+    // WriteSplats' staging, as large as its largest call since the scene was made.
+    Buffer write_staging_;
     // One view's outputs (projected splats, counters, sorted entries) and scratch.
     GeometryStageViewResources view_;
     uint64_t scene_bytes_ = 0;

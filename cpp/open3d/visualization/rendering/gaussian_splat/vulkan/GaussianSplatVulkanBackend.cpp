@@ -13,7 +13,6 @@
 #include "open3d/core/Exception.h"
 #include "open3d/core/HostMemory.h"
 #include "open3d/core/Logging.h"
-#include "open3d/core/ParallelFor.h"
 
 namespace open3d {
 namespace visualization {
@@ -204,18 +203,7 @@ void GaussianSplatVulkanBackend::WriteSceneSplatRanges(
             }
         }
     }
-    // A range per task: a streaming step packs 16 pages of 65,536 splats by default, most of
-    // the step's time on one thread.
-    std::vector<std::pair<int64_t, PackedGaussianSplats>> packed(ranges.size());
-    core::ParallelFor(
-        int64_t(ranges.size()),
-        [&](int64_t i) {
-            const auto& [first, cloud] = ranges[size_t(i)];
-            packed[size_t(i)] = {first, PackGaussianSplatAttrs(
-                                            *cloud, geometry_stage_resources_.Layout().precision)};
-        },
-        1);
-    geometry_stage_resources_.WriteSplats(*context_, pool_, packed);
+    geometry_stage_resources_.WriteSplats(*context_, pool_, ranges);
     geometry_.valid = false;  // the geometry stage's output is stale
 }
 
