@@ -337,7 +337,7 @@ void BindRendering(py::module_& m) {
         .def(
             "stream_splats",
             [](SplatScene& s, const std::string& path, const py::object& gpu_budget,
-               int64_t splat_budget, int64_t reads_per_step) {
+               int64_t splat_budget, int64_t reads_per_step, std::optional<bool> compact_storage) {
                 visualization::rendering::SplatStreamOptions options;
                 if (py::isinstance<py::str>(gpu_budget)) {
                     options.gpu_budget =
@@ -354,16 +354,20 @@ void BindRendering(py::module_& m) {
                 }
                 options.splat_budget = splat_budget;
                 options.reads_per_step = reads_per_step;
+                options.compact_storage =
+                    compact_storage.value_or(s.renderer->Config().compact_storage);
                 s.renderer->SplatRenderer().StreamSplats(path, options);
             },
             py::arg("path"), py::arg("gpu_budget") = 0, py::arg("splat_budget") = 0,
-            py::arg("reads_per_step") = 16,
+            py::arg("reads_per_step") = 16, py::arg("compact_storage") = py::none(),
             "Streams a paged file (write_splat_pages, gs-convert --pages) as the splat scene "
             "(docs/streaming.md): its pages are read on a worker thread into a GPU pool of "
             "gpu_budget bytes (an int, or a str such as '512M' or '2G'; 0 or 'auto': 1 GiB, or "
             "what the device holds in one scene where that is less) for the view of each "
             "render; each render shows the pages read since the one before. splat_budget: nodes "
-            "a cut may draw (0: what the pool holds). Raises Open3DError while splat clouds are "
+            "a cut may draw (0: what the pool holds). compact_storage: the pool at half precision "
+            "(about 1.8 times the splats in gpu_budget; None: the renderer's compact_storage); "
+            "the stream draws at its pool's precision. Raises Open3DError while splat clouds are "
             "held, for a refused file, or with the cpu backend (only vulkan streams).")
         .def(
             "stop_streaming",

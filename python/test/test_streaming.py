@@ -60,6 +60,30 @@ def test_stream_converges_to_the_clouds_image(tmp_path):
     assert r.scene.stop_streaming() and r.scene.stream_progress is None
 
 
+def test_a_compact_stream_holds_more_and_draws_as_the_compact_cloud(tmp_path):
+    pcd = distinct_depth_cloud(3000, seed=5)
+    path = str(tmp_path / "cloud.gspages")
+    o3d.t.io.write_splat_pages(path, pcd, page_capacity=64)
+    # SH degree 0: 16 + 40 bytes a splat and its bit exact, 16 + 20 compact; 8 exact pages
+    # of 64 splats are 28,736 bytes, which hold 12 compact ones (28,736 / (64 x 36.125)).
+    budget = int(8 * 64 * 56.125)
+    exact = Renderer(64, 64, "vulkan")
+    exact.scene.stream_splats(path, gpu_budget=budget)
+    assert exact.scene.stream_progress["pool_pages"] == 8
+    r = Renderer(64, 64, "vulkan")
+    r.compact_storage = True  # the stream follows the renderer's setting
+    r.scene.stream_splats(path, gpu_budget=budget)
+    assert r.scene.stream_progress["pool_pages"] == 12
+    r.scene.stream_splats(path, gpu_budget="1M", compact_storage=True, reads_per_step=64)
+    r.compact_storage = False  # the pool keeps its precision
+    looking_along_z(r)
+    image, _ = render_until_settled(r)
+    whole = Renderer(64, 64, "vulkan", compact_storage=True)
+    whole.scene.add_geometry("cloud", pcd)
+    looking_along_z(whole)
+    np.testing.assert_array_equal(image, whole.render_to_image())
+
+
 def test_what_cannot_stream_raises(tmp_path):
     pcd = distinct_depth_cloud(300)
     path = str(tmp_path / "cloud.gspages")

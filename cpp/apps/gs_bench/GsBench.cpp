@@ -59,7 +59,8 @@ struct Options {
     uint64_t max_tile_entries = 0;        // --max-tile-entries, 0: RenderConfig's default
     std::string stream;                   // --stream, empty: no streaming run
     std::string gpu_budget = "2G";
-    std::string stream_budget;  // empty: what the pool holds
+    std::string stream_budget;    // empty: what the pool holds
+    bool stream_compact = false;  // --stream-compact: the pool at half precision
     int64_t page_capacity = 65536;
     int64_t reads_per_step = 16;
 };
@@ -656,6 +657,7 @@ int Run(const Options& opt) {
                 opt.stream_budget.empty() ? 0 : bench::ParseBudgets(opt.stream_budget).at(0);
             stream.page_capacity = opt.page_capacity;
             stream.reads_per_step = opt.reads_per_step;
+            stream.compact_storage = opt.stream_compact;
             bench::RunStreamBench(job.cloud, hierarchy, cam, config,
                                   backend->Render(cam, config).color, stream);
         }
@@ -930,6 +932,10 @@ int main(int argc, char** argv) {
     app.add_option("--stream-budget", opt.stream_budget,
                    "--stream: splats per cut (k = 1000, M = 1000000; default: what the pool "
                    "holds)");
+    app.add_flag("--stream-compact", opt.stream_compact,
+                 "--stream: the pool at half precision (RenderConfig::compact_storage's "
+                 "packing, about 1.8 times the splats in --gpu-budget), its frames drawn so; "
+                 "the error columns still compare with the exact float32 render");
     app.add_option("--page-capacity", opt.page_capacity, "--stream: nodes per page")
         ->check(CLI::Range(int64_t(8), int64_t(1) << 30))
         ->capture_default_str();

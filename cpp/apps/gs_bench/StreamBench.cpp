@@ -41,19 +41,24 @@ void RunStreamBench(const t::geometry::PointCloud& scene,
 
     const auto start = std::chrono::steady_clock::now();
     const t::io::SplatPageFile file(options.path);
-    const double bytes_per_splat = rendering::StreamPoolBytesPerSplat(file.ShDegree());
+    const bool compact = options.compact_storage;
+    const double bytes_per_splat = rendering::StreamPoolBytesPerSplat(file.ShDegree(), compact);
     const int64_t pool_pages =
-        rendering::StreamPoolPages(file, options.gpu_budget, backend->MaxSceneSplats());
+        rendering::StreamPoolPages(file, options.gpu_budget, backend->MaxSceneSplats(), compact);
     const int64_t pool_splats = pool_pages * file.PageCapacity();
     const int64_t budget = options.splat_budget > 0 ? options.splat_budget : pool_splats;
     rendering::SplatStreamer streamer(file, pool_pages, budget);
-    backend->SetScenePool(pool_splats, file.ShDegree(), file.CenterMin(), file.CenterMax());
+    backend->SetScenePool(pool_splats, file.ShDegree(), file.CenterMin(), file.CenterMax(),
+                          compact);
+    rendering::RenderConfig pool_config = config;
+    pool_config.compact_storage = compact;
     std::printf(
         "stream: %s, %.2f GB on disk, %lld pages; pool %lld pages = %lld splats = %.2f GB "
-        "(%.0f bytes a splat), cut budget %lld\n",
+        "(%.0f bytes a splat%s), cut budget %lld\n",
         options.path.c_str(), file.FileBytes() / 1e9, static_cast<long long>(file.NumPages()),
         static_cast<long long>(pool_pages), static_cast<long long>(pool_splats),
-        pool_splats * bytes_per_splat / 1e9, bytes_per_splat, static_cast<long long>(budget));
+        pool_splats * bytes_per_splat / 1e9, bytes_per_splat, compact ? ", half precision" : "",
+        static_cast<long long>(budget));
 
     std::printf("stream: pool ready %.0f ms after the load started\n",
                 core::MillisecondsSince(start));
@@ -70,7 +75,7 @@ void RunStreamBench(const t::geometry::PointCloud& scene,
         const auto write_start = std::chrono::steady_clock::now();
         backend->ApplyStreamStep(step);
         const double write_ms = core::MillisecondsSince(write_start);
-        frame = backend->Render(camera, config);
+        frame = backend->Render(camera, pool_config);
         const double ms = core::MillisecondsSince(start);
         if (first_ms < 0) {
             first_ms = ms;

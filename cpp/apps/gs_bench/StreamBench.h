@@ -17,11 +17,12 @@ namespace open3d {
 namespace bench {
 
 struct StreamBenchOptions {
-    std::string path;            ///< the paged file written, then streamed
-    uint64_t gpu_budget = 0;     ///< bytes of the pool's splat storage
-    int64_t splat_budget = 0;    ///< nodes per cut; 0: what the pool holds
-    int64_t page_capacity = 0;   ///< nodes per page
-    int64_t reads_per_step = 0;  ///< pages read per step
+    std::string path;              ///< the paged file written, then streamed
+    uint64_t gpu_budget = 0;       ///< bytes of the pool's splat storage
+    int64_t splat_budget = 0;      ///< nodes per cut; 0: what the pool holds
+    int64_t page_capacity = 0;     ///< nodes per page
+    int64_t reads_per_step = 0;    ///< pages read per step
+    bool compact_storage = false;  ///< the pool at half precision
 };
 
 /// Writes `scene` (with `hierarchy`) as pages to options.path, streams it for `camera` into

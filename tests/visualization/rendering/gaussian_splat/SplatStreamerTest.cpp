@@ -322,6 +322,13 @@ TEST(SplatStreamSession, ByteSizesAndPoolPages) {
     ExpectErrorContaining([&] { StreamPoolPages(file, uint64_t(0.5 * page_bytes)); },
                           "holds no page");
     ExpectErrorContaining([&] { StreamPoolPages(file, 0, 63); }, "not one page of 64");
+    // At half precision a splat of degree 1 takes 16 + 4 x 5 + 4 x 5 bytes (9 SH values in
+    // fp16 pairs) and its bit, against 16 + 4 x 10 + 4 x 9: the budget of 3.5 exact pages
+    // holds 3.5 x 92.125 / 56.125 = 5.7 compact ones.
+    ASSERT_EQ(file.ShDegree(), 1);
+    EXPECT_EQ(rendering::StreamPoolBytesPerSplat(1), 92.125);
+    EXPECT_EQ(rendering::StreamPoolBytesPerSplat(1, true), 56.125);
+    EXPECT_EQ(StreamPoolPages(file, uint64_t(3.5 * page_bytes), INT64_MAX, true), 5);
 }
 
 TEST(SplatStreamSession, APageRefusedMidStreamSettlesWithItsError) {

@@ -34,7 +34,7 @@ Registry& GetRegistry() {
 }  // namespace
 
 void GaussianSplatBackend::SetScenePool(int64_t, int, const Eigen::Vector3d&,
-                                        const Eigen::Vector3d&) {
+                                        const Eigen::Vector3d&, bool) {
     core::ThrowError("the '{}' splat backend cannot stream a paged scene (the vulkan backend can)",
                      GetName());
 }

@@ -122,10 +122,11 @@ public:
 
     /// Streaming (docs/streaming.md): a scene of `capacity` splat slots of SH degree
     /// `sh_degree`, every one hidden, filled by ApplyStreamStep; `center_min` .. `center_max`
-    /// bound every centre that will be written. Backends without a pool (the default) throw
-    /// core::Open3DError naming themselves.
+    /// bound every centre that will be written; `compact_storage` stores it at half precision
+    /// (frames must then ask for RenderConfig::compact_storage). Backends without a pool (the
+    /// default) throw core::Open3DError naming themselves.
     virtual void SetScenePool(int64_t capacity, int sh_degree, const Eigen::Vector3d& center_min,
-                              const Eigen::Vector3d& center_max);
+                              const Eigen::Vector3d& center_max, bool compact_storage = false);
     /// Writes a SplatStreamer step's pages into the pool and shows its cut.
     virtual void ApplyStreamStep(const SplatStreamStep& step);
     /// The most splats a scene or pool may hold on this backend's device (what one storage

@@ -119,7 +119,7 @@ void GaussianSplatRenderer::StreamSplats(const std::string& path,
     const t::io::SplatPageFile& file = stream->File();
     try {
         backend_->SetScenePool(stream->PoolSplats(), file.ShDegree(), file.CenterMin(),
-                               file.CenterMax());
+                               file.CenterMax(), stream->CompactStorage());
     } catch (...) {
         backend_->ReleaseResources();  // a pool half made (device memory) is no scene
         throw;
@@ -248,7 +248,14 @@ void GaussianSplatRenderer::RenderGeometryStage(uint64_t view_id,
         if (!stream_view_) stream_view_ = view_id;
         if (*stream_view_ == view_id) stream_->SetView(camera);
     }
-    backend_->RenderGeometryStage(camera, config);
+    if (stream_) {
+        // The pool keeps the precision the stream was started with (no host copy to re-pack).
+        RenderConfig frame = config;
+        frame.compact_storage = stream_->CompactStorage();
+        backend_->RenderGeometryStage(camera, frame);
+    } else {
+        backend_->RenderGeometryStage(camera, config);
+    }
     ++counters_.geometry_stages;
     current_view_ = view_id;
     has_current_view_ = true;

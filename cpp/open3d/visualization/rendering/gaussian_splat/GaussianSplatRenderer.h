@@ -66,7 +66,9 @@ public:
     /// (docs/streaming.md "In the renderer and the viewer"): the backend holds a pool of
     /// options.gpu_budget bytes; the geometry stages of one view (the first drawn since, until
     /// released) give the streaming worker that view, and every Prepare shows the pages read
-    /// since. A stream replaces an earlier one. Throws core::Open3DError while clouds are held
+    /// since. The pool is stored at options.compact_storage's precision, and the stream's
+    /// frames draw at it whatever their RenderConfig says. A stream replaces an earlier one.
+    /// Throws core::Open3DError while clouds are held
     /// or for a refused file or options (nothing changes then), or when the backend cannot
     /// hold the pool (only "vulkan" can; an earlier stream has ended then).
     void StreamSplats(const std::string& path, const SplatStreamOptions& options = {});

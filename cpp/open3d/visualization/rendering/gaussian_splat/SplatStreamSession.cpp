@@ -60,12 +60,15 @@ uint64_t ParseGpuBudget(const std::string& text) {
     return text == "auto" ? 0 : ParseByteSize(text);
 }
 
-double StreamPoolBytesPerSplat(int sh_degree) {
-    return PackedSplatLayout(sh_degree, SplatPrecision::kExact).BytesPerSplat() + 1.0 / 8.0;
+double StreamPoolBytesPerSplat(int sh_degree, bool compact_storage) {
+    const SplatPrecision precision =
+        compact_storage ? SplatPrecision::kCompact : SplatPrecision::kExact;
+    return PackedSplatLayout(sh_degree, precision).BytesPerSplat() + 1.0 / 8.0;
 }
 
-int64_t StreamPoolPages(const t::io::SplatPageFile& file, uint64_t gpu_budget, int64_t max_splats) {
-    const double per_splat = StreamPoolBytesPerSplat(file.ShDegree());
+int64_t StreamPoolPages(const t::io::SplatPageFile& file, uint64_t gpu_budget, int64_t max_splats,
+                        bool compact_storage) {
+    const double per_splat = StreamPoolBytesPerSplat(file.ShDegree(), compact_storage);
     const int64_t capacity = file.PageCapacity();
     const int64_t most = max_splats / capacity;  // pages the backend holds
     if (most < 1) {
@@ -113,7 +116,8 @@ int64_t CutBudget(const SplatStreamOptions& options, int64_t pool_splats) {
 SplatStreamSession::SplatStreamSession(const std::string& path, const SplatStreamOptions& options,
                                        int64_t max_splats)
     : file_(path),
-      pool_pages_(StreamPoolPages(file_, options.gpu_budget, max_splats)),
+      compact_storage_(options.compact_storage),
+      pool_pages_(StreamPoolPages(file_, options.gpu_budget, max_splats, options.compact_storage)),
       streamer_(file_, pool_pages_, CutBudget(options, pool_pages_ * file_.PageCapacity())),
       worker_(streamer_, options.reads_per_step) {
     progress_.path = path;

@@ -27,6 +27,11 @@ struct SplatStreamOptions {
     int64_t splat_budget = 0;
     /// Pages read and checked per streaming step (a step's pages show together).
     int64_t reads_per_step = 16;
+    /// The pool at half precision (RenderConfig::compact_storage's packing: 84 instead of 152
+    /// bytes a splat at SH degree 2, so 1.8 times the splats in a budget). A pool keeps the
+    /// precision it is made at: the stream's frames draw at it whatever their
+    /// RenderConfig::compact_storage says.
+    bool compact_storage = false;
 };
 
 /// Where a stream stands, as of the last step the render thread took.
@@ -59,17 +64,18 @@ uint64_t ParseByteSize(const std::string& text);
 /// ParseByteSize's bytes.
 uint64_t ParseGpuBudget(const std::string& text);
 
-/// Bytes a splat of SH degree `sh_degree` takes in a pool: its packed exact words and its
-/// visibility bit.
-double StreamPoolBytesPerSplat(int sh_degree);
+/// Bytes a splat of SH degree `sh_degree` takes in a pool: its packed words (exact, or half
+/// precision with `compact_storage`) and its visibility bit.
+double StreamPoolBytesPerSplat(int sh_degree, bool compact_storage = false);
 
 /// Page slots a pool of `gpu_budget` bytes (0: SplatStreamOptions' default) holds for `file`
 /// on a backend that holds at most `max_splats` splats in a scene, and no more than the file
-/// has pages. Throws core::Open3DError
+/// has pages (at half precision with `compact_storage`). Throws core::Open3DError
 /// naming the sizes when it holds no page, or when a given budget makes a pool larger than
 /// the backend holds.
 int64_t StreamPoolPages(const t::io::SplatPageFile& file, uint64_t gpu_budget,
-                        int64_t max_splats = std::numeric_limits<int64_t>::max());
+                        int64_t max_splats = std::numeric_limits<int64_t>::max(),
+                        bool compact_storage = false);
 
 class SplatStreamSession {
 public:
@@ -86,6 +92,8 @@ public:
     const t::io::SplatPageFile& File() const { return file_; }
     /// Splat slots of the pool (the scene the backend holds).
     int64_t PoolSplats() const { return streamer_.PoolSplats(); }
+    /// SplatStreamOptions::compact_storage: the pool's precision.
+    bool CompactStorage() const { return compact_storage_; }
 
     /// Streams for `camera` from the worker's next step on; the same view again changes
     /// nothing (a renderer calls this every frame).
@@ -98,6 +106,7 @@ public:
 
 private:
     t::io::SplatPageFile file_;
+    const bool compact_storage_;
     const int64_t pool_pages_;  // StreamPoolPages, once
     SplatStreamer streamer_;
     SplatStreamWorker worker_;

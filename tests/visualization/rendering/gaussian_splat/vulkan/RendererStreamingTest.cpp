@@ -67,6 +67,29 @@ RenderOutput DrawUntilSettled(GaussianSplatRenderer& renderer, const camera::Pin
     return out;
 }
 
+TEST_F(RendererStreaming, ACompactStreamDrawsAtItsPoolsPrecision) {
+    // Frames that leave RenderConfig::compact_storage off draw a compact stream at half
+    // precision: the image of the whole scene stored compact.
+    const t::geometry::PointCloud scene = TwoClusters();
+    const std::string paged = TempDir() + "/two_clusters_compact.gspages";
+    t::io::WriteSplatPages(paged, scene, t::geometry::BuildSplatHierarchy(scene), 64);
+    SplatStreamOptions options;
+    options.compact_storage = true;
+    GaussianSplatRenderer renderer(MakeBackend());
+    renderer.StreamSplats(paged, options);
+    const camera::PinholeCamera cam = CameraAt(0.0);
+    int frames = 0;
+    const RenderOutput streamed = DrawUntilSettled(renderer, cam, frames);
+    auto plain = MakeBackend();
+    plain->SetScene(scene);
+    RenderConfig compact;
+    compact.compact_storage = true;
+    const RenderOutput whole = plain->Render(cam, compact);
+    EXPECT_GT(streamed.stats.num_visible, 500);
+    EXPECT_EQ(streamed.stats.num_visible, whole.stats.num_visible);
+    EXPECT_EQ(t::geometry::ComputeMaxAbsError(streamed.color, whole.color), 0.0);
+}
+
 TEST_F(RendererStreaming, FramesConvergeToTheWholeScenesImageAsTheViewMoves) {
     const t::geometry::PointCloud scene = TwoClusters();
     const std::string paged = TempDir() + "/two_clusters.gspages";

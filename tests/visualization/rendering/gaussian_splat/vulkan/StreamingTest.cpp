@@ -112,18 +112,21 @@ TEST_F(Streaming, ATinyPoolConvergesToTheWholeScenesImageAsTheViewMoves) {
 RenderOutput StreamedImage(const t::geometry::PointCloud& scene,
                            const t::geometry::SplatHierarchy& hierarchy, int64_t capacity,
                            const camera::PinholeCamera& cam,
-                           vulkan::GaussianSplatVulkanBackend& backend) {
+                           vulkan::GaussianSplatVulkanBackend& backend,
+                           bool compact_storage = false) {
     const std::string paged = TempDir() + "/scene_" + std::to_string(capacity) + ".gspages";
     t::io::WriteSplatPages(paged, scene, hierarchy, capacity);
     const t::io::SplatPageFile file(paged);
     SplatStreamer streamer(file, file.NumPages(), file.NumLeaves());
-    backend.SetScenePool(streamer.PoolSplats(), file.ShDegree(), file.CenterMin(),
-                         file.CenterMax());
+    backend.SetScenePool(streamer.PoolSplats(), file.ShDegree(), file.CenterMin(), file.CenterMax(),
+                         compact_storage);
     StreamUntilComplete(streamer, backend, cam, 1024);
     if (capacity == 8) {
         EXPECT_GT(file.NumPages(), hierarchy.NumNodes() / 8);  // pages of one to eight nodes
     }
-    return backend.Render(cam, {});
+    RenderConfig config;
+    config.compact_storage = compact_storage;
+    return backend.Render(cam, config);
 }
 
 TEST_F(Streaming, ManySmallPagesRenderAsOnePage) {
@@ -145,6 +148,34 @@ TEST_F(Streaming, ManySmallPagesRenderAsOnePage) {
     EXPECT_EQ(t::geometry::ComputeMaxAbsError(small.depth_expected, one.depth_expected), 0.0);
     // And what both show is the scene (the accuracy bound of the test above).
     EXPECT_GE(Psnr(small, cpu::RenderReference(scene, cam, {})), 90.0);
+}
+
+TEST_F(Streaming, ACompactPoolDrawsAsTheSceneStoredCompact) {
+    // The pages packed at half precision into the pool: the image of the whole scene stored
+    // compact, bit for bit (random splats: no two share a view depth).
+    const t::geometry::PointCloud scene = t::io::RandomCloud(3000, 1, 7);
+    const t::geometry::SplatHierarchy hierarchy = t::geometry::BuildSplatHierarchy(scene);
+    camera::PinholeCamera cam;
+    cam.width = cam.height = 64;
+    cam.fx = cam.fy = 50.0;
+    cam.cx = cam.cy = 31.5;
+    cam.world_to_camera(2, 3) = 40.0;
+    auto backend = MakeBackend();
+    const RenderOutput streamed = StreamedImage(scene, hierarchy, 64, cam, *backend, true);
+    RenderConfig compact;
+    compact.compact_storage = true;
+    auto plain = MakeBackend();
+    plain->SetScene(scene);
+    const RenderOutput whole = plain->Render(cam, compact);
+    EXPECT_GT(streamed.stats.num_visible, 1000);
+    EXPECT_EQ(streamed.stats.num_visible, whole.stats.num_visible);
+    EXPECT_EQ(t::geometry::ComputeMaxAbsError(streamed.color, whole.color), 0.0);
+    EXPECT_EQ(t::geometry::ComputeMaxAbsError(streamed.depth_expected, whole.depth_expected), 0.0);
+    // Half precision is not the exact image (the pool really is compact), and a frame that
+    // asks for float32 is refused: there is no host copy to re-pack.
+    EXPECT_GT(t::geometry::ComputeMaxAbsError(streamed.color, plain->Render(cam, {}).color), 0.0);
+    ExpectErrorContaining([&] { backend->Render(cam, {}); },
+                          "keeps the precision it was made at (half precision)");
 }
 
 TEST_F(Streaming, WritesIntoAPlainSceneDrawAsTheSceneWrittenWhole) {

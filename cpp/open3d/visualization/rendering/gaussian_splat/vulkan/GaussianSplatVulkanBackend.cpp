@@ -123,7 +123,8 @@ void GaussianSplatVulkanBackend::SetSceneHierarchy(const t::geometry::PointCloud
 
 void GaussianSplatVulkanBackend::SetScenePool(int64_t capacity, int sh_degree,
                                               const Eigen::Vector3d& center_min,
-                                              const Eigen::Vector3d& center_max) {
+                                              const Eigen::Vector3d& center_max,
+                                              bool compact_storage) {
     if (capacity < 1 || capacity > int64_t(UINT32_MAX)) {
         core::ThrowError("Vulkan backend: a scene pool of {} splats (1 to 2^32 - 1)", capacity);
     }
@@ -132,7 +133,8 @@ void GaussianSplatVulkanBackend::SetScenePool(int64_t capacity, int sh_degree,
     }
     // Allocated and zero-filled on the GPU: packing millions of placeholder splats on the
     // host took seconds before the first image.
-    PackedGaussianSplats like = PackedSplatLayout(sh_degree, SplatPrecision::kExact);
+    PackedGaussianSplats like = PackedSplatLayout(
+        sh_degree, compact_storage ? SplatPrecision::kCompact : SplatPrecision::kExact);
     like.center_min = center_min;
     like.center_max = center_max;
     if (geometry_.in_flight) Wait(*context_, geometry_stage_fence_.Get());

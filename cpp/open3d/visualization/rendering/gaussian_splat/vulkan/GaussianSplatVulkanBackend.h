@@ -142,12 +142,14 @@ public:
 
     /// A scene of `capacity` splat slots at SH degree `sh_degree`, every one hidden, whose
     /// splats arrive by WriteSceneSplats and are shown by SetVisibility: the pool a
-    /// SplatStreamer streams a paged file into (docs/streaming.md). Stored exactly (float32;
-    /// a frame with RenderConfig::compact_storage throws) and kept on the GPU only. The depth
-    /// range starts from `center_min` .. `center_max`, the bounds of every centre that will
-    /// be written. Throws for a capacity outside 1 .. 2^32 - 1 or a degree outside 0..3.
+    /// SplatStreamer streams a paged file into (docs/streaming.md). Stored exactly (float32),
+    /// or at half precision with `compact_storage`, and kept on the GPU only: there is no
+    /// host copy to re-pack, so a frame whose RenderConfig::compact_storage differs throws.
+    /// The depth range starts from `center_min` .. `center_max`, the bounds of every centre
+    /// that will be written. Throws for a capacity outside 1 .. 2^32 - 1 or a degree outside
+    /// 0..3.
     void SetScenePool(int64_t capacity, int sh_degree, const Eigen::Vector3d& center_min,
-                      const Eigen::Vector3d& center_max) override;
+                      const Eigen::Vector3d& center_max, bool compact_storage = false) override;
     /// Writes `splats` (valid, of the scene's SH degree) over splats [first, first + n) of the
     /// scene, on the GPU and in the copy kept for re-packing, after the frames that read the
     /// scene complete. The visibility mask is unchanged. Throws for a range outside the scene,

@@ -175,8 +175,11 @@ void GaussianSplatVulkanBackend::EnsureScenePrecision(const RenderConfig& config
     if (precision == geometry_stage_resources_.Layout().precision) return;
     if (pool_scene_) {
         core::ThrowError(
-            "Vulkan backend: a streamed scene pool is stored exactly (float32); "
-            "RenderConfig::compact_storage is not available for it");
+            "Vulkan backend: a streamed scene pool keeps the precision it was made at ({}); a "
+            "frame with RenderConfig::compact_storage = {} cannot draw it "
+            "(SplatStreamOptions::compact_storage chooses the pool's)",
+            precision == SplatPrecision::kCompact ? "float32" : "half precision",
+            precision == SplatPrecision::kCompact ? "true" : "false");
     }
     if (geometry_.in_flight) Wait(*context_, geometry_stage_fence_.Get());
     geometry_.in_flight = false;
