@@ -620,6 +620,14 @@ int Run(const Options& opt) {
     if (knobs.empty()) core::ThrowError("--knobs '{}' selects none of the known knobs", opt.knobs);
 
     std::vector<Row> rows;
+    // --stream's runs: a JSON row each (knob "stream").
+    struct StreamRow {
+        std::string scene, resolution;
+        int64_t splats;
+        std::string gpu_budget;
+        bench::StreamBenchResult result;
+    };
+    std::vector<StreamRow> streams;
     std::string device_name = opt.backend;
     for (SceneJob& job : jobs) {
         auto backend = rendering::CreateGaussianSplatBackend(opt.backend);
@@ -658,8 +666,12 @@ int Run(const Options& opt) {
             stream.page_capacity = opt.page_capacity;
             stream.reads_per_step = opt.reads_per_step;
             stream.compact_storage = opt.stream_compact;
-            bench::RunStreamBench(job.cloud, hierarchy, cam, config,
-                                  backend->Render(cam, config).color, stream);
+            const bench::StreamBenchResult result = bench::RunStreamBench(
+                job.cloud, hierarchy, cam, config, backend->Render(cam, config).color, stream);
+            streams.push_back(
+                {job.name,
+                 fmt::format("{}x{}", job_resolutions[0].first, job_resolutions[0].second),
+                 job.cloud.NumPoints(), opt.gpu_budget, result});
         }
         for (const auto& [w, h] : job_resolutions) {
             const auto cams = job.cameras(w, h);
@@ -842,6 +854,34 @@ int Run(const Options& opt) {
                 out.back()["fraction_over_1_255"] = r.over_1_255;
                 out.back()["p999_abs_error"] = r.p999;
             }
+        }
+        for (const StreamRow& s : streams) {
+            const bench::StreamBenchResult& r = s.result;
+            out.push_back({{"scene", s.scene},
+                           {"resolution", s.resolution},
+                           {"knob", "stream"},
+                           {"splats", s.splats},
+                           {"stream",
+                            {{"gpu_budget", s.gpu_budget},
+                             {"compact_storage", r.compact_storage},
+                             {"file_pages", r.file_pages},
+                             {"pool_pages", r.pool_pages},
+                             {"pool_splats", r.pool_splats},
+                             {"bytes_per_splat", r.bytes_per_splat},
+                             {"pool_ready_ms", r.pool_ready_ms},
+                             {"first_image_ms", r.first_image_ms},
+                             {"first_image_psnr_db", r.first_image_psnr_db},
+                             {"converged_ms", r.converged_ms},
+                             {"steps", r.steps},
+                             {"pages_read", r.pages_read},
+                             {"bytes_read", r.bytes_read},
+                             {"evictions", r.evictions},
+                             {"cut_nodes", r.cut_nodes},
+                             {"pool_full", r.pool_full},
+                             {"error_against", "exact render of the whole scene"}}},
+                           {"psnr_db_worst_view", r.psnr_db},
+                           {"max_abs_error", r.max_abs_error},
+                           {"fraction_over_1_255", r.fraction_over_1_255}});
         }
         WriteJson(opt.json, out);
         std::printf("\nwrote %s\n", opt.json.c_str());

@@ -23,10 +23,12 @@ namespace bench {
 
 namespace rendering = visualization::rendering;
 
-void RunStreamBench(const t::geometry::PointCloud& scene,
-                    const t::geometry::SplatHierarchy& hierarchy,
-                    const camera::PinholeCamera& camera, const rendering::RenderConfig& config,
-                    const t::geometry::Image& exact, const StreamBenchOptions& options) {
+StreamBenchResult RunStreamBench(const t::geometry::PointCloud& scene,
+                                 const t::geometry::SplatHierarchy& hierarchy,
+                                 const camera::PinholeCamera& camera,
+                                 const rendering::RenderConfig& config,
+                                 const t::geometry::Image& exact,
+                                 const StreamBenchOptions& options) {
     {
         const auto start = std::chrono::steady_clock::now();
         t::io::WriteSplatPages(options.path, scene, hierarchy, options.page_capacity);
@@ -60,8 +62,14 @@ void RunStreamBench(const t::geometry::PointCloud& scene,
         pool_splats * bytes_per_splat / 1e9, bytes_per_splat, compact ? ", half precision" : "",
         static_cast<long long>(budget));
 
-    std::printf("stream: pool ready %.0f ms after the load started\n",
-                core::MillisecondsSince(start));
+    StreamBenchResult result;
+    result.file_pages = file.NumPages();
+    result.pool_pages = pool_pages;
+    result.pool_splats = pool_splats;
+    result.bytes_per_splat = bytes_per_splat;
+    result.compact_storage = compact;
+    result.pool_ready_ms = core::MillisecondsSince(start);
+    std::printf("stream: pool ready %.0f ms after the load started\n", result.pool_ready_ms);
     double first_ms = -1.0, first_db = 0.0, last_print = -1.0;
     rendering::SplatStreamStep step;
     rendering::RenderOutput frame;
@@ -110,6 +118,19 @@ void RunStreamBench(const t::geometry::PointCloud& scene,
         first_ms, first_db, steps + 1, converged_ms, streamer.BytesRead() / 1e9,
         streamer.BytesRead() / 1e6 / (converged_ms / 1e3), m.psnr_db, m.max_abs_error,
         100.0 * m.fraction_over_threshold);
+    result.first_image_ms = first_ms;
+    result.first_image_psnr_db = first_db;
+    result.converged_ms = converged_ms;
+    result.steps = steps + 1;
+    result.pages_read = streamer.PagesRead();
+    result.evictions = streamer.Evictions();
+    result.bytes_read = streamer.BytesRead();
+    result.cut_nodes = step.cut_nodes;
+    result.pool_full = step.pages_wanted > 0;
+    result.psnr_db = m.psnr_db;
+    result.max_abs_error = m.max_abs_error;
+    result.fraction_over_1_255 = m.fraction_over_threshold;
+    return result;
 }
 
 }  // namespace bench
