@@ -89,8 +89,8 @@ struct GaussianViewParams {
     vec3 center_high;  // c_hi, the camera centre rounded to float32
     float reserved0;
     float fx, fy, cx, cy;  // intrinsics (pixels)
-    float guard_x;         // guard band 1.3 tan(fov_x / 2)
-    float guard_y;         // guard band 1.3 tan(fov_y / 2)
+    float guard_x;         // guard band half width 1.3 tan(fov_x / 2)
+    float guard_y;         // guard band half height 1.3 tan(fov_y / 2)
     float near_plane;
     float packed_depth_scale;  // packed key's 1 / (far - near); 0 = exact depth order
     uint width, height, tiles_x, tiles_y;
@@ -113,7 +113,9 @@ struct GaussianViewParams {
     // Nodes the level-of-detail cut may keep (RenderConfig::lod_budget, 0xFFFFFFFF: every
     // leaf); read only for a scene with a hierarchy (GaussianSplatLodContract.h).
     uint lod_budget;
-    uint reserved2, reserved3;
+    // Centre of the guard band in x / z and y / z: the image's centre ((W - 1) / 2 - cx) / fx,
+    // ((H - 1) / 2 - cy) / fy; 0 for a centred principal point (the original's only case).
+    float guard_center_x, guard_center_y;
 };
 
 // One projected splat, written for visible splats only, indexed by splat index (std430).
@@ -212,7 +214,8 @@ static_assert(offsetof(GaussianViewParams, reference_m10) == 168);
 static_assert(offsetof(GaussianViewParams, reference_m14) == 172);
 static_assert(offsetof(GaussianViewParams, depth_order) == 176);
 static_assert(offsetof(GaussianViewParams, lod_budget) == 180);
-static_assert(offsetof(GaussianViewParams, reserved3) == 188);
+static_assert(offsetof(GaussianViewParams, guard_center_x) == 184);
+static_assert(offsetof(GaussianViewParams, guard_center_y) == 188);
 static_assert(sizeof(GaussianGeometryAddresses) == 32);
 static_assert(offsetof(GaussianGeometryAddresses, sh_lo) == 8);
 static_assert(offsetof(GaussianGeometryAddresses, projected_lo) == 16);

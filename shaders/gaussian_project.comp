@@ -231,9 +231,12 @@ bool Project(uint i, uint slot, out float depth, out uint entries) {
     float px = fx * v.x / v.z + view.cx;
     float py = fy * v.y / v.z + view.cy;
 
-    // Jacobian at the guard-band clamped position (keeps off-screen footprints bounded).
-    float x_over_z = clamp(v.x / v.z, -view.guard_x, view.guard_x);
-    float y_over_z = clamp(v.y / v.z, -view.guard_y, view.guard_y);
+    // Jacobian at the guard-band clamped position (keeps off-screen footprints bounded); the
+    // band is centred on the image (on the axis for a centred principal point: -g .. g).
+    float x_over_z = clamp(v.x / v.z, view.guard_center_x - view.guard_x,
+                           view.guard_center_x + view.guard_x);
+    float y_over_z = clamp(v.y / v.z, view.guard_center_y - view.guard_y,
+                           view.guard_center_y + view.guard_y);
     float tx = x_over_z * v.z, ty = y_over_z * v.z;
     float z2 = v.z * v.z;
     // J's z column, -f tx / z^2 as the original computes it; past z ~ 1.8e19 z^2 overflows

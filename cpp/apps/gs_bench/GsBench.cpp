@@ -473,8 +473,7 @@ void AddLodRows(const Options& opt, const std::vector<int64_t>& budgets, const S
         exact.push_back(backend.Render(cam, config).color);
         if (opt.lod_supersample > 0) {
             const int s = opt.lod_supersample;
-            filtered.push_back(
-                backend.Render(bench::SupersampledView(cam, s), config).color.BoxDownsample(s));
+            filtered.push_back(bench::FilteredReference(backend, cam, s, config));
             exact_filtered_psnr.push_back(
                 t::geometry::ComputePSNR(exact.back(), filtered.back(), 1.0));
         }

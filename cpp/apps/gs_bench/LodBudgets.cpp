@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdlib>
 
+#include "BenchScenes.h"
 #include "open3d/core/Exception.h"
 #include "open3d/core/Timer.h"
 #include "open3d/visualization/rendering/gaussian_splat/SplatStreamer.h"
@@ -52,6 +53,45 @@ std::string BudgetLabel(int64_t budget) {
     if (budget >= 1000000 && budget % 1000 == 0) return shortest(budget / 1e6) + "M";
     if (budget >= 1000 && budget % 10 == 0) return shortest(budget / 1e3) + "k";
     return std::to_string(budget);
+}
+
+t::geometry::Image FilteredReference(visualization::rendering::GaussianSplatBackend& backend,
+                                     const camera::PinholeCamera& camera, int s,
+                                     const visualization::rendering::RenderConfig& config) {
+    const int w = camera.width, h = camera.height;
+    if (s < 1 || w % s != 0 || h % s != 0) {
+        core::ThrowError("--lod-supersample {}: does not divide the view's {} x {} pixels", s, w,
+                         h);
+    }
+    const camera::PinholeCamera fine = SupersampledView(camera, s);
+    t::geometry::Image out;
+    for (int ty = 0; ty < s; ++ty) {
+        for (int tx = 0; tx < s; ++tx) {
+            // Fine pixels [tx w, (tx + 1) w) x [ty h, (ty + 1) h) of the s-times image.
+            camera::PinholeCamera tile = fine;
+            tile.width = w;
+            tile.height = h;
+            tile.cx = fine.cx - double(tx) * w;
+            tile.cy = fine.cy - double(ty) * h;
+            const visualization::rendering::RenderOutput frame = backend.Render(tile, config);
+            if (frame.stats.error_flags != 0) {
+                core::ThrowError(
+                    "--lod-supersample {}: tile ({}, {}) of the filtered reference dropped tile "
+                    "entries (error flags {}): raise --max-tile-entries",
+                    s, tx, ty, frame.stats.error_flags);
+            }
+            const t::geometry::Image block = frame.color.BoxDownsample(s);
+            if (out.IsEmpty()) {
+                out = t::geometry::Image(h, w, block.GetChannels(), core::Dtype::Float32);
+            }
+            const int64_t c = block.GetChannels();
+            for (int64_t y = 0; y < block.GetRows(); ++y) {
+                std::copy_n(block.Data<float>() + y * block.GetCols() * c, block.GetCols() * c,
+                            &out.At<float>(ty * (h / s) + y, tx * (w / s)));
+            }
+        }
+    }
+    return out;
 }
 
 LodCut CutForView(const t::geometry::SplatHierarchy& hierarchy,

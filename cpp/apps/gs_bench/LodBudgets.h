@@ -8,8 +8,10 @@
 #include <vector>
 
 #include "open3d/camera/PinholeCamera.h"
+#include "open3d/t/geometry/Image.h"
 #include "open3d/t/geometry/PointCloud.h"
 #include "open3d/t/geometry/SplatHierarchy.h"
+#include "open3d/visualization/rendering/gaussian_splat/GaussianSplatBackend.h"
 
 namespace open3d {
 namespace bench {
@@ -28,6 +30,15 @@ struct LodCut {
     int64_t nodes = 0;
     double cut_ms = 0.0;
 };
+
+/// The exact render of `camera`'s view at s x s times its pixels, box-filtered back to its
+/// size (--lod-supersample): drawn as s x s tiles of the camera's own size (SupersampledView
+/// shifted by whole tiles), so no frame holds more tile entries than the view does at its own
+/// size. Throws core::Open3DError when s does not divide the size or a tile's frame dropped
+/// entries (its picture would be wrong).
+t::geometry::Image FilteredReference(visualization::rendering::GaussianSplatBackend& backend,
+                                     const camera::PinholeCamera& camera, int s,
+                                     const visualization::rendering::RenderConfig& config);
 
 /// The cut of `hierarchy` (built from `source`) for `camera` under `budget` splats.
 LodCut CutForView(const t::geometry::SplatHierarchy& hierarchy,

@@ -39,6 +39,12 @@ struct PinholeCamera {
     /// tan of half the horizontal / vertical field of view as 3DGS defines it: W / (2 fx).
     double GetTanHalfFovX() const { return width / (2.0 * fx); }
     double GetTanHalfFovY() const { return height / (2.0 * fy); }
+    /// x / z and y / z of the image's centre: ((W - 1) / 2 - cx) / fx, ((H - 1) / 2 - cy) / fy;
+    /// 0 for a centred principal point. The renderers' Jacobian guard band (1.3 tan of the half
+    /// field of view either side) is centred here, so an off-centre principal point (a crop, a
+    /// tile of a larger view) does not clamp splats inside the image.
+    double GetImageCenterTanX() const { return ((width - 1) / 2.0 - cx) / fx; }
+    double GetImageCenterTanY() const { return ((height - 1) / 2.0 - cy) / fy; }
 
     /// Throws core::Open3DError when sizes or focal lengths are not positive or values
     /// are not finite, or the rotation is not orthonormal.

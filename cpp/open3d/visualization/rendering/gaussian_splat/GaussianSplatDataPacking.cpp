@@ -271,6 +271,8 @@ PackedView PackGaussianView(const camera::PinholeCamera& camera, const RenderCon
     p.cy = float(camera.cy);
     p.guard_x = float(1.3 * camera.GetTanHalfFovX());
     p.guard_y = float(1.3 * camera.GetTanHalfFovY());
+    p.guard_center_x = float(camera.GetImageCenterTanX());
+    p.guard_center_y = float(camera.GetImageCenterTanY());
     p.near_plane = float(config.near_plane);
     // A positive scale is the packed key's, kept finite for a tiny depth range.
     if (choices.packed_key) {

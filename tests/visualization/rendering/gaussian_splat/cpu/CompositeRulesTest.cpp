@@ -150,9 +150,10 @@ TEST(CpuComposite, GuardBandSplatReachesIntoTheImageEdge) {
     s.scale = {0.45, 0.45, 0.45};
     s.opacity = 0.9;
     const RenderOutput out = RenderReference(MakeCloud({s}), MakeTestCamera());
-    const double lim = 1.3 * 64.0 / 200.0;
+    // Clamped at the band's left edge: its centre is the image's, (31.5 - cx) / fx.
+    const double edge = (31.5 - 32.0) / 100.0 - 1.3 * 64.0 / 200.0;
     const double k2 = std::pow(100.0 * double(0.45f) / 5.0, 2);
-    const double cov_a = k2 * (1 + lim * lim) + 0.3, cov_c = k2 + 0.3;
+    const double cov_a = k2 * (1 + edge * edge) + 0.3, cov_c = k2 + 0.3;
     const double cx = 32.0 + 100.0 * double(float(-2.6)) / 5.0;
     for (int y : {32, 40}) {
         const double dx = cx - 0.0, dy = 0.0 - y + 32.0;

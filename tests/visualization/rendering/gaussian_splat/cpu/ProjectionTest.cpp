@@ -113,15 +113,42 @@ TEST(CpuProjection, JacobianGuardBandClampsOffscreenSplats) {
     const auto p = ProjectSplats(MakeCloud({s}), MakeTestCamera(), RenderConfig{})[0];
     ASSERT_TRUE(p.IsVisible());
     EXPECT_NEAR(p.x, 32.0 + 100.0 * double(float(-0.52 * 5.0)) / 5.0, kTol);
-    const double lim = 1.3 * 64.0 / (2.0 * 100.0);
+    // The band is centred on the image: cx = 32 is half a pixel right of the centre 31.5.
+    const double lim = 1.3 * 64.0 / (2.0 * 100.0), center = (31.5 - 32.0) / 100.0;
     const double k2 = std::pow(100.0 * double(0.45f) / 5.0, 2);
-    // J row 0 = (f/z, 0, -f tx / z^2) with tx = -lim z: |row|^2 = (f/z)^2 (1 + lim^2).
-    EXPECT_NEAR(p.cov_a, k2 * (1.0 + lim * lim) + 0.3, 1e-7);
+    // J row 0 = (f/z, 0, -f tx / z^2) with tx = (center - lim) z:
+    // |row|^2 = (f/z)^2 (1 + (center - lim)^2).
+    EXPECT_NEAR(p.cov_a, k2 * (1.0 + (center - lim) * (center - lim)) + 0.3, 1e-7);
     EXPECT_NEAR(p.cov_c, k2 + 0.3, 1e-7);
     // Inside the guard band nothing is clamped: X / Z = -0.3 gives (1 + 0.09).
     s.position = {-0.3 * 5.0, 0, 5};
     const auto q = ProjectSplats(MakeCloud({s}), MakeTestCamera(), RenderConfig{})[0];
     EXPECT_NEAR(q.cov_a, k2 * (1.0 + double(float(-1.5)) * float(-1.5) / 25.0) + 0.3, 1e-7);
+}
+
+TEST(CpuProjection, TheGuardBandFollowsAnOffCentrePrincipalPoint) {
+    // A crop: the 64 x 64 camera's principal point at cx = -40, so the image spans
+    // X / Z = 0.405 .. 1.035 and its centre is X / Z = 0.72, beyond the band of a band
+    // centred on the axis (0.416). A splat at X / Z = 0.9 is inside the image: its Jacobian
+    // is taken where it is, as in a wide view whose band reaches it.
+    TestSplat s;
+    s.position = {0.9 * 5.0, 0, 5};
+    s.scale = {0.45, 0.45, 0.45};
+    camera::PinholeCamera crop = MakeTestCamera();
+    crop.cx = -40.0;
+    const auto p = ProjectSplats(MakeCloud({s}), crop, RenderConfig{})[0];
+    ASSERT_TRUE(p.IsVisible());
+    const double x_over_z = double(float(0.9 * 5.0)) / 5.0;
+    const double k2 = std::pow(100.0 * double(0.45f) / 5.0, 2);
+    EXPECT_NEAR(p.cov_a, k2 * (1.0 + x_over_z * x_over_z) + 0.3, 1e-7);
+    // The same splat in a view 4 times as wide (centred) projects alike.
+    camera::PinholeCamera wide = MakeTestCamera(256, 64);
+    wide.cx = 127.5;
+    wide.cy = 32.0;
+    const auto q = ProjectSplats(MakeCloud({s}), wide, RenderConfig{})[0];
+    EXPECT_NEAR(p.cov_a, q.cov_a, 1e-9);
+    EXPECT_NEAR(p.cov_b, q.cov_b, 1e-9);
+    EXPECT_NEAR(p.cov_c, q.cov_c, 1e-9);
 }
 
 TEST(CpuProjection, OffscreenSplatWithoutTilesIsCulled) {

@@ -187,7 +187,8 @@ TEST_F(GaussianSplatContractGpu, ShaderLayoutMatchesCpp) {
     EXPECT_EQ(v.reference_m14, 343.0f);
     EXPECT_EQ(v.depth_order, 344u);
     EXPECT_EQ(v.lod_budget, 345u);
-    EXPECT_EQ(v.reserved3, 347u);
+    EXPECT_EQ(v.guard_center_x, 346.0f);
+    EXPECT_EQ(v.guard_center_y, 347.0f);
 
     shader::GaussianProjectedSplat s;
     std::memcpy(&s, splat_out.GetMapped(), sizeof(s));

@@ -69,6 +69,31 @@ TEST_F(VulkanBackend, RealScenesMatchTheReference) {
     }
 }
 
+TEST_F(VulkanBackend, AnOffCentreCropMatchesTheReference) {
+    // Pixels [56, 88) x [32, 64) of a 96 x 96 view as a 32 x 32 crop: its principal point
+    // lies 8.5 pixels left of its image, which spans X / Z = 8.5 / f .. 40.5 / f, mostly past
+    // the 20.8 / f a band centred on the axis would clamp at. The shader must centre its
+    // guard band on the image as the reference does (CpuProjection.
+    // TheGuardBandFollowsAnOffCentrePrincipalPoint).
+    const std::string path = DataPath("playbot/playbot_31k.ply");
+    if (!FileExists(path)) OPEN3D_SKIP_OR_FAIL_WHEN_UNAVAILABLE(path + " is absent");
+    t::geometry::PointCloud cloud;
+    t::io::ReadPointCloud(path, cloud);
+    camera::PinholeCamera crop =
+        camera::ReadCamerasJson(DataPath("playbot/cameras.json")).at(0).camera.Resized(96, 96);
+    crop.width = crop.height = 32;
+    crop.cx -= 56.0;
+    crop.cy -= 32.0;
+    auto backend = MakeBackend();
+    backend->SetScene(cloud);
+    const RenderOutput gpu = backend->Render(crop, {});
+    const RenderOutput ref = cpu::RenderReference(cloud, crop, {});
+    EXPECT_GT(gpu.stats.num_visible, 1000);
+    const auto m = t::geometry::ComputeImageErrorMetrics(gpu.color, ref.color, 1.0, 1.0 / 255.0);
+    EXPECT_GE(m.psnr_db, 80.0) << "max error " << m.max_abs_error;
+    EXPECT_LE(m.max_abs_error, 1.0 / 255.0) << m.psnr_db << " dB";
+}
+
 TEST_F(VulkanBackend, UnchangedViewReusesGeometryStageAndGivesTheSameImage) {
     auto backend = MakeBackend();
     const t::geometry::PointCloud cloud = CreateDefaultGaussianSplatScene();

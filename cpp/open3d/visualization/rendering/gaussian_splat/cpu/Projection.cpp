@@ -142,7 +142,8 @@ struct ViewParams {
     shader::ReferenceDepthRow depth_row;     // the original's float32 matrix row (its view z)
     OriginalProjection original;             // its full projection, for its float32 pixel centre
     double fx, fy, cx, cy;
-    double lim_x, lim_y;  // 1.3 tan(fov / 2): the Jacobian guard band
+    double lim_x, lim_y;                // 1.3 tan(fov / 2): the Jacobian guard band's half width
+    double lim_center_x, lim_center_y;  // its centre, the image's (0 when centred)
     TileGrid grid;
 };
 
@@ -203,9 +204,14 @@ ProjectedSplat ProjectOne(const ViewParams& view, const RenderConfig& config, in
     out.original_y = original[1];
 
     // Perspective Jacobian at the clamped position: splats far outside the view would
-    // otherwise get huge, smeared footprints.
-    const double tx = std::clamp(v.x() / v.z(), -view.lim_x, view.lim_x) * v.z();
-    const double ty = std::clamp(v.y() / v.z(), -view.lim_y, view.lim_y) * v.z();
+    // otherwise get huge, smeared footprints. The band is centred on the image, not on the
+    // axis, so an off-centre principal point keeps every splat inside the image unclamped.
+    const double tx =
+        std::clamp(v.x() / v.z(), view.lim_center_x - view.lim_x, view.lim_center_x + view.lim_x) *
+        v.z();
+    const double ty =
+        std::clamp(v.y() / v.z(), view.lim_center_y - view.lim_y, view.lim_center_y + view.lim_y) *
+        v.z();
     Eigen::Matrix<double, 2, 3> j;
     j << view.fx / v.z(), 0.0, -view.fx * tx / (v.z() * v.z()), 0.0, view.fy / v.z(),
         -view.fy * ty / (v.z() * v.z());
@@ -282,6 +288,8 @@ std::vector<ProjectedSplat> ProjectSplats(const t::geometry::PointCloud& cloud,
     view.cy = camera.cy;
     view.lim_x = 1.3 * camera.GetTanHalfFovX();
     view.lim_y = 1.3 * camera.GetTanHalfFovY();
+    view.lim_center_x = camera.GetImageCenterTanX();
+    view.lim_center_y = camera.GetImageCenterTanY();
     view.grid = TileGrid::ForImage(camera.width, camera.height);
 
     const int64_t n = a.num_points;

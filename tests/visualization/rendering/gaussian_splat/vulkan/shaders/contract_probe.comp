@@ -73,8 +73,8 @@ void WriteStageStructs() {
     view_out.reference_m14 = 343.0;
     view_out.depth_order = 344u;
     view_out.lod_budget = 345u;
-    view_out.reserved2 = 346u;
-    view_out.reserved3 = 347u;
+    view_out.guard_center_x = 346.0;
+    view_out.guard_center_y = 347.0;
 
     splat_out.center_x = 400.0;
     splat_out.center_y = 401.0;
