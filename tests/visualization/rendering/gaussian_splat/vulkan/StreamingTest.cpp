@@ -107,6 +107,16 @@ TEST_F(Streaming, ATinyPoolConvergesToTheWholeScenesImageAsTheViewMoves) {
     EXPECT_GT(streamer.PagesRead(), need_a + need_b);
 }
 
+// A 64 x 64 camera 40 units in front of t::io::RandomCloud's splats.
+camera::PinholeCamera RandomCloudView() {
+    camera::PinholeCamera cam;
+    cam.width = cam.height = 64;
+    cam.fx = cam.fy = 50.0;
+    cam.cx = cam.cy = 31.5;
+    cam.world_to_camera(2, 3) = 40.0;
+    return cam;
+}
+
 // Streams `scene` cut into pages of `capacity` nodes with room for every page and renders
 // `cam` once nothing is missing.
 RenderOutput StreamedImage(const t::geometry::PointCloud& scene,
@@ -134,11 +144,7 @@ TEST_F(Streaming, ManySmallPagesRenderAsOnePage) {
     // same whatever slots the pool holds them in, and the images must be equal bit for bit.
     const t::geometry::PointCloud scene = t::io::RandomCloud(3000, 1, 7);
     const t::geometry::SplatHierarchy hierarchy = t::geometry::BuildSplatHierarchy(scene);
-    camera::PinholeCamera cam;
-    cam.width = cam.height = 64;
-    cam.fx = cam.fy = 50.0;
-    cam.cx = cam.cy = 31.5;
-    cam.world_to_camera(2, 3) = 40.0;
+    const camera::PinholeCamera cam = RandomCloudView();
     auto backend = MakeBackend();
     const RenderOutput small = StreamedImage(scene, hierarchy, 8, cam, *backend);
     const RenderOutput one = StreamedImage(scene, hierarchy, hierarchy.NumNodes(), cam, *backend);
@@ -154,14 +160,10 @@ TEST_F(Streaming, ACompactPoolDrawsAsTheSceneStoredCompact) {
     // The pages packed at half precision into the pool: the image of the whole scene stored
     // compact, bit for bit (random splats: no two share a view depth).
     const t::geometry::PointCloud scene = t::io::RandomCloud(3000, 1, 7);
-    const t::geometry::SplatHierarchy hierarchy = t::geometry::BuildSplatHierarchy(scene);
-    camera::PinholeCamera cam;
-    cam.width = cam.height = 64;
-    cam.fx = cam.fy = 50.0;
-    cam.cx = cam.cy = 31.5;
-    cam.world_to_camera(2, 3) = 40.0;
+    const camera::PinholeCamera cam = RandomCloudView();
     auto backend = MakeBackend();
-    const RenderOutput streamed = StreamedImage(scene, hierarchy, 64, cam, *backend, true);
+    const RenderOutput streamed =
+        StreamedImage(scene, t::geometry::BuildSplatHierarchy(scene), 64, cam, *backend, true);
     RenderConfig compact;
     compact.compact_storage = true;
     auto plain = MakeBackend();
@@ -186,11 +188,7 @@ TEST_F(Streaming, WritesIntoAPlainSceneDrawAsTheSceneWrittenWhole) {
     const auto p = RandomCloud(500, 1, 1), q = RandomCloud(200, 1, 2), r = RandomCloud(250, 1, 3),
                u = RandomCloud(50, 1, 4);
     const auto q2 = RandomCloud(200, 1, 5), u2 = RandomCloud(50, 1, 6), u3 = RandomCloud(50, 1, 7);
-    camera::PinholeCamera cam;
-    cam.width = cam.height = 64;
-    cam.fx = cam.fy = 50.0;
-    cam.cx = cam.cy = 31.5;
-    cam.world_to_camera(2, 3) = 40.0;
+    const camera::PinholeCamera cam = RandomCloudView();
     auto written = MakeBackend();
     written->SetScene(MergeGaussianSplatClouds({&p, &q, &r, &u}));
     written->WriteSceneSplats(950, u2);
