@@ -49,13 +49,21 @@ TEST_F(LodCut, EveryLeafDrawsTheSourceSceneBitForBit) {
     through_hierarchy->SetSceneHierarchy(scene.cloud, scene.hierarchy);
     plain->SetScene(scene.cloud);
     const int64_t n = scene.cloud.NumPoints();
-    for (const uint64_t budget : {uint64_t(0), uint64_t(n), uint64_t(n) + 1000}) {
+    // At half precision too: the hierarchy's nodes are re-packed from their host copy.
+    for (const auto& [budget, compact] : {std::pair{uint64_t(0), false},
+                                          {uint64_t(n), false},
+                                          {uint64_t(n) + 1000, false},
+                                          {uint64_t(0), true},
+                                          {uint64_t(n), true}}) {
         RenderConfig config;
         config.lod_budget = budget;
+        config.compact_storage = compact;
+        RenderConfig plain_config;
+        plain_config.compact_storage = compact;
         const camera::PinholeCamera cam = scene.views.at(3).camera.Resized(96, 96);
         const RenderOutput cut = through_hierarchy->Render(cam, config);
-        const RenderOutput exact = plain->Render(cam, {});
-        SCOPED_TRACE("budget " + std::to_string(budget));
+        const RenderOutput exact = plain->Render(cam, plain_config);
+        SCOPED_TRACE("budget " + std::to_string(budget) + (compact ? " compact" : ""));
         EXPECT_EQ(cut.stats.lod_cut_nodes, n);
         EXPECT_EQ(cut.stats.num_visible, exact.stats.num_visible);
         EXPECT_EQ(cut.stats.num_tile_entries, exact.stats.num_tile_entries);
@@ -63,6 +71,10 @@ TEST_F(LodCut, EveryLeafDrawsTheSourceSceneBitForBit) {
         // the same splats, the same ties, the same floats.
         EXPECT_EQ(t::geometry::ComputeMaxAbsError(cut.color, exact.color), 0.0);
         EXPECT_EQ(t::geometry::ComputeMaxAbsError(cut.depth_expected, exact.depth_expected), 0.0);
+        if (compact) {  // really stored at half precision
+            EXPECT_GT(t::geometry::ComputeMaxAbsError(cut.color, plain->Render(cam, {}).color),
+                      0.0);
+        }
     }
 }
 
