@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -468,14 +469,14 @@ void AddLodRows(const Options& opt, const std::vector<int64_t>& budgets, const S
     // The default knob: exact order, float32 storage.
     rendering::RenderConfig config = TimedConfig(opt);
     std::vector<t::geometry::Image> exact, filtered;
-    std::vector<double> exact_filtered_psnr;
+    // --lod-supersample: the exact render against the filtered one, worst view (every row's).
+    double exact_filtered_psnr = std::numeric_limits<double>::infinity();
     for (const auto& cam : cams) {
         exact.push_back(backend.Render(cam, config).color);
         if (opt.lod_supersample > 0) {
-            const int s = opt.lod_supersample;
-            filtered.push_back(bench::FilteredReference(backend, cam, s, config));
-            exact_filtered_psnr.push_back(
-                t::geometry::ComputePSNR(exact.back(), filtered.back(), 1.0));
+            filtered.push_back(bench::FilteredReference(backend, cam, opt.lod_supersample, config));
+            exact_filtered_psnr = std::min(
+                exact_filtered_psnr, t::geometry::ComputePSNR(exact.back(), filtered.back(), 1.0));
         }
     }
     auto lod_backend = rendering::CreateGaussianSplatBackend(opt.backend);
@@ -507,6 +508,11 @@ void AddLodRows(const Options& opt, const std::vector<int64_t>& budgets, const S
         row.lod_budget = budget;
         row.lod_on_gpu = vulkan != nullptr;
         row.hierarchy_build_ms = hierarchy_ms;
+        if (opt.lod_supersample > 0) {
+            row.lod_supersample = opt.lod_supersample;
+            row.exact_filtered_psnr = exact_filtered_psnr;
+            row.lod_filtered_psnr = std::numeric_limits<double>::infinity();
+        }
         config.lod_budget = static_cast<uint64_t>(budget);
         for (size_t v = 0; v < cams.size(); ++v) {
             double scene_nodes = static_cast<double>(hierarchy.NumNodes());
@@ -532,12 +538,8 @@ void AddLodRows(const Options& opt, const std::vector<int64_t>& budgets, const S
             }
             AddViewError(row, out.color, exact[v]);
             if (opt.lod_supersample > 0) {
-                const double psnr = t::geometry::ComputePSNR(out.color, filtered[v], 1.0);
-                row.lod_filtered_psnr = v == 0 ? psnr : std::min(row.lod_filtered_psnr, psnr);
-                row.exact_filtered_psnr =
-                    v == 0 ? exact_filtered_psnr[v]
-                           : std::min(row.exact_filtered_psnr, exact_filtered_psnr[v]);
-                row.lod_supersample = opt.lod_supersample;
+                row.lod_filtered_psnr = std::min(
+                    row.lod_filtered_psnr, t::geometry::ComputePSNR(out.color, filtered[v], 1.0));
             }
             if (vulkan != nullptr && v == 0) {
                 const rendering::RenderStats after = lod_backend->Render(cams[v], config).stats;

@@ -26,6 +26,11 @@ enum class SplatPrecision {
     kCompact,
 };
 
+/// The precision RenderConfig::compact_storage (or a pool's compact_storage) asks for.
+inline SplatPrecision SplatPrecisionFor(bool compact_storage) {
+    return compact_storage ? SplatPrecision::kCompact : SplatPrecision::kExact;
+}
+
 /// Per-splat GPU attributes of one cloud, ready to upload. Shapes use splats as rows.
 struct PackedGaussianSplats {
     SplatPrecision precision = SplatPrecision::kExact;

@@ -248,14 +248,10 @@ void GaussianSplatRenderer::RenderGeometryStage(uint64_t view_id,
         if (!stream_view_) stream_view_ = view_id;
         if (*stream_view_ == view_id) stream_->SetView(camera);
     }
-    if (stream_) {
-        // The pool keeps the precision the stream was started with (no host copy to re-pack).
-        RenderConfig frame = config;
-        frame.compact_storage = stream_->CompactStorage();
-        backend_->RenderGeometryStage(camera, frame);
-    } else {
-        backend_->RenderGeometryStage(camera, config);
-    }
+    // A stream's pool keeps the precision it was started with (no host copy to re-pack).
+    RenderConfig frame = config;
+    if (stream_) frame.compact_storage = stream_->CompactStorage();
+    backend_->RenderGeometryStage(camera, frame);
     ++counters_.geometry_stages;
     current_view_ = view_id;
     has_current_view_ = true;

@@ -61,9 +61,8 @@ uint64_t ParseGpuBudget(const std::string& text) {
 }
 
 double StreamPoolBytesPerSplat(int sh_degree, bool compact_storage) {
-    const SplatPrecision precision =
-        compact_storage ? SplatPrecision::kCompact : SplatPrecision::kExact;
-    return PackedSplatLayout(sh_degree, precision).BytesPerSplat() + 1.0 / 8.0;
+    return PackedSplatLayout(sh_degree, SplatPrecisionFor(compact_storage)).BytesPerSplat() +
+           1.0 / 8.0;
 }
 
 int64_t StreamPoolPages(const t::io::SplatPageFile& file, uint64_t gpu_budget, int64_t max_splats,

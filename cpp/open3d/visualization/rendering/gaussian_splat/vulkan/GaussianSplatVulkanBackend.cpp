@@ -133,8 +133,7 @@ void GaussianSplatVulkanBackend::SetScenePool(int64_t capacity, int sh_degree,
     }
     // Allocated and zero-filled on the GPU: packing millions of placeholder splats on the
     // host took seconds before the first image.
-    PackedGaussianSplats like = PackedSplatLayout(
-        sh_degree, compact_storage ? SplatPrecision::kCompact : SplatPrecision::kExact);
+    PackedGaussianSplats like = PackedSplatLayout(sh_degree, SplatPrecisionFor(compact_storage));
     like.center_min = center_min;
     like.center_max = center_max;
     if (geometry_.in_flight) Wait(*context_, geometry_stage_fence_.Get());
@@ -362,8 +361,7 @@ void GaussianSplatVulkanBackend::RenderGeometryStage(const camera::PinholeCamera
     camera.Validate();
     config.Validate();
     const auto start = std::chrono::steady_clock::now();
-    const SplatPrecision precision =
-        config.compact_storage ? SplatPrecision::kCompact : SplatPrecision::kExact;
+    const SplatPrecision precision = SplatPrecisionFor(config.compact_storage);
     if (precision != geometry_stage_resources_.Layout().precision) {
         if (geometry_.in_flight) Wait(*context_, geometry_stage_fence_.Get());
         geometry_.in_flight = false;

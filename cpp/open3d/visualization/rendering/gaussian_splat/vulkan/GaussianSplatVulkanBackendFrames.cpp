@@ -170,8 +170,7 @@ void GaussianSplatVulkanBackend::RetireLod() {
 }
 
 void GaussianSplatVulkanBackend::EnsureScenePrecision(const RenderConfig& config) {
-    const SplatPrecision precision =
-        config.compact_storage ? SplatPrecision::kCompact : SplatPrecision::kExact;
+    const SplatPrecision precision = SplatPrecisionFor(config.compact_storage);
     if (precision == geometry_stage_resources_.Layout().precision) return;
     if (pool_scene_) {
         core::ThrowError(
