@@ -959,7 +959,8 @@ int main(int argc, char** argv) {
     app.add_option("--max-tile-entries", opt.max_tile_entries,
                    "Tile entries a frame may hold before the farthest splats' are dropped "
                    "(RenderConfig::max_tile_entries_total; default 2^26 = 67,108,864; the "
-                   "Vulkan sort takes at most 134,215,680)")
+                   "Vulkan sort takes up to the device's limit: 1,073,741,823 on an H200, "
+                   "33,554,432 on lavapipe)")
         ->check(CLI::Range(uint64_t(1), uint64_t(1) << 40));
     app.add_option("--stream", opt.stream,
                    "Write the scene's hierarchy as a paged file here, then stream it back into "

@@ -512,9 +512,77 @@ TEST_F(RadixSortTest, StorageRequirements) {
     EXPECT_TRUE(need.params_usage & VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT);
     EXPECT_GT(RadixSort::GetStorageRequirements(0).keys_alt_bytes, 0u);  // no empty buffers
     EXPECT_THROW(RadixSort::GetStorageRequirements(RadixSort::kMaxCount + 1), core::Open3DError);
+    EXPECT_NO_THROW(RadixSort::GetStorageRequirements(RadixSort::kMaxCount));
     EXPECT_EQ(RadixSort::GetNumPasses(32), 4u);
     EXPECT_EQ(RadixSort::GetNumPasses(13), 2u);
     EXPECT_EQ(RadixSort::GetNumPasses(0), 0u);
+}
+
+TEST_F(RadixSortTest, TheDeviceLimitFollowsItsDispatchAndBindingLimits) {
+    // Blocks of 2048 pairs within maxComputeWorkGroupCount[0], keys within one binding.
+    EXPECT_EQ(RadixSort::MaxCountFor(65535, uint64_t(1) << 27), 33554432u);  // lavapipe
+    EXPECT_EQ(RadixSort::MaxCountFor(65535, 0xFFFFFFFFull), 65535u * 2048u);
+    EXPECT_EQ(RadixSort::MaxCountFor(0x7FFFFFFF, 0xFFFFFFFFull), 1073741823u);  // NVIDIA
+    EXPECT_EQ(RadixSort::MaxCountFor(0x7FFFFFFF, uint64_t(1) << 40), RadixSort::kMaxCount);
+    const VulkanDeviceInfo& info = Context().GetDeviceInfo();
+    EXPECT_EQ(sort_->GetMaxCount(),
+              RadixSort::MaxCountFor(info.max_compute_workgroups_x, info.max_storage_buffer_range));
+    EXPECT_GE(info.max_compute_workgroups_x, 65535u);  // Vulkan's minimum
+}
+
+TEST_F(RadixSortTest, SortsPastTheSmallestDispatchLimitWhereTheDeviceAllows) {
+    // 65,538 blocks of 2048 pairs: more workgroups than the 65,535 every device takes, so
+    // where the device allows it (NVIDIA: 2^31 - 1 along x) the sort dispatches them; where
+    // not (lavapipe), Record refuses the count, naming the limits, before recording anything.
+    const uint32_t n = 65535u * 2048u + 4097u;
+    if (sort_->GetMaxCount() < n) {
+        Buffer buffer(Context(), 1 << 16,
+                      VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT,
+                      MemoryUsage::kDevice);
+        RadixSortScratch scratch{buffer.Range(0, 4096), buffer.Range(4096, 4096),
+                                 buffer.Range(8192, 8192), buffer.Range(16384, 256)};
+        CommandBuffer cmd = Pool().Allocate();
+        cmd.Begin();
+        try {
+            sort_->Record(cmd.Get(), buffer.Range(32768, 4096), buffer.Range(40960, 4096), scratch,
+                          buffer.Range(60000, 4), n, 32);
+            ADD_FAILURE() << "a sort of " << n << " pairs was recorded past the device's "
+                          << sort_->GetMaxCount();
+        } catch (const core::Open3DError& e) {
+            EXPECT_NE(std::string(e.what()).find("maxComputeWorkGroupCount"), std::string::npos)
+                << e.what();
+        }
+        cmd.End();
+        return;
+    }
+    // 12-bit keys (two passes) from a hash of the index, values the index: the stable order
+    // is known without sorting on the host. Keys ascend, values ascend within a key, every
+    // value keeps its own key, and each key keeps its count: a stable permutation.
+    const auto key_of = [](uint32_t i) { return (i * 2654435761u) >> 20; };
+    std::vector<uint32_t> keys(n), values(n);
+    std::vector<uint32_t> counts(1u << 12, 0u);
+    for (uint32_t i = 0; i < n; ++i) {
+        keys[i] = key_of(i);
+        values[i] = i;
+        ++counts[keys[i]];
+    }
+    const GpuSortResult result = Sort(keys, values, n, 12);
+    EXPECT_EQ(result.params.count, n);
+    EXPECT_EQ(result.params.num_blocks, 65538u);
+    std::vector<uint32_t> seen(1u << 12, 0u);
+    uint64_t wrong = 0;
+    for (uint32_t j = 0; j < n; ++j) {
+        const uint32_t key = result.keys[j], value = result.values[j];
+        bool ok = value < n && key_of(value) == key;
+        if (j > 0) {
+            const uint32_t prev_key = result.keys[j - 1];
+            ok = ok && (prev_key < key || (prev_key == key && result.values[j - 1] < value));
+        }
+        if (key < seen.size()) ++seen[key];
+        wrong += ok ? 0 : 1;
+    }
+    EXPECT_EQ(wrong, 0u);
+    EXPECT_TRUE(seen == counts);
 }
 
 TEST_F(RadixSortTest, RejectsMisuse) {

@@ -202,19 +202,22 @@ TEST_F(VulkanBackend, EntryBuffersGrowInsteadOfDroppingEntries) {
 }
 
 TEST_F(VulkanBackend, EntryCapacityStopsAtTheSortLimit) {
-    // The config's limit binds below the sort's; above it, RadixSort::kMaxCount does (the scan
-    // saturates later), and geometry stage accepts exactly that capacity.
+    // The config's limit binds below the sort's; above it, the device's sort limit does (the
+    // scan saturates later), and geometry stage accepts exactly that capacity.
+    auto backend = MakeBackend();
+    const uint32_t sort_limit = backend->SortMaxCount();
+    const vulkan::VulkanDeviceInfo& info = backend->GetContext().GetDeviceInfo();
+    EXPECT_EQ(sort_limit, vulkan::RadixSort::MaxCountFor(info.max_compute_workgroups_x,
+                                                         info.max_storage_buffer_range));
     RenderConfig config;
     config.max_tile_entries_total = 1000;
-    EXPECT_EQ(GaussianSplatVulkanBackend::MaxEntryCapacity(config), 1000u);
+    EXPECT_EQ(GaussianSplatVulkanBackend::MaxEntryCapacity(config, sort_limit), 1000u);
     static_assert(vulkan::RadixSort::kMaxCount < shader::kScanSaturation - 1);
-    for (uint64_t total : {uint64_t(vulkan::RadixSort::kMaxCount),
-                           uint64_t(vulkan::RadixSort::kMaxCount) + 1, uint64_t(1) << 40}) {
+    for (uint64_t total : {uint64_t(sort_limit), uint64_t(sort_limit) + 1, uint64_t(1) << 40}) {
         config.max_tile_entries_total = total;
-        EXPECT_EQ(GaussianSplatVulkanBackend::MaxEntryCapacity(config),
-                  vulkan::RadixSort::kMaxCount);
+        EXPECT_EQ(GaussianSplatVulkanBackend::MaxEntryCapacity(config, sort_limit), sort_limit);
     }
-    const uint32_t bound = GaussianSplatVulkanBackend::MaxEntryCapacity(config);
+    const uint32_t bound = vulkan::RadixSort::kMaxCount;
     EXPECT_NO_THROW(vulkan::GaussianGeometryStage::GetStorageRequirements(1000, bound));
     EXPECT_NO_THROW(vulkan::RadixSort::GetStorageRequirements(bound));
     EXPECT_THROW(vulkan::GaussianGeometryStage::GetStorageRequirements(1000, bound + 1),

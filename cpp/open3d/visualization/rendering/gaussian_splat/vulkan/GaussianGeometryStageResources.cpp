@@ -5,8 +5,10 @@
 #include <cstring>
 #include <limits>
 
+#include "GaussianSplatProjectionContract.h"
 #include "open3d/core/Exception.h"
 #include "open3d/core/ParallelFor.h"
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/RadixSort.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/VulkanContext.h"
 
 namespace open3d {
@@ -264,6 +266,27 @@ void GeometryStageViewResources::Allocate(const VulkanContext& context, uint32_t
         core::ThrowError("GeometryStageViewResources: {} inner nodes of {} nodes", *lod_inner, n);
     }
     const uint32_t slots = lod_inner ? n - *lod_inner : n;
+    // The depth sort takes the slots, the tile sort the entries: both within what this
+    // device's dispatches and bindings reach (1.07G pairs on an H200, 33.5M on lavapipe).
+    const VulkanDeviceInfo& info = context.GetDeviceInfo();
+    const uint32_t sort_limit =
+        RadixSort::MaxCountFor(info.max_compute_workgroups_x, info.max_storage_buffer_range);
+    if (slots > sort_limit || entry_capacity > sort_limit) {
+        core::ThrowError(
+            "GeometryStageViewResources: {} slots / {} tile entries exceed the sort limit of "
+            "this device, {} pairs (maxComputeWorkGroupCount[0] {}, maxStorageBufferRange {} "
+            "bytes)",
+            slots, entry_capacity, sort_limit, info.max_compute_workgroups_x,
+            info.max_storage_buffer_range);
+    }
+    // The projection, the emit and the cut's passes run an invocation per splat or node, in
+    // workgroups of 256 along x.
+    if (uint64_t(n) > uint64_t(info.max_compute_workgroups_x) * shader::kProjectWorkgroupSize) {
+        core::ThrowError(
+            "GeometryStageViewResources: {} splats or nodes need more than the {} workgroups "
+            "of {} invocations one dispatch of this device holds (maxComputeWorkGroupCount[0])",
+            n, info.max_compute_workgroups_x, shader::kProjectWorkgroupSize);
+    }
     const GeometryStageStorageRequirements need =
         GaussianGeometryStage::GetStorageRequirements(slots, entry_capacity);
     const auto make = [&](VkDeviceSize bytes, VkBufferUsageFlags usage) {

@@ -10,6 +10,7 @@
 #include <utility>
 #include <vector>
 
+#include "GaussianSplatProjectionContract.h"
 #include "open3d/core/Exception.h"
 #include "open3d/core/HostMemory.h"
 #include "open3d/core/Logging.h"
@@ -56,9 +57,15 @@ void GaussianSplatVulkanBackend::WarnNewFlags(uint32_t flags) {
     warned_flags_ |= flags;
 }
 
-uint32_t GaussianSplatVulkanBackend::MaxEntryCapacity(const RenderConfig& config) {
+uint32_t GaussianSplatVulkanBackend::MaxEntryCapacity(const RenderConfig& config,
+                                                      uint32_t sort_max_count) {
     return static_cast<uint32_t>(std::min<uint64_t>(
-        {config.max_tile_entries_total, shader::kScanSaturation - 1, RadixSort::kMaxCount}));
+        {config.max_tile_entries_total, shader::kScanSaturation - 1, sort_max_count}));
+}
+
+uint32_t GaussianSplatVulkanBackend::SortMaxCount() const {
+    const VulkanDeviceInfo& info = context_->GetDeviceInfo();
+    return RadixSort::MaxCountFor(info.max_compute_workgroups_x, info.max_storage_buffer_range);
 }
 
 GaussianSplatVulkanBackend::GaussianSplatVulkanBackend(std::unique_ptr<VulkanContext> context,
@@ -101,12 +108,12 @@ void GaussianSplatVulkanBackend::SetSceneHierarchy(const t::geometry::PointCloud
     source.ValidateGaussianSplat();
     // Every pass after the cut runs over its list, at most a slot per leaf; the cut's own
     // passes index nodes with 32-bit integers. Refused before the nodes are gathered.
-    if (hierarchy.num_leaves > int64_t(RadixSort::kMaxCount) ||
+    if (hierarchy.num_leaves > int64_t(SortMaxCount()) ||
         hierarchy.NumNodes() > int64_t(INT32_MAX)) {
         core::ThrowError(
             "Vulkan backend: a hierarchy of {} nodes ({} splats + {} inner) exceeds the {} "
-            "splats the depth sort takes or the {} nodes the cut indexes",
-            hierarchy.NumNodes(), hierarchy.num_leaves, hierarchy.NumInner(), RadixSort::kMaxCount,
+            "splats the depth sort takes on this device or the {} nodes the cut indexes",
+            hierarchy.NumNodes(), hierarchy.num_leaves, hierarchy.NumInner(), SortMaxCount(),
             INT32_MAX);
     }
     const PackedLodNodes lod = PackLodNodes(hierarchy);
@@ -209,7 +216,12 @@ void GaussianSplatVulkanBackend::WriteSceneSplatRanges(
 }
 
 int64_t GaussianSplatVulkanBackend::MaxSceneSplats() const {
-    return static_cast<int64_t>(context_->GetDeviceInfo().max_storage_buffer_range / 16);
+    // The positions' binding (16 bytes a splat), the depth sort over a slot per splat, and
+    // the projection's workgroups of 256 along x in one dispatch.
+    const VulkanDeviceInfo& info = context_->GetDeviceInfo();
+    return static_cast<int64_t>(std::min<uint64_t>(
+        {info.max_storage_buffer_range / 16, SortMaxCount(),
+         uint64_t(info.max_compute_workgroups_x) * shader::kProjectWorkgroupSize}));
 }
 
 void GaussianSplatVulkanBackend::ApplyStreamStep(const SplatStreamStep& step) {
@@ -378,7 +390,7 @@ void GaussianSplatVulkanBackend::RenderGeometryStage(const camera::PinholeCamera
     CheckViewFits(static_cast<uint32_t>(camera.width), static_cast<uint32_t>(camera.height));
 
     EnsureViewBuffers(static_cast<uint32_t>(
-        std::min<uint64_t>(MaxEntryCapacity(config), initial_entry_capacity_)));
+        std::min<uint64_t>(MaxEntryCapacity(config, SortMaxCount()), initial_entry_capacity_)));
 
     const PackedView view = geometry_stage_resources_.ViewParams(camera, config);
 
@@ -669,7 +681,7 @@ RenderStats GaussianSplatVulkanBackend::RenderComposite(CompositeSink& sink) {
     // The allocation, not the config, cut this frame short: grow the entry buffers to what
     // it asked for (plus a quarter, so a moving camera does not regrow every frame) and
     // render it again. Geometry stage reported the full request, so one retry suffices.
-    const uint64_t limit = MaxEntryCapacity(geometry_.config);
+    const uint64_t limit = MaxEntryCapacity(geometry_.config, SortMaxCount());
     if ((gpu_counters.error_flags & kCountsClamped) &&
         geometry_stage_resources_.EntryCapacity() < limit && !growing_) {
         const uint64_t asked = gpu_counters.requested_entries;

@@ -170,9 +170,12 @@ public:
     }
 
     /// The most tile entries a frame of `config` may allocate: what the config allows, within
-    /// what the scan (saturating at shader::kScanSaturation) and the sorts
-    /// (RadixSort::kMaxCount) address. Entry buffers never grow past it.
-    static uint32_t MaxEntryCapacity(const RenderConfig& config);
+    /// what the scan (saturating at shader::kScanSaturation) and the sorts (`sort_max_count`:
+    /// SortMaxCount) address. Entry buffers never grow past it.
+    static uint32_t MaxEntryCapacity(const RenderConfig& config, uint32_t sort_max_count);
+    /// The most pairs this device's sorts take (RadixSort::MaxCountFor): 1,073,741,823 on an
+    /// H200, 33,554,432 on lavapipe.
+    uint32_t SortMaxCount() const;
 
     /// Counters that make the skips visible to tests and benchmarks.
     struct Counters {

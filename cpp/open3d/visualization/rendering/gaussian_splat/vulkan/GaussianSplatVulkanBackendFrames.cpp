@@ -577,10 +577,11 @@ uint64_t GaussianSplatVulkanBackend::SubmitBatch(const std::vector<camera::Pinho
     ReleaseUnusedImports();
     const uint32_t n = static_cast<uint32_t>(geometry_stage_resources_.Layout().num_splats);
     // A slot keeps the capacity it grew to for this scene.
-    const uint32_t capacity = slot.view && slot.view.NumSplats() == n
-                                  ? slot.view.EntryCapacity()
-                                  : static_cast<uint32_t>(std::min<uint64_t>(
-                                        MaxEntryCapacity(config), initial_entry_capacity_));
+    const uint32_t capacity =
+        slot.view && slot.view.NumSplats() == n
+            ? slot.view.EntryCapacity()
+            : static_cast<uint32_t>(std::min<uint64_t>(MaxEntryCapacity(config, SortMaxCount()),
+                                                       initial_entry_capacity_));
     FrameRecordingKey key = MakeKey(cameras, config, options, capacity);
     const VkDeviceSize color_bytes = VkDeviceSize(w) * h * ColorBytesPerPixel(options);
     uint8_t* const destination =
@@ -653,7 +654,7 @@ std::vector<RenderOutput> GaussianSplatVulkanBackend::WaitBatch(uint64_t ticket)
     // The allocation, not the config, cut a view short: grow the entry buffers to what the
     // largest view asked for (plus a quarter) and render the batch again, once (the geometry
     // stage reports the full request).
-    const uint64_t limit = MaxEntryCapacity(slot.config);
+    const uint64_t limit = MaxEntryCapacity(slot.config, SortMaxCount());
     uint64_t asked = 0;
     for (size_t i = 0; i < views; ++i) {
         const GaussianGeometryStageCounters c = counters_of(i);

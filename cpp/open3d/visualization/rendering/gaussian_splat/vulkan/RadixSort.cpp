@@ -22,8 +22,9 @@ using namespace shader;  // the contract's constants and structs
 
 static_assert(kErrorEntriesDropped == rendering::kEntriesDropped);
 static_assert(kErrorCountsClamped == rendering::kCountsClamped);
-static_assert(RadixSort::kMaxCount / kRadixSortBlockSize <= 65535u,
-              "blocks of the largest sort fit one dispatch (maxComputeWorkGroupCount >= 65535)");
+static_assert(uint64_t(kRadixSortBins) * (RadixSort::kMaxCount / kRadixSortBlockSize + 1) <
+                  (uint64_t(1) << 31),
+              "histogram indices of the largest sort fit a uint");
 static_assert(offsetof(RadixSortParams, dispatch_x) == offsetof(VkDispatchIndirectCommand, x) &&
                   offsetof(RadixSortParams, dispatch_z) == offsetof(VkDispatchIndirectCommand, z),
               "params start with the indirect dispatch arguments");
@@ -91,6 +92,20 @@ RadixSort::RadixSort(const VulkanContext& context) : context_(&context) {
     copy_ = create(spirv::kRadixSortCopy, "radix_sort_copy");
 }
 
+uint32_t RadixSort::MaxCountFor(uint32_t max_workgroups_x, uint64_t max_storage_buffer_range) {
+    // A large sort's blocks hold kRadixSortBlockSize pairs, one workgroup each (MaxBlocks).
+    const uint64_t by_dispatch = uint64_t(max_workgroups_x) * kRadixSortBlockSize;
+    // Keys and values are bound whole. The histogram, 1 + blocks uints per digit, takes about
+    // half a byte per pair, so it never binds first.
+    const uint64_t by_keys = max_storage_buffer_range / 4;
+    return static_cast<uint32_t>(std::min<uint64_t>({by_dispatch, by_keys, kMaxCount}));
+}
+
+uint32_t RadixSort::GetMaxCount() const {
+    const VulkanDeviceInfo& info = context_->GetDeviceInfo();
+    return MaxCountFor(info.max_compute_workgroups_x, info.max_storage_buffer_range);
+}
+
 RadixSortStorageRequirements RadixSort::GetStorageRequirements(uint32_t max_count) {
     if (max_count > kMaxCount) {
         core::ThrowError("RadixSort: max_count {} exceeds the supported {}", max_count, kMaxCount);
@@ -119,6 +134,14 @@ void RadixSort::CheckArguments(const BufferRange& keys, const BufferRange& value
                                const RadixSortScratch& scratch, const BufferRange& count,
                                uint32_t max_count, uint32_t num_bits) const {
     if (num_bits > 32) core::ThrowError("RadixSort: num_bits is {}, at most 32", num_bits);
+    if (max_count > GetMaxCount()) {
+        const VulkanDeviceInfo& info = context_->GetDeviceInfo();
+        core::ThrowError(
+            "RadixSort: max_count {} exceeds the {} pairs {} sorts (maxComputeWorkGroupCount[0] "
+            "{}, maxStorageBufferRange {} bytes)",
+            max_count, GetMaxCount(), info.name, info.max_compute_workgroups_x,
+            info.max_storage_buffer_range);
+    }
     const RadixSortStorageRequirements need = GetStorageRequirements(max_count);
     const VkDeviceSize alignment = context_->GetDeviceInfo().min_storage_buffer_offset_alignment;
     struct Check {

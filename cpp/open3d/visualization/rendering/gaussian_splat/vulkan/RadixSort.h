@@ -52,15 +52,24 @@ struct RadixSortScratch {
 
 class RadixSort {
 public:
-    /// Largest max_count: ceil(max_count / kRadixSortBlockSize) workgroups must fit one
-    /// dispatch (maxComputeWorkGroupCount >= 65535).
-    static constexpr uint32_t kMaxCount = 65535u * 2048u;
+    /// Largest max_count on any device: the sort's uint arithmetic (element and histogram
+    /// indices, RadixSortParamsFor) stays below 2^31. A device takes at most GetMaxCount().
+    static constexpr uint32_t kMaxCount = 1u << 30;
+    /// Largest max_count of a device with the given limits: ceil(max_count /
+    /// kRadixSortBlockSize) workgroups within maxComputeWorkGroupCount[0] (65535 on lavapipe,
+    /// 2^31 - 1 on NVIDIA: 134,215,680 or kMaxCount), the keys and values within one storage
+    /// binding (maxStorageBufferRange: 2^27 bytes on lavapipe, 2^32 - 1 on NVIDIA), and at
+    /// most kMaxCount.
+    static uint32_t MaxCountFor(uint32_t max_workgroups_x, uint64_t max_storage_buffer_range);
+    /// MaxCountFor this device: 33,554,431 pairs on lavapipe, 1,073,741,823 on an H200.
+    uint32_t GetMaxCount() const;
 
     /// Creates the pipelines. Throws core::Open3DError when the device's subgroups can be
     /// smaller than 4 invocations (the shaders size shared arrays by subgroup count).
     explicit RadixSort(const VulkanContext& context);
 
-    /// Scratch sizes for up to `max_count` pairs. Throws when max_count > kMaxCount.
+    /// Scratch sizes for up to `max_count` pairs. Throws when max_count > kMaxCount (Record
+    /// checks the device's GetMaxCount).
     static RadixSortStorageRequirements GetStorageRequirements(uint32_t max_count);
     /// Passes for `num_bits` key bits: ceil(num_bits / 8).
     static uint32_t GetNumPasses(uint32_t num_bits) { return (num_bits + 7u) / 8u; }
@@ -122,7 +131,8 @@ public:
     /// count visible to COMPUTE_SHADER reads (and orders earlier uses of the scratch);
     /// after it, results are COMPUTE_SHADER storage writes for the caller to barrier.
     /// `keys`/`values` offsets must be multiples of minStorageBufferOffsetAlignment;
-    /// `count` only needs 4-byte alignment. Throws core::Open3DError on misuse.
+    /// `count` only needs 4-byte alignment. Throws core::Open3DError on misuse, and for a
+    /// max_count above GetMaxCount().
     void Record(VkCommandBuffer cmd,
                 const BufferRange& keys,    // uint32 [max_count], sorted in place
                 const BufferRange& values,  // uint32 [max_count], permuted with keys

@@ -424,6 +424,7 @@ void VulkanContext::InitDevice(VkPhysicalDevice physical_device, uint32_t queue_
     info_.max_compute_shared_memory = properties.limits.maxComputeSharedMemorySize;
     info_.min_storage_buffer_offset_alignment = properties.limits.minStorageBufferOffsetAlignment;
     info_.max_storage_buffer_range = properties.limits.maxStorageBufferRange;
+    info_.max_compute_workgroups_x = properties.limits.maxComputeWorkGroupCount[0];
     const auto& family = query.queue_families[queue_family_index];
     info_.timestamp_period_ns =
         family.timestampValidBits > 0 ? properties.limits.timestampPeriod : 0.0f;

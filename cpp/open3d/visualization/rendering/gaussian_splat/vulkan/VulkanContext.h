@@ -69,7 +69,8 @@ struct VulkanDeviceInfo {
     uint32_t max_compute_shared_memory = 0;  ///< bytes per workgroup
     uint64_t min_storage_buffer_offset_alignment = 0;  ///< bytes
     uint64_t max_storage_buffer_range = 0;             ///< bytes one storage binding may span
-    float timestamp_period_ns = 0.0f;                  ///< 0 when timestamps are unsupported
+    uint32_t max_compute_workgroups_x = 0;  ///< maxComputeWorkGroupCount[0] of one dispatch
+    float timestamp_period_ns = 0.0f;       ///< 0 when timestamps are unsupported
     uint32_t queue_family_index = 0;
     /// VkPhysicalDeviceIDProperties: another API (GL) sharing memory with this device must
     /// report the same UUIDs.
