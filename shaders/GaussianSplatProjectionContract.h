@@ -45,33 +45,35 @@ OPEN3D_SHADER_CONST uint kSpecIndexedList = 3u;
 OPEN3D_SHADER_CONST uint kSpecCutList = 4u;
 
 // Descriptor set 0 of every geometry stage projection pipeline (one push-descriptor layout; each
-// shader declares only the bindings it uses). The shape and SH words and the projected records
-// are not bound: they are read through device addresses (GaussianGeometryAddresses).
-OPEN3D_SHADER_CONST uint kGeometryStageViewBinding = 0u;       // GaussianViewParams
-OPEN3D_SHADER_CONST uint kGeometryStagePositionsBinding = 1u;  // vec4[N]: xyz, sigmoid(opacity)
+// shader declares only the bindings it uses). The positions, the shape and SH words and the
+// projected records are not bound: they are read through device addresses
+// (GaussianGeometryAddresses). What is bound takes at most 4 bytes a splat or entry, within one
+// binding up to the sort's own limit (RadixSort::MaxCountFor).
+OPEN3D_SHADER_CONST uint kGeometryStageViewBinding = 0u;  // GaussianViewParams
 // uint[ceil(N / 32)], bit i = splat i; with kSpecCutList, uint[N]: the cut's nodes.
-OPEN3D_SHADER_CONST uint kGeometryStageVisibilityBinding = 2u;
-OPEN3D_SHADER_CONST uint kGeometryStageCountersBinding = 3u;     // GaussianGeometryStageCounters
-OPEN3D_SHADER_CONST uint kGeometryStageDepthKeysBinding = 4u;    // uint[N]: visible depth keys
-OPEN3D_SHADER_CONST uint kGeometryStageSplatIndexBinding = 5u;   // uint[N]: visible splat indices
-OPEN3D_SHADER_CONST uint kGeometryStageScanBinding = 6u;         // uint[scan words]: all levels
-OPEN3D_SHADER_CONST uint kGeometryStageEntryKeysBinding = 7u;    // uint[capacity]: tile index
-OPEN3D_SHADER_CONST uint kGeometryStageEntryValuesBinding = 8u;  // uint[capacity]: splat index
-OPEN3D_SHADER_CONST uint kGeometryStageSortParamsBinding = 9u;   // RadixSortParams of the next sort
-OPEN3D_SHADER_CONST uint kGeometryStageTileCountsBinding = 10u;  // uint[N]: tiles of splat i
-OPEN3D_SHADER_CONST uint kGeometryStageNumBindings = 11u;
+OPEN3D_SHADER_CONST uint kGeometryStageVisibilityBinding = 1u;
+OPEN3D_SHADER_CONST uint kGeometryStageCountersBinding = 2u;     // GaussianGeometryStageCounters
+OPEN3D_SHADER_CONST uint kGeometryStageDepthKeysBinding = 3u;    // uint[N]: visible depth keys
+OPEN3D_SHADER_CONST uint kGeometryStageSplatIndexBinding = 4u;   // uint[N]: visible splat indices
+OPEN3D_SHADER_CONST uint kGeometryStageScanBinding = 5u;         // uint[scan words]: all levels
+OPEN3D_SHADER_CONST uint kGeometryStageEntryKeysBinding = 6u;    // uint[capacity]: tile index
+OPEN3D_SHADER_CONST uint kGeometryStageEntryValuesBinding = 7u;  // uint[capacity]: splat index
+OPEN3D_SHADER_CONST uint kGeometryStageSortParamsBinding = 8u;   // RadixSortParams of the next sort
+OPEN3D_SHADER_CONST uint kGeometryStageTileCountsBinding = 9u;   // uint[N]: tiles of splat i
+OPEN3D_SHADER_CONST uint kGeometryStageNumBindings = 10u;
 
 // The buffers a splat count can grow past the range one storage binding reaches
 // (maxStorageBufferRange: 4 GiB on NVIDIA, 128 MiB on lavapipe; 98M splats of degree 3 have
-// 9.4 GB of SH words), as device addresses split into low and high words: the projection
-// reads the shape and SH words and writes the projected records, the emit reads those. They
-// sit in the geometry stage's push constants at kGeometryAddressesPushOffset, after the
-// scan's and the dispatch-args pass's constants, and are pushed with the bindings.
+// 9.4 GB of SH words, 268M splats 4 GiB of positions), as device addresses split into low and
+// high words: the projection reads the positions, shape and SH words and writes the projected
+// records, the emit reads those. They sit in the geometry stage's push constants at
+// kGeometryAddressesPushOffset, after the scan's and the dispatch-args pass's constants, and
+// are pushed with the bindings.
 struct GaussianGeometryAddresses {
     uint shape_lo, shape_hi;          // uint[N * shape words]
     uint sh_lo, sh_hi;                // uint[N * sh words]; unread at degree 0
     uint projected_lo, projected_hi;  // GaussianProjectedSplat[N]
-    uint reserved0, reserved1;
+    uint positions_lo, positions_hi;  // vec4[N]: xyz, sigmoid(opacity)
 };
 OPEN3D_SHADER_CONST uint kGeometryAddressesPushOffset = 32u;
 
@@ -219,6 +221,7 @@ static_assert(offsetof(GaussianViewParams, guard_center_y) == 188);
 static_assert(sizeof(GaussianGeometryAddresses) == 32);
 static_assert(offsetof(GaussianGeometryAddresses, sh_lo) == 8);
 static_assert(offsetof(GaussianGeometryAddresses, projected_lo) == 16);
+static_assert(offsetof(GaussianGeometryAddresses, positions_lo) == 24);
 
 static_assert(sizeof(GaussianProjectedSplat) == kProjectedSplatBytes);
 static_assert(offsetof(GaussianProjectedSplat, center_x) == 0);

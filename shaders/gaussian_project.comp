@@ -28,10 +28,7 @@ layout(constant_id = kSpecCutList) const uint kCutList = 0u;
 layout(std430, set = 0, binding = kGeometryStageViewBinding) readonly buffer ViewBlock {
     GaussianViewParams view;
 };
-layout(std430, set = 0, binding = kGeometryStagePositionsBinding) readonly buffer PositionsBlock {
-    vec4 positions[];  // xyz, sigmoid(opacity)
-};
-// The shape and SH words through their device addresses, as uint, uvec2 and uvec4: a warp's
+// The positions (xyz, sigmoid(opacity)) and the shape and SH words through their device addresses, as uint, uvec2 and uvec4: a warp's
 // scalar loads at a 40- or 96-byte stride touch 32 sectors per instruction, so the aligned
 // layouts are read in wider loads.
 layout(push_constant, std430) uniform AddressesBlock {
@@ -207,7 +204,9 @@ uint TileBound(float v, uint tiles) {
 bool Project(uint i, uint slot, out float depth, out uint entries) {
     depth = 0.0;
     if (kCutList == 0u && (visibility[i >> 5u] & (1u << (i & 31u))) == 0u) return false;
-    vec4 position_opacity = positions[i];
+    vec4 position_opacity = uintBitsToFloat(
+        Words4(RecordAddress(DeviceAddress(addresses.positions_lo, addresses.positions_hi), i, 16u))
+            .words[0]);
     vec3 p = position_opacity.xyz;
     // Camera-relative (p - c_hi) - c_lo: precise 1e5 from the origin too (GaussianSplatShared.h).
     vec3 c_hi = view.center_high;

@@ -21,7 +21,7 @@ namespace rendering {
 struct SplatStreamOptions {
     /// GPU memory of the pool in bytes (packed exact splats and their visibility bits): the
     /// pool holds as many whole pages as fit (at least one, at most the file's). 0: 1 GiB, or as
-    /// many pages as the backend holds in one scene where that is less (lavapipe: 8.4M splats).
+    /// many pages as the backend holds in one scene where that is less (lavapipe: 16.7M splats).
     uint64_t gpu_budget = 0;
     /// Nodes a cut may draw; 0: as many as the pool holds (a budget that cannot bind).
     int64_t splat_budget = 0;

@@ -124,18 +124,16 @@ void GaussianGeometryStage::PushBindings(VkCommandBuffer cmd,
                                          const GeometryStageSceneBuffers& scene,
                                          const GeometryStageViewBuffers& buffers) const {
     const std::array<const BufferRange*, kGeometryStageNumBindings> ranges{
-        &buffers.view_params,  &scene.positions,
-        &scene.visibility,     &buffers.counters,
-        &buffers.depth_keys,   &buffers.splat_indices,
-        &buffers.scan,         &buffers.entry_keys,
-        &buffers.entry_values, &buffers.sort_scratch.params,
+        &buffers.view_params, &scene.visibility,      &buffers.counters,
+        &buffers.depth_keys,  &buffers.splat_indices, &buffers.scan,
+        &buffers.entry_keys,  &buffers.entry_values,  &buffers.sort_scratch.params,
         &buffers.tile_counts};
-    static_assert(kGeometryStageViewBinding == 0 && kGeometryStagePositionsBinding == 1 &&
-                      kGeometryStageVisibilityBinding == 2 && kGeometryStageCountersBinding == 3 &&
-                      kGeometryStageDepthKeysBinding == 4 && kGeometryStageSplatIndexBinding == 5 &&
-                      kGeometryStageScanBinding == 6 && kGeometryStageEntryKeysBinding == 7 &&
-                      kGeometryStageEntryValuesBinding == 8 &&
-                      kGeometryStageSortParamsBinding == 9 && kGeometryStageTileCountsBinding == 10,
+    static_assert(kGeometryStageViewBinding == 0 && kGeometryStageVisibilityBinding == 1 &&
+                      kGeometryStageCountersBinding == 2 && kGeometryStageDepthKeysBinding == 3 &&
+                      kGeometryStageSplatIndexBinding == 4 && kGeometryStageScanBinding == 5 &&
+                      kGeometryStageEntryKeysBinding == 6 &&
+                      kGeometryStageEntryValuesBinding == 7 &&
+                      kGeometryStageSortParamsBinding == 8 && kGeometryStageTileCountsBinding == 9,
                   "ranges above are listed in binding order");
     std::array<VkDescriptorBufferInfo, kGeometryStageNumBindings> infos{};
     std::array<VkWriteDescriptorSet, kGeometryStageNumBindings> writes{};
@@ -158,8 +156,10 @@ void GaussianGeometryStage::PushBindings(VkCommandBuffer cmd,
     const auto sh = DeviceAddressWords(scene.sh, "GaussianGeometryStage: the SH words");
     const auto projected =
         DeviceAddressWords(buffers.projected, "GaussianGeometryStage: the projected records");
-    const GaussianGeometryAddresses addresses{shape[0],     shape[1],     sh[0], sh[1],
-                                              projected[0], projected[1], 0u,    0u};
+    const auto positions =
+        DeviceAddressWords(scene.positions, "GaussianGeometryStage: the positions");
+    const GaussianGeometryAddresses addresses{
+        shape[0], shape[1], sh[0], sh[1], projected[0], projected[1], positions[0], positions[1]};
     vkCmdPushConstants(cmd, pipeline_layout_.Get(), VK_SHADER_STAGE_COMPUTE_BIT,
                        kGeometryAddressesPushOffset, sizeof(addresses), &addresses);
 }

@@ -74,13 +74,11 @@ Buffer UploadStorageBuffer(const VulkanContext& context, const CommandPool& pool
 
 void GeometryStageResources::UploadScene(const VulkanContext& context, const CommandPool& pool,
                                          const PackedGaussianSplats& packed) {
-    // The positions (16 bytes a splat) are bound: 268M splats on a 4 GiB binding. The shape
-    // and SH words (up to 136 bytes a splat) are read by device address and have no such
-    // limit.
-    const uint64_t n = packed.num_splats;
-    RequireStorageBinding(context, "positions", packed.positions.size() * sizeof(float), n);
+    // The positions, shape and SH words are read by device address, so no binding's range
+    // limits the splats (a hierarchy's cut binds its nodes' positions: UploadLod checks its
+    // nodes, 16 bytes each as a position). The visibility mask (4 bytes per 32 splats) is bound.
     positions = UploadStorageBuffer(context, pool, packed.positions.data(),
-                                    packed.positions.size() * sizeof(float));
+                                    packed.positions.size() * sizeof(float), kAddressed);
     shape = UploadStorageBuffer(context, pool, packed.shape.data(), packed.shape.size() * 4,
                                 kAddressed);
     sh = UploadStorageBuffer(context, pool, packed.sh.data(), packed.sh.size() * 4, kAddressed);
@@ -117,10 +115,9 @@ void GeometryStageResources::AllocateScene(const VulkanContext& context, const C
         });
         return device;
     };
-    RequireStorageBinding(context, "positions", n * 4 * sizeof(float), n);
     const VkDeviceSize visibility_bytes = (n + 31) / 32 * 4;
     RequireStorageBinding(context, "visibility", visibility_bytes, n);
-    positions = zeroed(n * 4 * sizeof(float), 0);
+    positions = zeroed(n * 4 * sizeof(float), kAddressed);
     shape = zeroed(n * like.shape_words_per_splat * 4, kAddressed);
     sh = zeroed(n * like.sh_words_per_splat * 4, kAddressed);
     visibility = zeroed(visibility_bytes, 0);
@@ -222,6 +219,9 @@ void GeometryStageResources::UploadLod(const VulkanContext& context, const Comma
     const VkDeviceSize previous_offset =
         (children_offset + children_bytes + alignment - 1) / alignment * alignment;
     RequireStorageBinding(context, "hierarchy nodes", node_bytes, lod.nodes.size());
+    // The cut binds the nodes' positions too (the projection reads them by address).
+    RequireStorageBinding(context, "positions of the hierarchy's nodes",
+                          VkDeviceSize(layout_.num_splats) * 4 * sizeof(float), lod.nodes.size());
     RequireStorageBinding(context, "hierarchy children", children_bytes, lod.nodes.size());
     lod_nodes = UploadStorageBuffer(context, pool, previous_offset + 4, [&](uint8_t* staging) {
         std::memcpy(staging, lod.nodes.data(), node_bytes);

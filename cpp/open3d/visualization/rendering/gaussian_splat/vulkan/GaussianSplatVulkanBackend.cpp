@@ -216,12 +216,12 @@ void GaussianSplatVulkanBackend::WriteSceneSplatRanges(
 }
 
 int64_t GaussianSplatVulkanBackend::MaxSceneSplats() const {
-    // The positions' binding (16 bytes a splat), the depth sort over a slot per splat, and
-    // the projection's workgroups of 256 along x in one dispatch.
+    // The depth sort over a slot per splat (its keys and the other per-splat words within one
+    // binding), and the projection's workgroups of 256 along x in one dispatch; the splats'
+    // own words are read by device address.
     const VulkanDeviceInfo& info = context_->GetDeviceInfo();
     return static_cast<int64_t>(std::min<uint64_t>(
-        {info.max_storage_buffer_range / 16, SortMaxCount(),
-         uint64_t(info.max_compute_workgroups_x) * shader::kProjectWorkgroupSize}));
+        SortMaxCount(), uint64_t(info.max_compute_workgroups_x) * shader::kProjectWorkgroupSize));
 }
 
 void GaussianSplatVulkanBackend::ApplyStreamStep(const SplatStreamStep& step) {

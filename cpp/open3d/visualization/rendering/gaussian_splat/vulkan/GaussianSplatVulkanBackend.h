@@ -158,8 +158,9 @@ public:
 
     /// Writes a SplatStreamer step's pages into the pool and shows its cut.
     void ApplyStreamStep(const SplatStreamStep& step) override;
-    /// The positions (16 bytes a splat) are one storage binding: maxStorageBufferRange / 16
-    /// (8.4M splats on lavapipe's 128 MiB, 268M on a 4 GiB range).
+    /// The most splats a scene may have here: what the depth sort takes (SortMaxCount) and the
+    /// projection dispatches, an invocation a splat (16.7M on lavapipe: 65,535 workgroups of
+    /// 256; 1.07G on an H200). The splats' own words are read by device address.
     int64_t MaxSceneSplats() const override;
 
     /// Replaces the visibility mask: bit i of word i / 32 shows splat i ([ceil(N / 32)]).
