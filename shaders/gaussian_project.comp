@@ -28,9 +28,9 @@ layout(constant_id = kSpecCutList) const uint kCutList = 0u;
 layout(std430, set = 0, binding = kGeometryStageViewBinding) readonly buffer ViewBlock {
     GaussianViewParams view;
 };
-// The positions (xyz, sigmoid(opacity)) and the shape and SH words through their device addresses, as uint, uvec2 and uvec4: a warp's
-// scalar loads at a 40- or 96-byte stride touch 32 sectors per instruction, so the aligned
-// layouts are read in wider loads.
+// The positions (xyz, sigmoid(opacity)) and the shape and SH words through their device
+// addresses, as uint, uvec2 and uvec4: a warp's scalar loads at a 40- or 96-byte stride touch
+// 32 sectors per instruction, so the aligned layouts are read in wider loads.
 layout(push_constant, std430) uniform AddressesBlock {
     layout(offset = kGeometryAddressesPushOffset) GaussianGeometryAddresses addresses;
 };
