@@ -46,6 +46,10 @@ constexpr VkBufferUsageFlags kAddressed = VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_
 
 }  // namespace
 
+uint64_t MaxSplatsPerDispatch(const VulkanDeviceInfo& info) {
+    return uint64_t(info.max_compute_workgroups_x) * shader::kProjectWorkgroupSize;
+}
+
 Buffer UploadStorageBuffer(const VulkanContext& context, const CommandPool& pool, const void* data,
                            VkDeviceSize bytes, VkBufferUsageFlags extra_usage) {
     return UploadStorageBuffer(
@@ -269,8 +273,7 @@ void GeometryStageViewResources::Allocate(const VulkanContext& context, uint32_t
     // The depth sort takes the slots, the tile sort the entries: both within what this
     // device's dispatches and bindings reach (1.07G pairs on an H200, 33.5M on lavapipe).
     const VulkanDeviceInfo& info = context.GetDeviceInfo();
-    const uint32_t sort_limit =
-        RadixSort::MaxCountFor(info.max_compute_workgroups_x, info.max_storage_buffer_range);
+    const uint32_t sort_limit = RadixSort::MaxCountFor(info);
     if (slots > sort_limit || entry_capacity > sort_limit) {
         core::ThrowError(
             "GeometryStageViewResources: {} slots / {} tile entries exceed the sort limit of "
@@ -279,9 +282,7 @@ void GeometryStageViewResources::Allocate(const VulkanContext& context, uint32_t
             slots, entry_capacity, sort_limit, info.max_compute_workgroups_x,
             info.max_storage_buffer_range);
     }
-    // The projection, the emit and the cut's passes run an invocation per splat or node, in
-    // workgroups of 256 along x.
-    if (uint64_t(n) > uint64_t(info.max_compute_workgroups_x) * shader::kProjectWorkgroupSize) {
+    if (uint64_t(n) > MaxSplatsPerDispatch(info)) {
         core::ThrowError(
             "GeometryStageViewResources: {} splats or nodes need more than the {} workgroups "
             "of {} invocations one dispatch of this device holds (maxComputeWorkGroupCount[0])",

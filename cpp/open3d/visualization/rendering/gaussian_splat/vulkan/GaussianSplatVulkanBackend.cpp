@@ -10,7 +10,6 @@
 #include <utility>
 #include <vector>
 
-#include "GaussianSplatProjectionContract.h"
 #include "open3d/core/Exception.h"
 #include "open3d/core/HostMemory.h"
 #include "open3d/core/Logging.h"
@@ -64,8 +63,7 @@ uint32_t GaussianSplatVulkanBackend::MaxEntryCapacity(const RenderConfig& config
 }
 
 uint32_t GaussianSplatVulkanBackend::SortMaxCount() const {
-    const VulkanDeviceInfo& info = context_->GetDeviceInfo();
-    return RadixSort::MaxCountFor(info.max_compute_workgroups_x, info.max_storage_buffer_range);
+    return RadixSort::MaxCountFor(context_->GetDeviceInfo());
 }
 
 GaussianSplatVulkanBackend::GaussianSplatVulkanBackend(std::unique_ptr<VulkanContext> context,
@@ -217,11 +215,10 @@ void GaussianSplatVulkanBackend::WriteSceneSplatRanges(
 
 int64_t GaussianSplatVulkanBackend::MaxSceneSplats() const {
     // The depth sort over a slot per splat (its keys and the other per-splat words within one
-    // binding), and the projection's workgroups of 256 along x in one dispatch; the splats'
-    // own words are read by device address.
-    const VulkanDeviceInfo& info = context_->GetDeviceInfo();
-    return static_cast<int64_t>(std::min<uint64_t>(
-        SortMaxCount(), uint64_t(info.max_compute_workgroups_x) * shader::kProjectWorkgroupSize));
+    // binding), and the per-splat passes' one dispatch; the splats' own words are read by
+    // device address.
+    return static_cast<int64_t>(
+        std::min<uint64_t>(SortMaxCount(), MaxSplatsPerDispatch(context_->GetDeviceInfo())));
 }
 
 void GaussianSplatVulkanBackend::ApplyStreamStep(const SplatStreamStep& step) {

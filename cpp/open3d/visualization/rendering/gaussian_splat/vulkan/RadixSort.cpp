@@ -101,10 +101,11 @@ uint32_t RadixSort::MaxCountFor(uint32_t max_workgroups_x, uint64_t max_storage_
     return static_cast<uint32_t>(std::min<uint64_t>({by_dispatch, by_keys, kMaxCount}));
 }
 
-uint32_t RadixSort::GetMaxCount() const {
-    const VulkanDeviceInfo& info = context_->GetDeviceInfo();
+uint32_t RadixSort::MaxCountFor(const VulkanDeviceInfo& info) {
     return MaxCountFor(info.max_compute_workgroups_x, info.max_storage_buffer_range);
 }
+
+uint32_t RadixSort::GetMaxCount() const { return MaxCountFor(context_->GetDeviceInfo()); }
 
 RadixSortStorageRequirements RadixSort::GetStorageRequirements(uint32_t max_count) {
     if (max_count > kMaxCount) {

@@ -24,6 +24,7 @@ namespace rendering {
 namespace vulkan {
 
 class VulkanContext;
+struct VulkanDeviceInfo;
 
 /// Bytes and usage of the scratch buffers a sort of up to max_count pairs needs.
 struct RadixSortStorageRequirements {
@@ -61,7 +62,10 @@ public:
     /// binding (maxStorageBufferRange: 2^27 bytes on lavapipe, 2^32 - 1 on NVIDIA), and at
     /// most kMaxCount.
     static uint32_t MaxCountFor(uint32_t max_workgroups_x, uint64_t max_storage_buffer_range);
-    /// MaxCountFor this device: 33,554,431 pairs on lavapipe, 1,073,741,823 on an H200.
+    /// MaxCountFor a device's reported limits: 33,554,432 pairs on lavapipe, 1,073,741,823 on
+    /// an H200.
+    static uint32_t MaxCountFor(const VulkanDeviceInfo& info);
+    /// MaxCountFor this sorter's device.
     uint32_t GetMaxCount() const;
 
     /// Creates the pipelines. Throws core::Open3DError when the device's subgroups can be
