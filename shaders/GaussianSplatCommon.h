@@ -42,6 +42,27 @@ static_assert(sizeof(vec4) == 16 && sizeof(uvec4) == 16 && sizeof(vec3) == 12);
 OPEN3D_SHADER_CONST uint kErrorEntriesDropped = 1u;
 OPEN3D_SHADER_CONST uint kErrorCountsClamped = 2u;
 
+// ---- Workgroup grids past maxComputeWorkGroupCount[0] ----
+// Vulkan guarantees 65,535 workgroups along each axis of a dispatch, and lavapipe and many
+// integrated and mobile GPUs give no more along x (NVIDIA gives 2^31 - 1). A pass over more
+// workgroups than max_x lays them out in rows: (x, y, 1, 0) with x <= max_x, the fewest rows
+// y and fewer than y spare workgroups (x * y - groups). Shaders number their workgroup
+// row-major (FlatWorkGroupIndex) and the spare ones find nothing past the count, so on a
+// device whose x axis holds the whole pass the grid is the one-row grid it was.
+OPEN3D_SHADER_FUNC uvec4 DispatchGridFor(uint groups, uint max_x) {
+    uint width = max_x < 1u ? 1u : max_x;
+    if (groups <= width) return uvec4(groups, 1u, 1u, 0u);
+    uint rows = (groups - 1u) / width + 1u;
+    return uvec4((groups - 1u) / rows + 1u, rows, 1u, 0u);
+}
+
+#ifndef __cplusplus
+// The row-major index of this workgroup in a grid from DispatchGridFor (compute shaders).
+uint FlatWorkGroupIndex() { return gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x; }
+// Workgroups in this dispatch's grid.
+uint FlatNumWorkGroups() { return gl_NumWorkGroups.x * gl_NumWorkGroups.y; }
+#endif
+
 #ifdef __cplusplus
 static_assert(kErrorEntriesDropped == 1u && kErrorCountsClamped == 2u);
 }  // namespace shader

@@ -106,6 +106,8 @@ struct GaussianLodPushConstants {
     uint num_inner;
     uint list_slots;  // LodListSlots of the view's budget
     uint walk;        // 1: the threshold pass follows the walk from the root (kLodPassWalk*)
+    // The device's maxComputeWorkGroupCount[0]: the walk's grids it writes (DispatchGridFor).
+    uint max_groups_x;
 };
 
 // Slots of the cut's node list, known before the cut is: the cut never exceeds the budget
@@ -142,7 +144,8 @@ static_assert(sizeof(GaussianLodNode) == 16);
 static_assert(offsetof(GaussianLodNode, parent) == 4);
 static_assert(offsetof(GaussianLodNode, children) == 8);
 static_assert(offsetof(GaussianLodNode, first_child) == 12);
-static_assert(sizeof(GaussianLodPushConstants) == 16);
+static_assert(sizeof(GaussianLodPushConstants) == 20);
+static_assert(offsetof(GaussianLodPushConstants, max_groups_x) == 16);
 static_assert(kLodWorkgroupSize % 32 == 0, "the list pass reads whole words");
 static_assert(offsetof(GaussianLodPushConstants, num_inner) == 4);
 static_assert(offsetof(GaussianLodPushConstants, list_slots) == 8);

@@ -59,11 +59,11 @@ OPEN3D_SHADER_CONST uint kRadixSortMaxPasses = 4u;
 // Written on the GPU by radix_sort_setup.comp from the element count; the first three
 // members are a VkDispatchIndirectCommand for the per-block passes.
 struct RadixSortParams {
-    uint dispatch_x;  // number of blocks = ceil(count / block_size)
-    uint dispatch_y;  // 1
+    uint dispatch_x;  // the blocks' grid, DispatchGridFor(num_blocks, max_groups_x)
+    uint dispatch_y;
     uint dispatch_z;  // 1
     uint count;       // min(count from the producer, max_count)
-    uint num_blocks;  // == dispatch_x, row stride of the histogram table
+    uint num_blocks;  // ceil(count / block_size), row stride of the histogram table
     uint flags;       // kErrorCountsClamped when the producer's count exceeded max_count
     uint block_size;  // elements per block: kRadixSortWorkgroupSize * (1..16)
     // Subtracted from every key before its digits are taken; a multiple of kRadixSortBins,
@@ -99,7 +99,9 @@ struct RadixSortPushConstants {
     uint num_passes;  // passes recorded: ceil(num_bits / 8)
     // 1: RadixSort::Output::kValuesOnly (the last pass that runs and the copy write no keys)
     uint values_only;
-    uint reserved0;
+    // The device's maxComputeWorkGroupCount[0]: the per-block passes' grids
+    // (DispatchGridFor) that the setup writes.
+    uint max_groups_x;
     uint reserved1;
     uint reserved2;
 };
@@ -111,9 +113,11 @@ struct RadixSortPushConstants {
 // chunks. radix_sort_setup.comp calls it, and so does a producer that writes the sort's
 // parameters itself (gaussian_dispatch_args.comp, and GaussianGeometryStage on the host for the
 // depth sort, whose count is N), saving the sort its setup dispatch. No
-// overflow: the host keeps max_count far below 2^32 - kRadixSortBlockSize.
+// overflow: the host keeps max_count far below 2^32 - kRadixSortBlockSize. The per-block
+// passes' grids are DispatchGridFor(num_blocks, max_groups_x): rows where the blocks pass
+// the device's maxComputeWorkGroupCount[0].
 OPEN3D_SHADER_FUNC RadixSortParams RadixSortParamsFor(uint count, uint max_count,
-                                                      uint target_blocks) {
+                                                      uint target_blocks, uint max_groups_x) {
     RadixSortParams p;
     p.flags = 0u;
     if (count > max_count) {
@@ -128,8 +132,9 @@ OPEN3D_SHADER_FUNC RadixSortParams RadixSortParamsFor(uint count, uint max_count
     chunks = chunks < kRadixSortItemsPerInvocation ? chunks : kRadixSortItemsPerInvocation;
     p.block_size = kRadixSortWorkgroupSize * chunks;
     p.num_blocks = (count + p.block_size - 1u) / p.block_size;
-    p.dispatch_x = p.num_blocks;
-    p.dispatch_y = 1u;
+    uvec4 grid = DispatchGridFor(p.num_blocks, max_groups_x);
+    p.dispatch_x = grid.x;
+    p.dispatch_y = grid.y;
     p.dispatch_z = 1u;
     p.count = count;
     p.key_base = 0u;
@@ -138,10 +143,10 @@ OPEN3D_SHADER_FUNC RadixSortParams RadixSortParamsFor(uint count, uint max_count
     p.range_passes = 0u;
     p.reserved0 = 0u;
     for (uint pass = 0u; pass < kRadixSortMaxPasses; ++pass) {
-        p.pass_blocks[pass] = uvec4(p.num_blocks, 1u, 1u, 0u);
+        p.pass_blocks[pass] = grid;
         p.pass_rows[pass] = uvec4(kRadixSortBins, 1u, 1u, 0u);
     }
-    p.copy_blocks = uvec4(0u, 1u, 1u, 0u);
+    p.copy_blocks = uvec4(0u, grid.y, 1u, 0u);
     return p;
 }
 
@@ -177,6 +182,7 @@ static_assert(offsetof(RadixSortPushConstants, drop_max_keys) == 20);
 static_assert(offsetof(RadixSortPushConstants, key_range) == 24);
 static_assert(offsetof(RadixSortPushConstants, num_passes) == 28);
 static_assert(offsetof(RadixSortPushConstants, values_only) == 32);
+static_assert(offsetof(RadixSortPushConstants, max_groups_x) == 36);
 static_assert(offsetof(RadixSortPushConstants, reserved2) == 44);
 static_assert(offsetof(RadixSortParams, reserved0) == 44);
 

@@ -80,6 +80,9 @@ struct GaussianDispatchArgsPushConstants {
     // fit) are written here, saving the sort its setup dispatch.
     uint sort_max_count;
     uint sort_target_blocks;
+    // The device's maxComputeWorkGroupCount[0]: the emit's, the scan levels' and the tile
+    // sort's grids (DispatchGridFor).
+    uint max_groups_x;
 };
 
 // Push constants of gaussian_scan.comp.
@@ -160,12 +163,14 @@ OPEN3D_SHADER_FUNC uint ListValueCount(uint value, uint num_splats) {
 // the block sums of level l, ceil(count / kScanBlockSize^l) of them); levels at and past
 // `num_levels` are not recorded and get zero groups. gaussian_dispatch_args.comp sizes the
 // packed key's scan from visible_count with it, GaussianGeometryStage the exact order's from N.
-OPEN3D_SHADER_FUNC GaussianScanLevel ScanLevelFor(uint count, uint level, uint num_levels) {
+OPEN3D_SHADER_FUNC GaussianScanLevel ScanLevelFor(uint count, uint level, uint num_levels,
+                                                  uint max_groups_x) {
     for (uint l = 0u; l < level; ++l) count = (count + kScanBlockSize - 1u) / kScanBlockSize;
     bool recorded = level < num_levels;
+    uvec4 grid = DispatchGridFor((count + kScanBlockSize - 1u) / kScanBlockSize, max_groups_x);
     GaussianScanLevel size;
-    size.dispatch_x = recorded ? (count + kScanBlockSize - 1u) / kScanBlockSize : 0u;
-    size.dispatch_y = 1u;
+    size.dispatch_x = recorded ? grid.x : 0u;
+    size.dispatch_y = grid.y;
     size.dispatch_z = 1u;
     size.count = recorded ? count : 0u;
     return size;
@@ -186,7 +191,7 @@ static_assert(offsetof(GaussianGeometryStageCounters, error_flags) == 12);
 static_assert(offsetof(GaussianGeometryStageCounters, emit_dispatch_x) == 16);
 static_assert(offsetof(GaussianGeometryStageCounters, scan_levels) == 32);
 
-static_assert(sizeof(GaussianDispatchArgsPushConstants) == 16);
+static_assert(sizeof(GaussianDispatchArgsPushConstants) == 20);
 static_assert(offsetof(GaussianDispatchArgsPushConstants, num_levels) == 4);
 static_assert(sizeof(GaussianScanPushConstants) == 32);
 static_assert(offsetof(GaussianScanPushConstants, write_total) == 16);

@@ -35,11 +35,12 @@ uint DivCeil(uint a, uint b) {
 
 void SizeScanAndEmit() {
     uint visible = counters.visible_count;
-    counters.emit_dispatch_x = DivCeil(visible, kEmitWorkgroupSize);
-    counters.emit_dispatch_y = 1u;
+    uvec4 emit = DispatchGridFor(DivCeil(visible, kEmitWorkgroupSize), pc.max_groups_x);
+    counters.emit_dispatch_x = emit.x;
+    counters.emit_dispatch_y = emit.y;
     counters.emit_dispatch_z = 1u;
     for (uint level = 0u; level < kScanMaxLevels; ++level) {
-        counters.scan_levels[level] = ScanLevelFor(visible, level, pc.num_levels);
+        counters.scan_levels[level] = ScanLevelFor(visible, level, pc.num_levels, pc.max_groups_x);
     }
 }
 
@@ -72,7 +73,8 @@ void CountFittingEntries() {
     // The allocation, not RenderConfig::max_tile_entries_total, was the binding limit.
     if (total > capacity && capacity < view.max_tile_entries_total) flags |= kErrorCountsClamped;
     if (flags != 0u) atomicOr(counters.error_flags, flags);
-    sort_params = RadixSortParamsFor(entries, pc.sort_max_count, pc.sort_target_blocks);
+    sort_params =
+        RadixSortParamsFor(entries, pc.sort_max_count, pc.sort_target_blocks, pc.max_groups_x);
 }
 
 void main() {

@@ -47,8 +47,9 @@ layout(std430, set = 0, binding = kGeometryStageEntryValuesBinding) writeonly bu
 void UnpackKeys() {
     uint depth_bits = kSortKeyBits - view.tile_bits;
     uint count = counters.entry_count;
-    uint stride = gl_NumWorkGroups.x * kEmitWorkgroupSize;
-    for (uint i = gl_GlobalInvocationID.x; i < count; i += stride) {
+    uint stride = FlatNumWorkGroups() * kEmitWorkgroupSize;
+    uint first = FlatWorkGroupIndex() * kEmitWorkgroupSize + gl_LocalInvocationIndex;
+    for (uint i = first; i < count; i += stride) {
         entry_keys[i] = entry_keys[i] >> depth_bits;
     }
 }
@@ -58,7 +59,7 @@ void main() {
         UnpackKeys();
         return;
     }
-    uint k = gl_GlobalInvocationID.x;
+    uint k = FlatWorkGroupIndex() * kEmitWorkgroupSize + gl_LocalInvocationIndex;
     uint visible = counters.visible_count;
     if (k >= visible) return;
     uint begin = ScanOffset(k);

@@ -166,7 +166,10 @@ void StartWalk() {
 }
 
 void main() {
-    uint id = gl_GlobalInvocationID.x;
+    // Workgroups in rows past maxComputeWorkGroupCount[0] (DispatchGridFor): every pass
+    // takes its workgroup's flat index, and the spare ones of a last row find ids past the end.
+    uint flat_group = FlatWorkGroupIndex();
+    uint id = flat_group * kLodWorkgroupSize + gl_LocalInvocationID.x;
     uint lane = gl_LocalInvocationID.x;
     if (kPass == kLodPassSizes) {
         if (id < pc.num_inner) buckets[pc.num_inner + id] = SizeBucket(pc.num_leaves + id);
@@ -241,9 +244,11 @@ void main() {
                     previous_threshold = threshold;
                     walk[kLodWalkRound] = kLodWalkDone;
                     walk[kLodWalkArgs] = 0u;
-                    walk[kLodWalkMaskArgs] =
-                        (walk[kLodWalkCursor] + kLodWorkgroupSize - 1u) / kLodWorkgroupSize;
-                    walk[kLodWalkMaskArgs + 1u] = 1u;
+                    uvec4 mask_grid = DispatchGridFor(
+                        (walk[kLodWalkCursor] + kLodWorkgroupSize - 1u) / kLodWorkgroupSize,
+                        pc.max_groups_x);
+                    walk[kLodWalkMaskArgs] = mask_grid.x;
+                    walk[kLodWalkMaskArgs + 1u] = mask_grid.y;
                     walk[kLodWalkMaskArgs + 2u] = 1u;
                 }
             } else {
@@ -297,7 +302,7 @@ void main() {
         uint begin = walk[kLodWalkBegin], end = walk[kLodWalkEnd];
         uint guess = walk[kLodWalkGuess];
         uint first_index =
-            begin + gl_WorkGroupID.x * kLodWorkgroupSize * kLodWalkNodesPerInvocation + lane;
+            begin + flat_group * kLodWorkgroupSize * kLodWalkNodesPerInvocation + lane;
         uint opening[kLodWalkNodesPerInvocation], first_slot[kLodWalkNodesPerInvocation];
         [[unroll]] for (uint r = 0u; r < kLodWalkNodesPerInvocation; ++r) {
             opening[r] = kLodNoParent;
@@ -342,7 +347,8 @@ void main() {
         // dispatch and a barrier more per level.
         if (lane == 0u) {
             memoryBarrierBuffer();  // this workgroup's cursor addition before its count
-            s_last_group = atomicAdd(walk[kLodWalkGroupsDone], 1u) + 1u == gl_NumWorkGroups.x;
+            // Spare workgroups of the grid count too: they ran with no nodes.
+            s_last_group = atomicAdd(walk[kLodWalkGroupsDone], 1u) + 1u == FlatNumWorkGroups();
         }
         barrier();
         if (s_last_group && lane == 0u) {
@@ -350,7 +356,9 @@ void main() {
             walk[kLodWalkBegin] = begin;
             walk[kLodWalkEnd] = end;
             walk[kLodWalkGroupsDone] = 0u;
-            walk[kLodWalkArgs] = LodWalkGroups(end - begin);
+            uvec4 grid = DispatchGridFor(LodWalkGroups(end - begin), pc.max_groups_x);
+            walk[kLodWalkArgs] = grid.x;
+            walk[kLodWalkArgs + 1u] = grid.y;
         }
     } else if (kPass == kLodPassWalkMask) {
         if (id < walk[kLodWalkCursor]) {
@@ -376,9 +384,9 @@ void main() {
         uint own = id < groups ? group_counts[id] : 0u;
         uint inclusive = InclusivePrefixSum(lane, own);
         if (id < groups) group_counts[id] = inclusive - own;
-        if (lane == kLodWorkgroupSize - 1u) {
-            group_counts[LodBlockBase(pc.num_leaves + pc.num_inner) + gl_WorkGroupID.x] =
-                inclusive;
+        uint nodes_total = pc.num_leaves + pc.num_inner;
+        if (lane == kLodWorkgroupSize - 1u && flat_group < LodBlocks(nodes_total)) {
+            group_counts[LodBlockBase(nodes_total) + flat_group] = inclusive;
         }
     } else if (kPass == kLodPassBlockOffsets) {
         // Lane i sums a run of consecutive block totals, the lanes' sums are scanned in

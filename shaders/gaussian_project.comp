@@ -318,7 +318,7 @@ bool Project(uint i, uint slot, out float depth, out uint entries) {
 }
 
 void main() {
-    uint i = gl_GlobalInvocationID.x;
+    uint i = FlatWorkGroupIndex() * kProjectWorkgroupSize + gl_LocalInvocationIndex;
     float depth = 0.0;
     uint entries = 0u;
     // Slot i holds splat i, or the cut's node list[i] (its slots past the cut's size are

@@ -57,8 +57,12 @@ uint LoadCount(uint index) {
 }
 
 void ScanBlockPass(uint count) {
+    uint block = FlatWorkGroupIndex();
+    // A spare workgroup of the grid's last row (a block past the count) has nothing to add
+    // and must not store a block sum.
+    if (block > 0u && block * kScanBlockSize >= count) return;
     uint local = gl_LocalInvocationIndex;
-    uint first = gl_WorkGroupID.x * kScanBlockSize + local * kScanItemsPerInvocation;
+    uint first = block * kScanBlockSize + local * kScanItemsPerInvocation;
     uint values[kScanItemsPerInvocation];
     uint sum = 0u;
     for (uint k = 0u; k < kScanItemsPerInvocation; ++k) {
@@ -86,7 +90,7 @@ void ScanBlockPass(uint count) {
         if (pc.write_total != 0u) {
             counters.requested_entries = block_total;
         } else {
-            scan[pc.sums_base + gl_WorkGroupID.x] = block_total;
+            scan[pc.sums_base + block] = block_total;
         }
     }
 }

@@ -25,7 +25,7 @@ layout(std430, set = 0, binding = kRadixSortValuesOutBinding) writeonly buffer V
 void main() {
     uint count = params.count;
     uint block_size = params.block_size;
-    uint block_begin = gl_WorkGroupID.x * block_size;
+    uint block_begin = FlatWorkGroupIndex() * block_size;  // spare workgroups: past count
     for (uint i = gl_LocalInvocationIndex; i < block_size; i += kRadixSortWorkgroupSize) {
         uint index = block_begin + i;
         if (index < count) {

@@ -24,6 +24,8 @@ shared uint s_key_min;  // this block's kept keys, with PassCount::kFromKeyRange
 shared uint s_key_max;
 
 void main() {
+    uint block = FlatWorkGroupIndex();
+    if (block >= params.num_blocks) return;  // a spare workgroup of the grid's last row
     uint local = gl_LocalInvocationIndex;
     g_key_base = params.key_base;
     s_counts[local] = 0u;
@@ -36,7 +38,7 @@ void main() {
     barrier();
     uint count = params.count;
     uint block_size = params.block_size;
-    uint block_begin = gl_WorkGroupID.x * block_size;
+    uint block_begin = block * block_size;
     uint chunks = block_size / kRadixSortWorkgroupSize;  // uniform, 1..8
     // All loads first, so that they are in flight together (one load, then its atomic, per
     // step measured slower: docs/perf/h200.md).
@@ -66,7 +68,7 @@ void main() {
         }
     }
     barrier();
-    histogram[kRadixSortBins + local * params.num_blocks + gl_WorkGroupID.x] = s_counts[local];
+    histogram[kRadixSortBins + local * params.num_blocks + block] = s_counts[local];
     if (track_range && local == 0u && s_key_min <= s_key_max) {
         // A block inside the range recorded so far changes nothing. The recorded values
         // only move outwards, so one read late in this dispatch can only skip atomics

@@ -66,12 +66,13 @@ uint HalfOf(uint word, uint digit) {
 }
 
 void main() {
+    uint block = FlatWorkGroupIndex();
+    if (block >= params.num_blocks) return;  // a spare workgroup of the grid's last row
     g_key_base = params.key_base;
     InitScanSlot();
     uint local = gl_LocalInvocationIndex;
     uint count = params.count;
     uint num_blocks = params.num_blocks;
-    uint block = gl_WorkGroupID.x;
     uint block_kept;  // pairs of this block the histogram counted (all but dropped keys)
     bool write_keys = WritesKeys(params.range_passes != 0u ? params.range_passes : pc.num_passes);
 

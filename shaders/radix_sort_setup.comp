@@ -22,7 +22,8 @@ layout(std430, set = 0, binding = kRadixSortCountBinding) readonly buffer CountB
 };
 
 void main() {
-    RadixSortParams p = RadixSortParamsFor(counts[pc.count_index], pc.max_count, pc.target_blocks);
+    RadixSortParams p = RadixSortParamsFor(counts[pc.count_index], pc.max_count, pc.target_blocks,
+                                          pc.max_groups_x);
     if (pc.key_range != 0u) {
         uint key_min = params.key_min;
         uint key_max = params.key_max;
@@ -38,10 +39,10 @@ void main() {
         p.range_passes = passes;
         for (uint pass = 0u; pass < kRadixSortMaxPasses; ++pass) {
             bool runs = pass < passes;
-            p.pass_blocks[pass].x = runs ? p.num_blocks : 0u;
+            p.pass_blocks[pass].x = runs ? p.dispatch_x : 0u;
             p.pass_rows[pass].x = runs ? kRadixSortBins : 0u;
         }
-        p.copy_blocks.x = passes % 2u == 1u ? p.num_blocks : 0u;
+        p.copy_blocks.x = passes % 2u == 1u ? p.dispatch_x : 0u;
     }
     params = p;
 }

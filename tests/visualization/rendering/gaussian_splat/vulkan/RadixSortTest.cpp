@@ -157,8 +157,9 @@ protected:
         // With a drop, the kept count sits at byte 44 (another count of the same producer).
         if (kept_count) vkCmdFillBuffer(c, count_buffer.Get(), 44, 4, *kept_count);
         if (producer) {
-            const shader::RadixSortParams written = shader::RadixSortParamsFor(
-                gpu_count, std::max(capacity, 1u), sort_->GetTargetBlocks());
+            const shader::RadixSortParams written =
+                shader::RadixSortParamsFor(gpu_count, std::max(capacity, 1u),
+                                           sort_->GetTargetBlocks(), sort_->GetMaxGroupsX());
             vkCmdUpdateBuffer(c, params.Get(), 0, sizeof(written), &written);
         }
         RecordMemoryBarrier(
@@ -230,11 +231,14 @@ protected:
             // The setup shader and the C++ compilation of RadixSortParamsFor agree (a
             // producer that writes the parameters itself relies on it), and the blocks fit
             // the histogram that GetStorageRequirements sized.
-            const shader::RadixSortParams want =
-                shader::RadixSortParamsFor(c.count, c.count + padding, sort_->GetTargetBlocks());
+            const shader::RadixSortParams want = shader::RadixSortParamsFor(
+                c.count, c.count + padding, sort_->GetTargetBlocks(), sort_->GetMaxGroupsX());
             EXPECT_EQ(gpu.params.block_size, want.block_size);
             EXPECT_EQ(gpu.params.num_blocks, want.num_blocks);
-            EXPECT_EQ(gpu.params.dispatch_x, want.num_blocks);
+            EXPECT_EQ(gpu.params.dispatch_x, want.dispatch_x);
+            EXPECT_EQ(gpu.params.dispatch_y, want.dispatch_y);
+            EXPECT_GE(uint64_t(gpu.params.dispatch_x) * gpu.params.dispatch_y,
+                      gpu.params.num_blocks);
             const uint64_t area_words =
                 RadixSort::GetStorageRequirements(c.count + padding).histogram_bytes / 4;
             EXPECT_LE(256u + 256u * uint64_t(gpu.params.num_blocks), area_words);
@@ -518,16 +522,77 @@ TEST_F(RadixSortTest, StorageRequirements) {
     EXPECT_EQ(RadixSort::GetNumPasses(0), 0u);
 }
 
-TEST_F(RadixSortTest, TheDeviceLimitFollowsItsDispatchAndBindingLimits) {
-    // Blocks of 2048 pairs within maxComputeWorkGroupCount[0], keys within one binding.
-    EXPECT_EQ(RadixSort::MaxCountFor(65535, uint64_t(1) << 27), 33554432u);  // lavapipe
-    EXPECT_EQ(RadixSort::MaxCountFor(65535, 0xFFFFFFFFull), 65535u * 2048u);
-    EXPECT_EQ(RadixSort::MaxCountFor(0x7FFFFFFF, 0xFFFFFFFFull), 1073741823u);  // NVIDIA
-    EXPECT_EQ(RadixSort::MaxCountFor(0x7FFFFFFF, uint64_t(1) << 40), RadixSort::kMaxCount);
+TEST_F(RadixSortTest, TheDeviceLimitFollowsItsBindingLimit) {
+    // Keys within one binding, at most kMaxCount; the blocks' workgroups go in rows past
+    // maxComputeWorkGroupCount[0], which therefore bounds nothing.
+    EXPECT_EQ(RadixSort::MaxCountFor(uint64_t(1) << 27), 33554432u);  // lavapipe
+    EXPECT_EQ(RadixSort::MaxCountFor(0xFFFFFFFFull), 1073741823u);    // NVIDIA
+    EXPECT_EQ(RadixSort::MaxCountFor(uint64_t(1) << 40), RadixSort::kMaxCount);
     const VulkanDeviceInfo& info = Context().GetDeviceInfo();
-    EXPECT_EQ(sort_->GetMaxCount(),
-              RadixSort::MaxCountFor(info.max_compute_workgroups_x, info.max_storage_buffer_range));
+    EXPECT_EQ(sort_->GetMaxCount(), RadixSort::MaxCountFor(info.max_storage_buffer_range));
+    EXPECT_EQ(sort_->GetMaxGroupsX(), info.max_compute_workgroups_x);
     EXPECT_GE(info.max_compute_workgroups_x, 65535u);  // Vulkan's minimum
+}
+
+TEST_F(RadixSortTest, SortsWithBlocksInRowsPastTheWorkgroupLimit) {
+    // A sorter told that its device holds 3 workgroups along x lays the blocks of every
+    // per-block pass (histogram, scatter, the odd pass count's copy) out in rows, with spare
+    // workgroups in the last row. It must sort as std::stable_sort does, with the setup's
+    // parameters and with the producer's, with dropped keys and the key range's passes.
+    BorrowedVulkanHandles handles;
+    handles.instance = Context().GetInstance();
+    handles.physical_device = Context().GetPhysicalDevice();
+    handles.device = Context().GetDevice();
+    handles.queue = Context().GetQueue();
+    handles.queue_family_index = Context().GetQueueFamilyIndex();
+    handles.max_workgroups_x = 3;
+    const std::unique_ptr<VulkanContext> narrow = VulkanContext::CreateFromBorrowed(handles);
+    std::unique_ptr<RadixSort> rows = std::make_unique<RadixSort>(*narrow);
+    ASSERT_EQ(rows->GetMaxGroupsX(), 3u);
+    sort_.swap(rows);  // Sort() records with sort_; swapped back below
+    struct Restore {
+        std::unique_ptr<RadixSort>& a;
+        std::unique_ptr<RadixSort>& b;
+        ~Restore() { a.swap(b); }
+    } restore{sort_, rows};
+    // 197 blocks of 512 pairs on a GPU (its target of 256 blocks), 66 rows of 3; 50 blocks of
+    // 2048 on a CPU device (fewer blocks), 17 rows. One workgroup spare either way.
+    const uint32_t n = 196u * 512u + 1u;
+    CheckSort({"rows", n, Pattern::kRandom}, 5);
+    CheckSort({"rows, tiles", n, Pattern::kTiles, 13}, 0);
+    const GpuSortResult shape =
+        Sort(MakeKeys({"shape", n, Pattern::kRandom}, 3), std::vector<uint32_t>(n, 0u), n, 8);
+    const uint32_t blocks = shape.params.num_blocks;
+    EXPECT_EQ(blocks, (n + shape.params.block_size - 1) / shape.params.block_size);
+    EXPECT_EQ(shape.params.dispatch_x, 3u);
+    EXPECT_EQ(shape.params.dispatch_y, (blocks + 2) / 3);
+    EXPECT_EQ(blocks % 3, 2u);  // a spare workgroup in the last row
+    // The depth sort's way: the producer's parameters, dropped ~0u keys, the passes the kept
+    // keys' range needs, values only.
+    std::vector<uint32_t> keys = MakeKeys({"depth", n, Pattern::kRandom}, 4);
+    std::vector<uint32_t> values(n);
+    uint32_t kept = 0;
+    for (uint32_t i = 0; i < n; ++i) {
+        values[i] = i;
+        if (i % 5 == 0)
+            keys[i] = shader::kRadixSortDroppedKey;
+        else
+            keys[i] = 0x3F000000u + (keys[i] >> 12);  // a 20-bit span: three passes
+        kept += keys[i] != shader::kRadixSortDroppedKey;
+    }
+    const GpuSortResult depth =
+        Sort(keys, values, n, 32, RadixSort::Params::kWrittenByProducer, &kept,
+             RadixSort::PassCount::kFromKeyRange, RadixSort::Output::kValuesOnly);
+    std::vector<uint32_t> want_keys, want_values;
+    for (uint32_t i = 0; i < n; ++i) {
+        if (keys[i] == shader::kRadixSortDroppedKey) continue;
+        want_keys.push_back(keys[i]);
+        want_values.push_back(values[i]);
+    }
+    ReferenceSort(want_keys, want_values, 32);
+    ASSERT_EQ(want_values.size(), kept);
+    EXPECT_TRUE(std::equal(want_values.begin(), want_values.end(), depth.values.begin()));
+    EXPECT_EQ(depth.params.range_passes, 3u);
 }
 
 TEST_F(RadixSortTest, SortsPastTheSmallestDispatchLimitWhereTheDeviceAllows) {
@@ -585,13 +650,13 @@ TEST_F(RadixSortTest, RejectsMisuse) {
     EXPECT_THROW(sort_->Record(cmd.Get(), buffer.Range(32772, 4000), buffer.Range(40960, 4096),
                                scratch, buffer.Range(60000, 4), 1000, 32),
                  core::Open3DError);  // misaligned keys
-    // More pairs than this device dispatches or binds: refused first, naming its limits.
+    // More pairs than this device binds: refused first, naming its limit.
     try {
         sort_->Record(cmd.Get(), buffer.Range(32768, 4096), buffer.Range(40960, 4096), scratch,
                       buffer.Range(60000, 4), sort_->GetMaxCount() + 1, 32);
         ADD_FAILURE() << "a sort past the device's " << sort_->GetMaxCount() << " pairs";
     } catch (const core::Open3DError& e) {
-        EXPECT_NE(std::string(e.what()).find("maxComputeWorkGroupCount"), std::string::npos)
+        EXPECT_NE(std::string(e.what()).find("maxStorageBufferRange"), std::string::npos)
             << e.what();
     }
     cmd.End();

@@ -8,7 +8,7 @@
 // splat), the same coverage and median depth per pixel, and colour / expected depth within
 // a tolerance that the comment beside it justifies by the error measured on lavapipe (an
 // H100 fits the same bounds; docs/perf/lavapipe.md and docs/perf/h100.md have both, and
-// docs/vulkan.md "Numerical stress suite" the rules these cases hold the renderers to).
+// docs/accuracy.md "Numerical stress suite" the rules these cases hold the renderers to).
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>

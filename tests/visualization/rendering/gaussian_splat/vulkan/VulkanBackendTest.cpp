@@ -207,8 +207,8 @@ TEST_F(VulkanBackend, EntryCapacityStopsAtTheSortLimit) {
     auto backend = MakeBackend();
     const uint32_t sort_limit = backend->SortMaxCount();
     const vulkan::VulkanDeviceInfo& info = backend->GetContext().GetDeviceInfo();
-    EXPECT_EQ(sort_limit, vulkan::RadixSort::MaxCountFor(info.max_compute_workgroups_x,
-                                                         info.max_storage_buffer_range));
+    EXPECT_EQ(sort_limit, vulkan::RadixSort::MaxCountFor(info.max_storage_buffer_range));
+    EXPECT_EQ(backend->MaxSceneSplats(), int64_t(sort_limit));
     RenderConfig config;
     config.max_tile_entries_total = 1000;
     EXPECT_EQ(GaussianSplatVulkanBackend::MaxEntryCapacity(config, sort_limit), 1000u);

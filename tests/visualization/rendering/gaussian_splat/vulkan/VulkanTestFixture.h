@@ -57,11 +57,14 @@ protected:
         return handles;
     }
     static visualization::rendering::vulkan::CommandPool& Pool() { return *pool_; }
-    /// A Vulkan backend on the shared device, so the validation check covers it.
+    /// A Vulkan backend on the shared device, so the validation check covers it;
+    /// `max_workgroups_x` as BorrowedVulkanHandles says (0: the device's).
     static std::unique_ptr<visualization::rendering::vulkan::GaussianSplatVulkanBackend>
-    MakeBackend(uint32_t entry_capacity = 1u << 22) {
+    MakeBackend(uint32_t entry_capacity = 1u << 22, uint32_t max_workgroups_x = 0) {
+        visualization::rendering::vulkan::BorrowedVulkanHandles handles = BorrowedHandles();
+        handles.max_workgroups_x = max_workgroups_x;
         return std::make_unique<visualization::rendering::vulkan::GaussianSplatVulkanBackend>(
-            visualization::rendering::vulkan::VulkanContext::CreateFromBorrowed(BorrowedHandles()),
+            visualization::rendering::vulkan::VulkanContext::CreateFromBorrowed(handles),
             entry_capacity);
     }
 

@@ -179,6 +179,8 @@ void GaussianGeometryStage::Record(VkCommandBuffer cmd, const GeometryStageScene
     const GeometryStageChoices& choices = view.choices;
     const uint32_t n = choices.num_splats;
     const uint32_t capacity = choices.entry_capacity_allocated;
+    // Per-splat passes lay their workgroups out in rows past this (DispatchGridFor).
+    const uint32_t max_groups_x = sort_.GetMaxGroupsX();
     const bool packed_key = choices.packed_key;
     const bool slots_fit = scene.lod ? n >= 1 && n <= scene.lod_leaves : n == scene.num_splats;
     if (!slots_fit || choices.entry_capacity > capacity) {
@@ -214,14 +216,16 @@ void GaussianGeometryStage::Record(VkCommandBuffer cmd, const GeometryStageScene
     GaussianGeometryStageCounters initial_counters{};
     initial_counters.num_splats = n;
     if (!packed_key) {
-        initial_counters.emit_dispatch_x = DivCeil(n, kEmitWorkgroupSize);
-        initial_counters.emit_dispatch_y = 1;
+        const uvec4 emit = DispatchGridFor(DivCeil(n, kEmitWorkgroupSize), max_groups_x);
+        initial_counters.emit_dispatch_x = emit.x;
+        initial_counters.emit_dispatch_y = emit.y;
         initial_counters.emit_dispatch_z = 1;
         for (uint32_t level = 0; level < kScanMaxLevels; ++level) {
-            initial_counters.scan_levels[level] = ScanLevelFor(n, level, need.num_scan_levels);
+            initial_counters.scan_levels[level] =
+                ScanLevelFor(n, level, need.num_scan_levels, max_groups_x);
         }
         const RadixSortParams depth_sort =
-            RadixSortParamsFor(n, std::max(n, 1u), sort_.GetTargetBlocks());
+            RadixSortParamsFor(n, std::max(n, 1u), sort_.GetTargetBlocks(), max_groups_x);
         vkCmdUpdateBuffer(cmd, buffers.sort_scratch.params.buffer,
                           buffers.sort_scratch.params.offset, sizeof(depth_sort), &depth_sort);
     }
@@ -267,7 +271,10 @@ void GaussianGeometryStage::Record(VkCommandBuffer cmd, const GeometryStageScene
     vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE,
                       GetProjectPipeline(choices.sh_degree, choices.antialias, scene.precision,
                                          !packed_key, scene.lod));
-    if (n > 0) vkCmdDispatch(cmd, DivCeil(n, kProjectWorkgroupSize), 1, 1);
+    if (n > 0) {
+        const uvec4 grid = DispatchGridFor(DivCeil(n, kProjectWorkgroupSize), max_groups_x);
+        vkCmdDispatch(cmd, grid.x, grid.y, 1);
+    }
     ComputeBarrier(cmd);
 
     // 2. Packed key: the scan and the emit follow the append order of the visible splats,
@@ -275,6 +282,7 @@ void GaussianGeometryStage::Record(VkCommandBuffer cmd, const GeometryStageScene
     GaussianDispatchArgsPushConstants args{};
     args.num_levels = need.num_scan_levels;
     args.sort_target_blocks = sort_.GetTargetBlocks();
+    args.max_groups_x = max_groups_x;
     if (packed_key) {
         args.mode = kDispatchArgsAfterProject;
         vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, dispatch_args_.Get());

@@ -46,10 +46,6 @@ constexpr VkBufferUsageFlags kAddressed = VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_
 
 }  // namespace
 
-uint64_t MaxSplatsPerDispatch(const VulkanDeviceInfo& info) {
-    return uint64_t(info.max_compute_workgroups_x) * shader::kProjectWorkgroupSize;
-}
-
 Buffer UploadStorageBuffer(const VulkanContext& context, const CommandPool& pool, const void* data,
                            VkDeviceSize bytes, VkBufferUsageFlags extra_usage) {
     return UploadStorageBuffer(
@@ -271,22 +267,16 @@ void GeometryStageViewResources::Allocate(const VulkanContext& context, uint32_t
     }
     const uint32_t slots = lod_inner ? n - *lod_inner : n;
     // The depth sort takes the slots, the tile sort the entries: both within what this
-    // device's dispatches and bindings reach (1.07G pairs on an H200, 33.5M on lavapipe).
+    // device's bindings reach (1.07G pairs on an H200, 33.5M on lavapipe). The per-splat and
+    // per-node passes lay their workgroups out in rows (DispatchGridFor), so
+    // maxComputeWorkGroupCount bounds none of them.
     const VulkanDeviceInfo& info = context.GetDeviceInfo();
     const uint32_t sort_limit = RadixSort::MaxCountFor(info);
     if (slots > sort_limit || entry_capacity > sort_limit) {
         core::ThrowError(
             "GeometryStageViewResources: {} slots / {} tile entries exceed the sort limit of "
-            "this device, {} pairs (maxComputeWorkGroupCount[0] {}, maxStorageBufferRange {} "
-            "bytes)",
-            slots, entry_capacity, sort_limit, info.max_compute_workgroups_x,
-            info.max_storage_buffer_range);
-    }
-    if (uint64_t(n) > MaxSplatsPerDispatch(info)) {
-        core::ThrowError(
-            "GeometryStageViewResources: {} splats or nodes need more than the {} workgroups "
-            "of {} invocations one dispatch of this device holds (maxComputeWorkGroupCount[0])",
-            n, info.max_compute_workgroups_x, shader::kProjectWorkgroupSize);
+            "this device, {} pairs (maxStorageBufferRange {} bytes)",
+            slots, entry_capacity, sort_limit, info.max_storage_buffer_range);
     }
     const GeometryStageStorageRequirements need =
         GaussianGeometryStage::GetStorageRequirements(slots, entry_capacity);

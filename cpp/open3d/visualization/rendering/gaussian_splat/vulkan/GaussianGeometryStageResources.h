@@ -24,11 +24,6 @@ namespace vulkan {
 
 struct VulkanDeviceInfo;
 
-/// The most splats (or hierarchy nodes) the per-splat passes take in one dispatch: the
-/// projection, the emit and the cut run an invocation each, in workgroups of 256 along x, within
-/// maxComputeWorkGroupCount[0] (16.7M on lavapipe, 549G on NVIDIA).
-uint64_t MaxSplatsPerDispatch(const VulkanDeviceInfo& info);
-
 /// A device-local storage buffer holding `bytes` of `data` (at least 16 bytes, zero-padded),
 /// copied through a staging buffer and waited for; `extra_usage` is added to the storage and
 /// transfer usages (VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT for what is read by address).

@@ -28,7 +28,8 @@ void ComputeToCompute(VkCommandBuffer cmd) {
 
 }  // namespace
 
-GaussianLodCut::GaussianLodCut(const VulkanContext& context) : context_(context) {
+GaussianLodCut::GaussianLodCut(const VulkanContext& context)
+    : context_(context), max_groups_x_(context.GetDeviceInfo().max_compute_workgroups_x) {
     set_layout_ = CreateStorageBufferPushLayout(context, kLodNumBindings);
     pipeline_layout_ =
         CreatePipelineLayout(context, set_layout_.Get(), sizeof(GaussianLodPushConstants));
@@ -101,7 +102,8 @@ void GaussianLodCut::PushBindings(VkCommandBuffer cmd, const LodCutBuffers& buff
 
 void GaussianLodCut::Dispatch(VkCommandBuffer cmd, uint32_t pass, uint32_t groups) const {
     vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, passes_[pass].Get());
-    vkCmdDispatch(cmd, groups, 1, 1);
+    const uvec4 grid = DispatchGridFor(groups, max_groups_x_);
+    vkCmdDispatch(cmd, grid.x, grid.y, 1);
 }
 
 void GaussianLodCut::RecordWalk(VkCommandBuffer cmd, const LodCutBuffers& buffers) const {
@@ -155,7 +157,7 @@ void GaussianLodCut::Record(VkCommandBuffer cmd, const LodCutBuffers& buffers,
                         VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
     PushBindings(cmd, buffers);
     const GaussianLodPushConstants push{buffers.num_leaves, buffers.num_inner, buffers.list_slots,
-                                        walk ? 1u : 0u};
+                                        walk ? 1u : 0u, max_groups_x_};
     vkCmdPushConstants(cmd, pipeline_layout_.Get(), VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(push),
                        &push);
     // A hierarchy of one splat has no inner node: the sizes and buckets passes do nothing,

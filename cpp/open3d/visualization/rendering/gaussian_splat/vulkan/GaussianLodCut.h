@@ -79,6 +79,7 @@ private:
     void RecordWalk(VkCommandBuffer cmd, const LodCutBuffers& buffers) const;
 
     const VulkanContext& context_;
+    uint32_t max_groups_x_;  // the device's maxComputeWorkGroupCount[0] (DispatchGridFor)
     UniqueDescriptorSetLayout set_layout_;
     UniquePipelineLayout pipeline_layout_;
     std::array<UniquePipeline, shader::kLodNumPasses> passes_;  // by kLodPass* value

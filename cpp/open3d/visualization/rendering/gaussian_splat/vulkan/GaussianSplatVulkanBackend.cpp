@@ -215,10 +215,9 @@ void GaussianSplatVulkanBackend::WriteSceneSplatRanges(
 
 int64_t GaussianSplatVulkanBackend::MaxSceneSplats() const {
     // The depth sort over a slot per splat (its keys and the other per-splat words within one
-    // binding), and the per-splat passes' one dispatch; the splats' own words are read by
-    // device address.
-    return static_cast<int64_t>(
-        std::min<uint64_t>(SortMaxCount(), MaxSplatsPerDispatch(context_->GetDeviceInfo())));
+    // binding); the splats' own words are read by device address, and the per-splat passes
+    // lay their workgroups out in rows past maxComputeWorkGroupCount[0] (DispatchGridFor).
+    return static_cast<int64_t>(SortMaxCount());
 }
 
 void GaussianSplatVulkanBackend::ApplyStreamStep(const SplatStreamStep& step) {

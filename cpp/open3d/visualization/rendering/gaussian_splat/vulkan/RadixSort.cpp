@@ -92,20 +92,22 @@ RadixSort::RadixSort(const VulkanContext& context) : context_(&context) {
     copy_ = create(spirv::kRadixSortCopy, "radix_sort_copy");
 }
 
-uint32_t RadixSort::MaxCountFor(uint32_t max_workgroups_x, uint64_t max_storage_buffer_range) {
-    // A large sort's blocks hold kRadixSortBlockSize pairs, one workgroup each (MaxBlocks).
-    const uint64_t by_dispatch = uint64_t(max_workgroups_x) * kRadixSortBlockSize;
+uint32_t RadixSort::MaxCountFor(uint64_t max_storage_buffer_range) {
     // Keys and values are bound whole. The histogram, 1 + blocks uints per digit, takes about
     // half a byte per pair, so it never binds first.
     const uint64_t by_keys = max_storage_buffer_range / 4;
-    return static_cast<uint32_t>(std::min<uint64_t>({by_dispatch, by_keys, kMaxCount}));
+    return static_cast<uint32_t>(std::min<uint64_t>(by_keys, kMaxCount));
 }
 
 uint32_t RadixSort::MaxCountFor(const VulkanDeviceInfo& info) {
-    return MaxCountFor(info.max_compute_workgroups_x, info.max_storage_buffer_range);
+    return MaxCountFor(info.max_storage_buffer_range);
 }
 
 uint32_t RadixSort::GetMaxCount() const { return MaxCountFor(context_->GetDeviceInfo()); }
+
+uint32_t RadixSort::GetMaxGroupsX() const {
+    return context_->GetDeviceInfo().max_compute_workgroups_x;
+}
 
 RadixSortStorageRequirements RadixSort::GetStorageRequirements(uint32_t max_count) {
     if (max_count > kMaxCount) {
@@ -138,10 +140,9 @@ void RadixSort::CheckArguments(const BufferRange& keys, const BufferRange& value
     if (max_count > GetMaxCount()) {
         const VulkanDeviceInfo& info = context_->GetDeviceInfo();
         core::ThrowError(
-            "RadixSort: max_count {} exceeds the {} pairs {} sorts (maxComputeWorkGroupCount[0] "
-            "{}, maxStorageBufferRange {} bytes)",
-            max_count, GetMaxCount(), info.name, info.max_compute_workgroups_x,
-            info.max_storage_buffer_range);
+            "RadixSort: max_count {} exceeds the {} pairs {} sorts (its keys within one "
+            "binding of maxStorageBufferRange {} bytes, at most {})",
+            max_count, GetMaxCount(), info.name, info.max_storage_buffer_range, kMaxCount);
     }
     const RadixSortStorageRequirements need = GetStorageRequirements(max_count);
     const VkDeviceSize alignment = context_->GetDeviceInfo().min_storage_buffer_offset_alignment;
@@ -209,6 +210,7 @@ void RadixSort::Record(VkCommandBuffer cmd, const BufferRange& keys, const Buffe
     push.target_blocks = GetTargetBlocks();
     push.num_passes = num_passes;
     push.values_only = output == Output::kValuesOnly ? 1u : 0u;
+    push.max_groups_x = GetMaxGroupsX();
 
     const VkPipelineLayout layout = pipeline_layout_.Get();
     const auto bind = [&](const BufferRange& keys_in, const BufferRange& values_in,

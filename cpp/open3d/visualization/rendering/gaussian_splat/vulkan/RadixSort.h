@@ -56,17 +56,19 @@ public:
     /// Largest max_count on any device: the sort's uint arithmetic (element and histogram
     /// indices, RadixSortParamsFor) stays below 2^31. A device takes at most GetMaxCount().
     static constexpr uint32_t kMaxCount = 1u << 30;
-    /// Largest max_count of a device with the given limits: ceil(max_count /
-    /// kRadixSortBlockSize) workgroups within maxComputeWorkGroupCount[0] (65535 on lavapipe,
-    /// 2^31 - 1 on NVIDIA: 134,215,680 or kMaxCount), the keys and values within one storage
-    /// binding (maxStorageBufferRange: 2^27 bytes on lavapipe, 2^32 - 1 on NVIDIA), and at
-    /// most kMaxCount.
-    static uint32_t MaxCountFor(uint32_t max_workgroups_x, uint64_t max_storage_buffer_range);
+    /// Largest max_count of a device with the given limit: the keys and values within one
+    /// storage binding (maxStorageBufferRange: 2^27 bytes on lavapipe, 2^32 - 1 on NVIDIA),
+    /// and at most kMaxCount. The blocks' workgroups are laid out in rows where they pass
+    /// maxComputeWorkGroupCount[0] (DispatchGridFor), so that limit bounds nothing.
+    static uint32_t MaxCountFor(uint64_t max_storage_buffer_range);
     /// MaxCountFor a device's reported limits: 33,554,432 pairs on lavapipe, 1,073,741,823 on
     /// an H200.
     static uint32_t MaxCountFor(const VulkanDeviceInfo& info);
     /// MaxCountFor this sorter's device.
     uint32_t GetMaxCount() const;
+    /// The device's maxComputeWorkGroupCount[0], which RadixSortParamsFor takes: producers
+    /// that write the parameters themselves pass it.
+    uint32_t GetMaxGroupsX() const;
 
     /// Creates the pipelines. Throws core::Open3DError when the device's subgroups can be
     /// smaller than 4 invocations (the shaders size shared arrays by subgroup count).
@@ -86,7 +88,8 @@ public:
     /// Who writes `scratch.params` before the passes.
     enum class Params {
         kSetupPass,  ///< the sort's own setup dispatch, from the GPU count at `count`
-        /// The producer already wrote RadixSortParamsFor(count, max_count, GetTargetBlocks())
+        /// The producer already wrote RadixSortParamsFor(count, max_count, GetTargetBlocks(),
+        /// GetMaxGroupsX())
         /// (from a shader, or from the host with vkCmdUpdateBuffer) and made it visible to
         /// COMPUTE_SHADER and DRAW_INDIRECT reads: one dispatch fewer. `count` is not read
         /// (but by the setup after the first pass of kFromKeyRange without a DropMaxKeys).

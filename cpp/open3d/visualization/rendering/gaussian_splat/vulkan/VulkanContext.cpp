@@ -311,6 +311,7 @@ std::unique_ptr<VulkanContext> VulkanContext::CreateHeadless(const VulkanContext
                             : std::nullopt,
                         EnvironmentSwitchOn("OPEN3D_VULKAN_HOST_IMPORT") &&
                             chosen.HasExtension(VK_EXT_EXTERNAL_MEMORY_HOST_EXTENSION_NAME));
+    context->LimitWorkgroupsX(options.max_workgroups_x);
     return context;
 }
 
@@ -350,7 +351,13 @@ std::unique_ptr<VulkanContext> VulkanContext::CreateFromBorrowed(
     context->InitDevice(handles.physical_device, handles.queue_family_index,
                         handles.external_memory_fd_enabled, std::nullopt,
                         handles.host_memory_import_enabled);
+    context->LimitWorkgroupsX(handles.max_workgroups_x);
     return context;
+}
+
+void VulkanContext::LimitWorkgroupsX(uint32_t max_workgroups_x) {
+    if (max_workgroups_x == 0) return;
+    info_.max_compute_workgroups_x = std::min(info_.max_compute_workgroups_x, max_workgroups_x);
 }
 
 void VulkanContext::InitDevice(VkPhysicalDevice physical_device, uint32_t queue_family_index,

@@ -31,6 +31,11 @@ struct VulkanContextOptions {
     /// Uses the first suitable device whose name contains this text; empty picks the best
     /// (discrete > integrated > virtual > CPU). Env OPEN3D_VULKAN_DEVICE overrides it.
     std::string device_name_filter;
+    /// Treats the device as if its maxComputeWorkGroupCount[0] were at most this (0: as
+    /// reported). Every pass then lays out its workgroups in rows of at most this many
+    /// (DispatchGridFor), as on a device at Vulkan's minimum of 65,535: tests run those
+    /// layouts on small scenes with it.
+    uint32_t max_workgroups_x = 0;
 };
 
 /// Handles owned by a host application that the context uses without destroying them.
@@ -53,6 +58,8 @@ struct BorrowedVulkanHandles {
     /// use beside `queue`; VK_NULL_HANDLE for none.
     VkQueue transfer_queue = VK_NULL_HANDLE;
     uint32_t transfer_queue_family_index = 0;
+    /// As VulkanContextOptions::max_workgroups_x.
+    uint32_t max_workgroups_x = 0;
 };
 
 /// What the device is, as reported in the log at creation.
@@ -69,8 +76,10 @@ struct VulkanDeviceInfo {
     uint32_t max_compute_shared_memory = 0;  ///< bytes per workgroup
     uint64_t min_storage_buffer_offset_alignment = 0;  ///< bytes
     uint64_t max_storage_buffer_range = 0;             ///< bytes one storage binding may span
-    uint32_t max_compute_workgroups_x = 0;  ///< maxComputeWorkGroupCount[0] of one dispatch
-    float timestamp_period_ns = 0.0f;       ///< 0 when timestamps are unsupported
+    /// maxComputeWorkGroupCount[0] of one dispatch (or VulkanContextOptions::max_workgroups_x
+    /// where lower): passes past it lay their workgroups out in rows (DispatchGridFor).
+    uint32_t max_compute_workgroups_x = 0;
+    float timestamp_period_ns = 0.0f;  ///< 0 when timestamps are unsupported
     uint32_t queue_family_index = 0;
     /// VkPhysicalDeviceIDProperties: another API (GL) sharing memory with this device must
     /// report the same UUIDs.
@@ -161,6 +170,8 @@ public:
 
 private:
     VulkanContext();
+    // VulkanContextOptions::max_workgroups_x (0: nothing changes).
+    void LimitWorkgroupsX(uint32_t max_workgroups_x);
     void InitDevice(VkPhysicalDevice physical_device, uint32_t queue_family_index,
                     bool external_memory_fd, std::optional<uint32_t> transfer_family = std::nullopt,
                     bool host_memory_import = false);
