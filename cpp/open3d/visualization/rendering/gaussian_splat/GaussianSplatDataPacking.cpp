@@ -125,14 +125,23 @@ PackedGaussianSplats PackGaussianSplatAttrs(const t::geometry::PointCloud& cloud
 void PackGaussianSplatAttrsInto(const t::geometry::PointCloud& cloud,
                                 const PackedGaussianSplats& layout, PackedSplatSpans out,
                                 Eigen::Vector3d& center_min, Eigen::Vector3d& center_max) {
+    PackGaussianSplatRangeInto(cloud, 0, cloud.NumPoints(), layout, out, center_min, center_max);
+}
+
+void PackGaussianSplatRangeInto(const t::geometry::PointCloud& cloud, int64_t begin, int64_t end,
+                                const PackedGaussianSplats& layout, PackedSplatSpans out,
+                                Eigen::Vector3d& center_min, Eigen::Vector3d& center_max) {
     const t::geometry::GaussianSplatArrays a = cloud.GetGaussianSplatArrays();  // validates
+    if (begin < 0 || begin > end || end > a.num_points) {
+        core::ThrowError("packing splats [{}, {}) of a cloud of {}", begin, end, a.num_points);
+    }
     if (a.sh_degree < layout.sh_degree) {
         core::ThrowError("packing splats of SH degree {} at degree {}", a.sh_degree,
                          layout.sh_degree);
     }
     const int rest_values = 3 * t::geometry::NumSHRestCoeffs(layout.sh_degree);
     std::vector<double> values(std::max(10, rest_values));
-    for (int64_t i = 0; i < a.num_points; ++i) {
+    for (int64_t i = begin; i < end; ++i) {
         for (int c = 0; c < 3; ++c) *out.positions++ = a.positions[3 * i + c];
         const Eigen::Vector3d center(a.positions[3 * i], a.positions[3 * i + 1],
                                      a.positions[3 * i + 2]);

@@ -82,6 +82,11 @@ struct PackedSplatSpans {
 void PackGaussianSplatAttrsInto(const t::geometry::PointCloud& cloud,
                                 const PackedGaussianSplats& layout, PackedSplatSpans out,
                                 Eigen::Vector3d& center_min, Eigen::Vector3d& center_max);
+/// PackGaussianSplatAttrsInto for the cloud's splats [begin, end) alone, written from the
+/// start of `out` (a large scene packed a part per thread).
+void PackGaussianSplatRangeInto(const t::geometry::PointCloud& cloud, int64_t begin, int64_t end,
+                                const PackedGaussianSplats& layout, PackedSplatSpans out,
+                                Eigen::Vector3d& center_min, Eigen::Vector3d& center_max);
 
 /// Sets (visible = true) or clears the bits of splats [begin, end) in a visibility mask.
 void SetSplatVisibility(std::vector<uint32_t>& mask, int64_t begin, int64_t end, bool visible);

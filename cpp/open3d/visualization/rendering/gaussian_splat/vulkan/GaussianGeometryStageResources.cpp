@@ -90,6 +90,71 @@ void GeometryStageResources::UploadScene(const VulkanContext& context, const Com
     SetLayout(packed, packed.num_splats);
 }
 
+void GeometryStageResources::UploadSceneInParts(const VulkanContext& context,
+                                                const CommandPool& pool,
+                                                const t::geometry::PointCloud& cloud,
+                                                SplatPrecision precision,
+                                                const std::vector<uint32_t>& mask) {
+    const t::geometry::GaussianSplatArrays arrays = cloud.GetGaussianSplatArrays();  // validates
+    const int64_t n = arrays.num_points;
+    if (n > static_cast<int64_t>(std::numeric_limits<uint32_t>::max())) {
+        core::ThrowError("uploading {} splats: at most 2^32 - 1 fit a splat index", n);
+    }
+    AllocateScene(context, pool, PackedSplatLayout(arrays.sh_degree, precision), n);
+    // One staging buffer for a submission's parts: its positions, then shape, then SH words.
+    const int64_t per_submission = std::min(n, kUploadPartSplats * kUploadPartsPerSubmission);
+    const VkDeviceSize position_bytes = 4 * sizeof(float);
+    const VkDeviceSize shape_bytes = layout_.shape_words_per_splat * 4;
+    const VkDeviceSize sh_bytes = layout_.sh_words_per_splat * 4;
+    const VkDeviceSize splat_bytes = position_bytes + shape_bytes + sh_bytes;
+    Buffer staging(context, std::max<VkDeviceSize>(per_submission * splat_bytes, 16),
+                   VK_BUFFER_USAGE_TRANSFER_SRC_BIT, MemoryUsage::kHostUpload);
+    auto* bytes = static_cast<uint8_t*>(staging.GetMapped());
+    for (int64_t first = 0; first < n; first += per_submission) {
+        const int64_t count = std::min(per_submission, n - first);
+        const VkDeviceSize shape_base = count * position_bytes;
+        const VkDeviceSize sh_base = shape_base + count * shape_bytes;
+        const int64_t parts = (count + kUploadPartSplats - 1) / kUploadPartSplats;
+        std::vector<Eigen::Vector3d> mins(parts, layout_.center_min),
+            maxs(parts, layout_.center_max);
+        core::ParallelFor(
+            parts,
+            [&](int64_t k) {
+                const int64_t offset = k * kUploadPartSplats;
+                const int64_t end = std::min(offset + kUploadPartSplats, count);
+                PackGaussianSplatRangeInto(
+                    cloud, first + offset, first + end, layout_,
+                    {reinterpret_cast<float*>(bytes + offset * position_bytes),
+                     reinterpret_cast<uint32_t*>(bytes + shape_base + offset * shape_bytes),
+                     reinterpret_cast<uint32_t*>(bytes + sh_base + offset * sh_bytes)},
+                    mins[size_t(k)], maxs[size_t(k)]);
+            },
+            1);
+        for (int64_t k = 0; k < parts; ++k) {
+            layout_.center_min = layout_.center_min.cwiseMin(mins[size_t(k)]);
+            layout_.center_max = layout_.center_max.cwiseMax(maxs[size_t(k)]);
+        }
+        SubmitAndWait(context, pool, [&](VkCommandBuffer cmd) {
+            const VkDeviceSize at = static_cast<VkDeviceSize>(first);
+            const VkBufferCopy to_positions{0, at * position_bytes, count * position_bytes};
+            const VkBufferCopy to_shape{shape_base, at * shape_bytes, count * shape_bytes};
+            vkCmdCopyBuffer(cmd, staging.Get(), positions.Get(), 1, &to_positions);
+            vkCmdCopyBuffer(cmd, staging.Get(), shape.Get(), 1, &to_shape);
+            if (sh_bytes > 0) {
+                const VkBufferCopy to_sh{sh_base, at * sh_bytes, count * sh_bytes};
+                vkCmdCopyBuffer(cmd, staging.Get(), sh.Get(), 1, &to_sh);
+            }
+        });
+    }
+    if (mask.empty()) {
+        std::vector<uint32_t> shown((static_cast<size_t>(n) + 31) / 32, 0u);
+        SetSplatVisibility(shown, 0, n, true);
+        UploadVisibility(context, pool, shown);
+    } else {
+        UploadVisibility(context, pool, mask);
+    }
+}
+
 void GeometryStageResources::SetLayout(const PackedGaussianSplats& like, int64_t num_splats) {
     layout_.precision = like.precision;
     layout_.num_splats = num_splats;

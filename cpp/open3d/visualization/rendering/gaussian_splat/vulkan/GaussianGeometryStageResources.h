@@ -67,6 +67,17 @@ public:
     /// binding must name a buffer) and keeps the packing's sizes.
     void UploadScene(const VulkanContext& context, const CommandPool& pool,
                      const PackedGaussianSplats& packed);
+    /// Packs and uploads a valid cloud at `precision` (its SH degree), part by part: parts of
+    /// kUploadPartSplats packed in parallel straight into one staging buffer of
+    /// kUploadPartsPerSubmission parts, copied and waited for in turn. The host then holds
+    /// the staging (about 160 MB), not a packed copy of the scene (152 bytes a splat, 22 GB
+    /// for 144.5M splats). `mask` is the visibility mask (empty: every splat shown). The
+    /// words are PackGaussianSplatAttrs's, bit for bit.
+    void UploadSceneInParts(const VulkanContext& context, const CommandPool& pool,
+                            const t::geometry::PointCloud& cloud, SplatPrecision precision,
+                            const std::vector<uint32_t>& mask);
+    static constexpr int64_t kUploadPartSplats = 65536;
+    static constexpr int64_t kUploadPartsPerSubmission = 16;
     /// Zero-filled buffers for `capacity` splats packed like `like` (its words per splat,
     /// precision, degree and centre bounds), every splat hidden: a scene whose splats are
     /// written later (WriteSplats).

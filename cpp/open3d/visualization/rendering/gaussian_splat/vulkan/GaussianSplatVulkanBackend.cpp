@@ -92,6 +92,12 @@ GaussianSplatVulkanBackend::~GaussianSplatVulkanBackend() {
 
 void GaussianSplatVulkanBackend::SetScene(const t::geometry::PointCloud& cloud) {
     cloud.ValidateGaussianSplat();
+    // The backend keeps a host copy (re-packed when the storage precision changes); the
+    // upload itself packs through a staging buffer of at most a million splats.
+    core::RequireHostMemory(static_cast<uint64_t>(cloud.NumBytes()),
+                            fmt::format("vulkan backend: a host copy of {} splats",
+                                        cloud.NumPoints()),
+                            "fewer splats");
     if (geometry_.in_flight) Wait(*context_, geometry_stage_fence_.Get());
     geometry_ = GeometryState{};
     cloud_ = cloud;
@@ -232,18 +238,9 @@ void GaussianSplatVulkanBackend::ApplyStreamStep(const SplatStreamStep& step) {
 void GaussianSplatVulkanBackend::UploadScene(SplatPrecision precision) {
     RetireSceneBuffers(false);
     ++scene_serial_;
-    {
-        // The packed copy is about as large as the cloud's attributes (compact: about half).
-        const uint64_t cloud_bytes = cloud_->NumBytes();
-        core::RequireHostMemory(
-            precision == SplatPrecision::kCompact ? cloud_bytes / 2 : cloud_bytes,
-            fmt::format("vulkan backend: packing {} splats for upload", cloud_->NumPoints()),
-            precision == SplatPrecision::kCompact ? "fewer splats"
-                                                  : "compact storage needs about half");
-    }
-    PackedGaussianSplats packed = PackGaussianSplatAttrs(*cloud_, precision);
-    if (!visibility_mask_.empty()) packed.visibility = visibility_mask_;
-    geometry_stage_resources_.UploadScene(*context_, pool_, packed);
+    // Packed a part at a time into a staging buffer (no packed copy of the scene on the host).
+    geometry_stage_resources_.UploadSceneInParts(*context_, pool_, *cloud_, precision,
+                                                 visibility_mask_);
     ++counters_.scene_uploads;
 }
 
