@@ -94,10 +94,9 @@ void GaussianSplatVulkanBackend::SetScene(const t::geometry::PointCloud& cloud) 
     cloud.ValidateGaussianSplat();
     // The backend keeps a host copy (re-packed when the storage precision changes); the
     // upload itself packs through a staging buffer of at most a million splats.
-    core::RequireHostMemory(static_cast<uint64_t>(cloud.NumBytes()),
-                            fmt::format("vulkan backend: a host copy of {} splats",
-                                        cloud.NumPoints()),
-                            "fewer splats");
+    core::RequireHostMemory(
+        static_cast<uint64_t>(cloud.NumBytes()),
+        fmt::format("vulkan backend: a host copy of {} splats", cloud.NumPoints()), "fewer splats");
     if (geometry_.in_flight) Wait(*context_, geometry_stage_fence_.Get());
     geometry_ = GeometryState{};
     cloud_ = cloud;
