@@ -539,12 +539,7 @@ TEST_F(RadixSortTest, SortsWithBlocksInRowsPastTheWorkgroupLimit) {
     // per-block pass (histogram, scatter, the odd pass count's copy) out in rows, with spare
     // workgroups in the last row. It must sort as std::stable_sort does, with the setup's
     // parameters and with the producer's, with dropped keys and the key range's passes.
-    BorrowedVulkanHandles handles;
-    handles.instance = Context().GetInstance();
-    handles.physical_device = Context().GetPhysicalDevice();
-    handles.device = Context().GetDevice();
-    handles.queue = Context().GetQueue();
-    handles.queue_family_index = Context().GetQueueFamilyIndex();
+    BorrowedVulkanHandles handles = BorrowedHandles();
     handles.max_workgroups_x = 3;
     const std::unique_ptr<VulkanContext> narrow = VulkanContext::CreateFromBorrowed(handles);
     std::unique_ptr<RadixSort> rows = std::make_unique<RadixSort>(*narrow);
