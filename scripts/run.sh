@@ -7,22 +7,23 @@
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 build_dir="${BUILD_DIR:-$root/build}"
-mkdir -p "$build_dir"
-# Quiet build; on failure show what went wrong.
-if ! bash "$root/scripts/build.sh" >"$build_dir/build.log" 2>&1; then
-  tail -n 40 "$build_dir/build.log" >&2
-  echo "run.sh: the build failed (full log: $build_dir/build.log)" >&2
-  exit 1
-fi
+# Only what this script runs: gs-render, and the viewer when a display is there to show it
+# (the tests and the Python package are built by scripts/test.sh and scripts/build.sh).
+targets="gs-render"
+if [ $# -eq 0 ] && [ -n "${DISPLAY:-}" ]; then targets="GaussianSplat"; fi
+echo "run.sh: building $targets (build.sh prints each phase)"
+BUILD_TARGETS="$targets" bash "$root/scripts/build.sh"
 if [ $# -eq 0 ]; then
   if [ -n "${DISPLAY:-}" ]; then
     # A display: the interactive viewer on the default scene with a red sphere.
+    echo "run.sh: opening the viewer on the built-in default scene"
     exec "$build_dir/bin/GaussianSplat"
   fi
   echo "run.sh: no display (DISPLAY is unset), so the default scene is rendered to a PNG" \
        "instead of opening the viewer (build/bin/GaussianSplat)."
   set -- --sphere --output "$build_dir/default_scene.png" --depth-output "$build_dir/default_scene_depth.png"
 fi
+echo "run.sh: rendering: gs-render $*"
 if [ -z "${DISPLAY:-}" ] && command -v xvfb-run >/dev/null; then
   exec xvfb-run -a -s "-screen 0 1280x1024x24" "$build_dir/bin/gs-render" "$@"
 fi

@@ -1,21 +1,16 @@
 #!/usr/bin/env bash
-# The CPU and lavapipe tests under AddressSanitizer + UndefinedBehaviorSanitizer (a second
-# build in $BUILD_DIR, default build-asan). Run by CI after README command 2.
+# The CPU and lavapipe tests under AddressSanitizer + UndefinedBehaviorSanitizer (clang-14, a
+# second build in $BUILD_DIR, default build-asan, shared with scripts/fuzz.sh:
+# scripts/sanitized-build.sh). Run by CI after README command 2.
 # The Vulkan validation layer stays off here: with it loaded LeakSanitizer reports
 # allocations it cannot attribute (docs/environment-notes.md); the main test run keeps
 # validation on. Extra arguments go to ctest.
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 build_dir="${BUILD_DIR:-$root/build-asan}"
-bash "$root/scripts/setup.sh"
-# -O1 -g1: line tables for the reports at 60% of the -O2 -g compile time (a 2-core CI
-# machine spends most of this script compiling: 15 s -> 9 s for VulkanBackendTest.cpp).
-cmake -S "$root" -B "$build_dir" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DOPEN3D_SANITIZE=ON \
-  -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1 -DNDEBUG" -DCMAKE_C_FLAGS_RELWITHDEBINFO="-O1 -g1 -DNDEBUG" \
-  -DOPEN3D_BUILD_BENCHMARKS=OFF >/dev/null
-cmake --build "$build_dir" -j"$(nproc)" --target tests_core tests_geometry tests_io tests_camera \
-  tests_gaussian_splat tests_gaussian_splat_cpu tests_gaussian_splat_vulkan gs-render gs-convert \
-  gs-bench
+BUILD_DIR="$build_dir" bash "$root/scripts/sanitized-build.sh" tests_core tests_geometry tests_io \
+  tests_camera tests_gaussian_splat tests_gaussian_splat_cpu tests_gaussian_splat_vulkan \
+  gs-render gs-convert gs-bench
 cd "$build_dir"
 export OPEN3D_VULKAN_VALIDATION=0
 export ASAN_OPTIONS="detect_leaks=1:abort_on_error=1"

@@ -116,23 +116,26 @@ def test_rendering_releases_the_gil(data):
     r.scene.add_geometry("playbot", pcd)
     r.setup_camera(o3d.camera.read_cameras_json(str(data("playbot/cameras.json")))[0].camera)
     done = threading.Event()
+    rendering = False
     ticks = 0
 
     def count():
         nonlocal ticks
         while not done.is_set():
-            ticks += 1
+            ticks += rendering
             time.sleep(0.001)
 
     thread = threading.Thread(target=count)
     thread.start()
-    start = time.monotonic()
+    rendering = True
     r.render_to_image()
-    seconds = time.monotonic() - start
+    rendering = False
     done.set()
     thread.join()
-    # With the GIL held the counter would stand still for the whole render.
-    assert ticks > 10 * seconds, (ticks, seconds)
+    # Counted only while the render runs: with the GIL held the counter could tick only at
+    # the switches just before the call enters C++ and just after it returns (two at most);
+    # released, it ticks all along (hundreds in a one-second render, dozens on a busy machine).
+    assert ticks >= 5, ticks
 
 
 def test_knobs_as_keyword_arguments(data, backend):

@@ -64,6 +64,8 @@ struct Options {
     bool stream_compact = false;  // --stream-compact: the pool at half precision
     int64_t page_capacity = 65536;
     int64_t reads_per_step = 16;
+    double warm_up_seconds = -1.0;  // --warm-up, < 0: until the GPU time settles
+    int wall_frames = 50;           // --wall-frames
 };
 
 struct Knob {
@@ -217,16 +219,16 @@ rendering::RenderStats MedianHost(const std::vector<rendering::RenderStats>& fra
     return m;
 }
 
-// Times `frames` frames (geometry stage + composite stage, no readback) after at least
-// kWarmUpSeconds of the same frames, and returns the median of each GPU pass and of the CPU wall
-// time per frame. Frames follow each other with only the submit/fence gap, so a GPU that lowers its
-// clocks when idle (every NVIDIA board does) is timed at full clock: with a readback between frames
-// the H100 ran the same depth sort 2.5-5x slower. (Run loops time everything before the CPU
-// references: see Run.)
+// Times `frames` frames (geometry stage + composite stage, no readback) after warm-up frames
+// (`warm_up_seconds` of them, or with a negative value until the GPU time settles), and returns the
+// median of each GPU pass and of the CPU wall time per frame. Frames follow each other with only
+// the submit/fence gap, so a GPU that lowers its clocks when idle (every NVIDIA board does) is
+// timed at full clock: with a readback between frames the H100 ran the same depth sort 2.5-5x
+// slower. (Run loops time everything before the CPU references: see Run.)
 TimedFrames RunTimedFrames(rendering::GaussianSplatBackend& backend,
                            const camera::PinholeCamera& camera,
                            const rendering::RenderConfig& config, int frames,
-                           const std::string& depth) {
+                           const std::string& depth, double warm_up_seconds) {
     constexpr double kWarmUpSeconds = 1.0;
     rendering::CompositeInputs no_readback;
     no_readback.read_back = false;
@@ -247,7 +249,9 @@ TimedFrames RunTimedFrames(rendering::GaussianSplatBackend& backend,
     // cycle is only ~25%) to reach full clocks: a fixed 1 s warm-up left rows 1.6x slow.
     const auto warm_start = std::chrono::steady_clock::now();
     double previous = INFINITY;
-    while (core::MillisecondsSince(warm_start) < 10000.0) {
+    while (warm_up_seconds >= 0.0 && core::MillisecondsSince(warm_start) < 1000.0 * warm_up_seconds)
+        frame();
+    while (warm_up_seconds < 0.0 && core::MillisecondsSince(warm_start) < 10000.0) {
         std::vector<double> window;
         for (int i = 0; i < 20; ++i) {
             const rendering::RenderStats s = frame();
@@ -318,13 +322,13 @@ rendering::RenderConfig TimedConfig(const Options& opt) {
 }
 
 // Wall ms per frame with frames in flight over `cams`, colour only, without and with the
-// RGBA32F readback, each over max(50, --repeat) frames.
+// RGBA32F readback, each over max(--wall-frames, --repeat) frames.
 std::pair<double, double> PipelinedMs(const Options& opt,
                                       rendering::vulkan::GaussianSplatVulkanBackend& vulkan,
                                       const std::vector<camera::PinholeCamera>& cams,
                                       const rendering::RenderConfig& config) {
     rendering::BatchOptions colour;  // colour only, as the timed frames
-    const int frames = std::max(50, opt.repeat);
+    const int frames = std::max(opt.wall_frames, opt.repeat);
     colour.read_back = false;
     const double no_readback = bench::PipelinedMsPerFrame(vulkan, cams, config, colour, frames);
     colour.read_back = true;
@@ -526,8 +530,8 @@ void AddLodRows(const Options& opt, const std::vector<int64_t>& budgets, const S
             const rendering::RenderOutput out = lod_backend->Render(cams[v], config);
             if (vulkan != nullptr)
                 row.lod_nodes += static_cast<double>(out.stats.lod_cut_nodes) / n;
-            const TimedFrames timed =
-                RunTimedFrames(*lod_backend, cams[v], config, opt.repeat, opt.depth);
+            const TimedFrames timed = RunTimedFrames(*lod_backend, cams[v], config, opt.repeat,
+                                                     opt.depth, opt.warm_up_seconds);
             AddView(row, timed, out.stats, cams.size());
             row.bytes_per_splat += static_cast<double>(out.stats.gpu_scene_bytes) / scene_nodes / n;
             if (vulkan != nullptr) {
@@ -693,8 +697,8 @@ int Run(const Options& opt) {
                     // One full frame for the error columns, then timed frames without
                     // readback (per-pass medians).
                     rendering::RenderOutput out = backend->Render(cams[v], config);
-                    const TimedFrames timed =
-                        RunTimedFrames(*backend, cams[v], config, opt.repeat, opt.depth);
+                    const TimedFrames timed = RunTimedFrames(*backend, cams[v], config, opt.repeat,
+                                                             opt.depth, opt.warm_up_seconds);
                     AddView(row, timed, out.stats, cams.size());
                     row.bytes_per_splat =
                         static_cast<double>(out.stats.gpu_scene_bytes) / row.splats;
@@ -706,34 +710,38 @@ int Run(const Options& opt) {
                         PipelinedMs(opt, *vulkan, cams, config);
                     if (opt.batch > 0) {
                         const int repeats = 5;
+                        const double batch_warm_up =
+                            opt.warm_up_seconds < 0.0 ? 1.0 : opt.warm_up_seconds;
                         rendering::BatchOptions o;
-                        const bench::BatchThroughput f =
-                            bench::MeasureBatch(*vulkan, cams, config, o, opt.batch, repeats);
+                        const bench::BatchThroughput f = bench::MeasureBatch(
+                            *vulkan, cams, config, o, opt.batch, repeats, batch_warm_up);
                         // Into the caller's memory, allocated and faulted in once (what
                         // Python's render_batch(out=...) does).
                         std::vector<uint8_t> buffer(size_t(opt.batch) * cams[0].width *
                                                     cams[0].height * 16);
                         o.color_destination = buffer.data();
-                        const bench::BatchThroughput b =
-                            bench::MeasureBatch(*vulkan, cams, config, o, opt.batch, repeats);
+                        const bench::BatchThroughput b = bench::MeasureBatch(
+                            *vulkan, cams, config, o, opt.batch, repeats, batch_warm_up);
                         o.color_destination = nullptr;
                         row.batch_float_into_buffer_vps = b.views_per_second;
                         // Into memory the device copies into directly (imported where the
                         // device can: no host copy at all).
                         o.color_memory = rendering::BatchHostMemory(buffer.size());
                         row.batch_float_host_memory_vps =
-                            bench::MeasureBatch(*vulkan, cams, config, o, opt.batch, repeats)
+                            bench::MeasureBatch(*vulkan, cams, config, o, opt.batch, repeats,
+                                                batch_warm_up)
                                 .views_per_second;
                         o.color_uint8 = true;
                         row.batch_uint8_host_memory_vps =
-                            bench::MeasureBatch(*vulkan, cams, config, o, opt.batch, repeats)
+                            bench::MeasureBatch(*vulkan, cams, config, o, opt.batch, repeats,
+                                                batch_warm_up)
                                 .views_per_second;
                         o.color_memory = rendering::BatchHostMemory();
-                        const bench::BatchThroughput u =
-                            bench::MeasureBatch(*vulkan, cams, config, o, opt.batch, repeats);
+                        const bench::BatchThroughput u = bench::MeasureBatch(
+                            *vulkan, cams, config, o, opt.batch, repeats, batch_warm_up);
                         o.read_back = false;
-                        const bench::BatchThroughput g =
-                            bench::MeasureBatch(*vulkan, cams, config, o, opt.batch, repeats);
+                        const bench::BatchThroughput g = bench::MeasureBatch(
+                            *vulkan, cams, config, o, opt.batch, repeats, batch_warm_up);
                         row.batch_float_vps = f.views_per_second;
                         row.batch_uint8_vps = u.views_per_second;
                         row.batch_gpu_only_vps = g.views_per_second;
@@ -923,6 +931,16 @@ int main(int argc, char** argv) {
                    "Timed frames per view and knob (medians, after warm-up frames until the GPU "
                    "time settles)")
         ->check(CLI::Range(1, 10000))
+        ->capture_default_str();
+    app.add_option("--warm-up", opt.warm_up_seconds,
+                   "Seconds of warm-up frames before each timed row (and batch measurement); "
+                   "default: until the GPU time stops falling (1-10 s; batches 1 s). 0 times "
+                   "at once: for smoke tests, not for numbers")
+        ->check(CLI::Range(0.0, 600.0));
+    app.add_option("--wall-frames", opt.wall_frames,
+                   "Vulkan: frames of each frames-in-flight wall-clock measurement (at least "
+                   "--repeat)")
+        ->check(CLI::Range(1, 100000))
         ->capture_default_str();
     app.add_option("--knobs", opt.knobs, "Comma list of knobs or 'all'")->capture_default_str();
     app.add_option("--depth", opt.depth,

@@ -44,14 +44,14 @@ double PipelinedMsPerFrame(GaussianSplatVulkanBackend& backend,
 BatchThroughput MeasureBatch(GaussianSplatVulkanBackend& backend,
                              const std::vector<camera::PinholeCamera>& cameras,
                              const RenderConfig& config, const BatchOptions& options, int batch,
-                             int repeats) {
+                             int repeats, double warm_up_seconds) {
     std::vector<camera::PinholeCamera> views;
     for (int i = 0; i < batch; ++i) views.push_back(cameras[i % cameras.size()]);
     // Records, allocates, and brings the clocks up (they fall while the host alone works).
     const auto warm = std::chrono::steady_clock::now();
     do {
         backend.RenderBatch(views, config, options);
-    } while (core::MillisecondsSince(warm) < 1000.0);
+    } while (core::MillisecondsSince(warm) < 1000.0 * warm_up_seconds);
     BatchThroughput result;
     double gpu_ms = 0.0;
     const auto start = std::chrono::steady_clock::now();

@@ -26,12 +26,13 @@ struct BatchThroughput {
     int submissions_per_batch = 0;
 };
 
-/// RenderBatch of `batch` views (`cameras` repeated) `repeats` times after one warm-up batch.
+/// RenderBatch of `batch` views (`cameras` repeated) `repeats` times after warm-up batches
+/// for `warm_up_seconds` (at least one: it records and allocates).
 BatchThroughput MeasureBatch(visualization::rendering::vulkan::GaussianSplatVulkanBackend& backend,
                              const std::vector<camera::PinholeCamera>& cameras,
                              const visualization::rendering::RenderConfig& config,
                              const visualization::rendering::BatchOptions& options, int batch,
-                             int repeats);
+                             int repeats, double warm_up_seconds);
 
 /// GB/s (1e9 bytes) of one device-to-host copy of `bytes` repeated `repeats` times with
 /// nothing else running: from a device buffer into page-aligned host memory the device

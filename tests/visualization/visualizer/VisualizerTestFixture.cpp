@@ -96,7 +96,8 @@ void VisualizerTest::AddWallAndSphere(visualization::Visualizer& vis) {
 }
 
 bool VisualizerTest::WaitForSize(visualization::Visualizer& vis, int width, int height) {
-    for (int i = 0; i < 500; ++i) {
+    // A minute: only a window that never resizes takes that long, however busy the machine.
+    for (int i = 0; i < 6000; ++i) {
         vis.PollEvents();
         if (vis.GetWidth() == width && vis.GetHeight() == height) return true;
         std::this_thread::sleep_for(std::chrono::milliseconds(10));

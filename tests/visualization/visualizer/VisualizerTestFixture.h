@@ -37,7 +37,7 @@ protected:
     visualization::Visualizer& MakeVisualizer(visualization::VisualizerOptions options);
     /// Adds "wall" (splats) and "sphere" (mesh), in that order, and fits the camera.
     void AddWallAndSphere(visualization::Visualizer& vis);
-    /// Polls events until the framebuffer is width x height (false after ~5 s).
+    /// Polls events until the framebuffer is width x height (false after about a minute).
     bool WaitForSize(visualization::Visualizer& vis, int width, int height);
 
     static rendering::FilamentEngine* engine_;

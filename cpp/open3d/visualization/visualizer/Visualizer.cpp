@@ -353,23 +353,35 @@ void Visualizer::WriteScreenshot(const t::geometry::Image& rgb) {
     core::LogInfo("Saved screenshot {}", path);
 }
 
+void Visualizer::NoteBackgroundChanges() {
+    // A reduced frame while the camera moved is refined once it stops.
+    if (last_divisor_ > 1 && !IsCameraMoving()) PostRedraw();
+    // Pages that arrived show in the next frame (within the 0.1 s an idle loop sleeps),
+    // and so does a new progress line (the last step taken, the stream settled).
+    if (scene_->GetScene().GetSplatRenderer().HasStreamNews()) PostRedraw();
+    if (const auto progress = GetStreamProgress()) {
+        std::string line = rendering::FormatStreamProgress(*progress);
+        if (line != stream_line_) {
+            stream_line_ = std::move(line);
+            PostRedraw();
+        }
+    }
+}
+
+bool Visualizer::IsIdle() {
+    NoteBackgroundChanges();
+    if (redraw_frames_ > 0 && fb_width_ > 0 && fb_height_ > 0) return false;
+    const auto progress = GetStreamProgress();
+    return !progress || progress->settled;
+}
+
 void Visualizer::Run(const RunOptions& options) {
     const double start = NowSeconds();
     int64_t frames = 0;
     while (PollEvents()) {
         if (options.poll) options.poll();
-        // A reduced frame while the camera moved is refined once it stops.
-        if (last_divisor_ > 1 && !IsCameraMoving()) PostRedraw();
-        // Pages that arrived show in the next frame (within the 0.1 s an idle loop sleeps),
-        // and so does a new progress line (the last step taken, the stream settled).
-        if (scene_->GetScene().GetSplatRenderer().HasStreamNews()) PostRedraw();
-        if (const auto progress = GetStreamProgress()) {
-            std::string line = rendering::FormatStreamProgress(*progress);
-            if (line != stream_line_) {
-                stream_line_ = std::move(line);
-                PostRedraw();
-            }
-        }
+        const bool idle = IsIdle();
+        if (options.until_idle && !options.continuous && idle) break;
         if (fb_width_ <= 0 || fb_height_ <= 0 || !(options.continuous || redraw_frames_ > 0)) {
             // Minimised or idle: sleep until input. The gap is not a frame time.
             last_present_s_ = -1.0;

@@ -81,6 +81,10 @@ struct RunOptions {
     /// Called on every loop iteration, drawn or idle (about ten times a second while idle):
     /// background work reports here (a finished load, progress in SetStatus).
     std::function<void()> poll;
+    /// Return as soon as the visualizer is idle (IsIdle): everything asked for is drawn and
+    /// a stream has settled. Scripts and tests wait for that event instead of a time
+    /// (max_seconds then only bounds a hang). Ignored with `continuous`.
+    bool until_idle = false;
 };
 
 class Visualizer : public WindowEventHandler {
@@ -181,6 +185,10 @@ public:
     void PostRedraw() { redraw_frames_ = std::max(redraw_frames_, 2); }
     /// Asks the loop to end (Esc and Q do the same).
     void Close();
+    /// True when Run would draw nothing more without new input: no frame is owed (input,
+    /// a change, a reduced frame still to refine, a new stream progress line) and a stream,
+    /// if any, has settled. Takes in what background work reported since the last call.
+    bool IsIdle();
 
     // Images.
     /// Draws a frame and reads the window back: UInt8 [H, W, 3], top row first, exactly
@@ -286,6 +294,9 @@ private:
     bool DeferDuringFrame(std::function<void()> handler);
     void OpenFiles(const std::vector<std::string>& paths);
     void WriteScreenshot(const t::geometry::Image& rgb);
+    /// Owes frames for what changed without input: a reduced frame to refine, pages that
+    /// arrived, a new stream progress line.
+    void NoteBackgroundChanges();
 
     std::unique_ptr<rendering::FilamentEngine> owned_engine_;
     std::unique_ptr<rendering::FilamentRenderer> owned_renderer_;

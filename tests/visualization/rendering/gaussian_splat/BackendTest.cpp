@@ -122,14 +122,10 @@ TEST(DefaultScene, ExercisesShDegree3AnisotropyAndPartialOpacity) {
     EXPECT_GT(a.color.At<float>(20, 32, 3), 0.99f);
 }
 
-TEST(DefaultScene, RendersQuicklyAt640x480) {
+// Its speed is the benchmarks' business (no timed assertion here).
+TEST(DefaultScene, RendersAt640x480) {
     const auto cloud = CreateDefaultGaussianSplatScene();
-    const auto start = std::chrono::steady_clock::now();
     const auto out = cpu::RenderReference(cloud, GetDefaultSceneCamera(640, 480));
-    const double seconds =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    // Measured ~0.2 s on 2 cores; 10 s only catches a pathological regression.
-    EXPECT_LT(seconds, 10.0);
     EXPECT_GT(out.stats.num_visible, 3000);
 }
 

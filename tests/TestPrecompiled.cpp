@@ -1,0 +1,1 @@
+// The translation unit that builds tests/TestPrecompiled.h once for every test binary.
