@@ -24,9 +24,12 @@ endfunction()
 function(open3d_set_test_flags target)
   open3d_set_target_flags(${target})
   if(CMAKE_BUILD_TYPE STREQUAL "Release")
-    # GCC 12 at -O1 warns of a memcpy out of bounds inside std::string's operator+ of a
-    # temporary (false positives, GCC bug 105651 and its kin); -O3 does not.
-    target_compile_options(${target} PRIVATE -O1 -Wno-array-bounds -Wno-stringop-overflow -Wno-restrict)
+    target_compile_options(${target} PRIVATE -O1)
+    if(CMAKE_CXX_COMPILER_ID STREQUAL "GNU")
+      # GCC 12 at -O1 warns of a memcpy out of bounds inside std::string's operator+ of a
+      # temporary (false positives, GCC bug 105651 and its kin); -O3 does not.
+      target_compile_options(${target} PRIVATE -Wno-array-bounds -Wno-stringop-overflow -Wno-restrict)
+    endif()
   endif()
 endfunction()
 
