@@ -94,7 +94,7 @@ struct Row {
     // with readback (ms per frame), and the host's part of a stage-path / one-submission frame.
     double frame_ms = 0, pipelined_ms = 0, pipelined_readback_ms = 0;
     double frame_gpu_ms = 0, frame_job_gpu_ms = 0;
-    rendering::RenderStats stage_host, frame_host;  // host_* fields only
+    rendering::RenderStats stage_host, frame_host;  // host_* fields and dispatch counts only
     // --batch: views per second (colour read back as float32 / uint8, or left on the GPU).
     double batch_float_vps = 0, batch_uint8_vps = 0, batch_gpu_only_vps = 0;
     double batch_float_into_buffer_vps = 0;  // float32 into one reused buffer
@@ -309,6 +309,10 @@ TimedFrames RunTimedFrames(rendering::GaussianSplatBackend& backend,
     m.frame_gpu_ms = Median(passes);
     m.frame_job_gpu_ms = Median(job);
     m.frame_host = MedianHost(submission_stats);
+    if (!submission_stats.empty()) {  // the same recording every frame: its counts
+        m.frame_host.dispatches = submission_stats.back().dispatches;
+        m.frame_host.dependent_dispatches = submission_stats.back().dependent_dispatches;
+    }
     return m;
 }
 
@@ -360,6 +364,10 @@ void AddView(Row& row, const TimedFrames& timed, const rendering::RenderStats& f
         sum->host_wait_ms += part->host_wait_ms / n;
         sum->host_readback_ms += part->host_readback_ms / n;
     }
+    // Dispatch counts: the largest of the views' recordings (the view does not change them).
+    row.frame_host.dispatches = std::max(row.frame_host.dispatches, timed.frame_host.dispatches);
+    row.frame_host.dependent_dispatches =
+        std::max(row.frame_host.dependent_dispatches, timed.frame_host.dependent_dispatches);
     row.visible += full.num_visible / static_cast<int64_t>(num_views);
     row.entries += full.num_tile_entries / static_cast<int64_t>(num_views);
     row.error_flags |= full.error_flags;
@@ -427,10 +435,12 @@ void PrintTable(const std::vector<Row>& rows) {
         if (r.pipelined_ms > 0) {
             std::printf(
                 "%-11s wall ms/frame: one submission %.3f (GPU: passes %.3f, submission %.3f), "
-                "in flight %.3f, in flight + readback %.3f  [host ms, stage path / one "
-                "submission: record %.3f / %.3f, submit %.3f / %.3f, wait %.3f / %.3f]\n",
+                "in flight %.3f, in flight + readback %.3f; %d dispatches, %d dependent  [host "
+                "ms, stage path / one submission: record %.3f / %.3f, submit %.3f / %.3f, wait "
+                "%.3f / %.3f]\n",
                 "", r.frame_ms, r.frame_gpu_ms, r.frame_job_gpu_ms, r.pipelined_ms,
-                r.pipelined_readback_ms, r.stage_host.host_record_ms, r.frame_host.host_record_ms,
+                r.pipelined_readback_ms, r.frame_host.dispatches, r.frame_host.dependent_dispatches,
+                r.stage_host.host_record_ms, r.frame_host.host_record_ms,
                 r.stage_host.host_submit_ms, r.frame_host.host_submit_ms, r.stage_host.host_wait_ms,
                 r.frame_host.host_wait_ms);
         }
@@ -807,6 +817,8 @@ int Run(const Options& opt) {
                            {"frame_ms", r.frame_ms},
                            {"frame_gpu_passes_ms", r.frame_gpu_ms},
                            {"frame_gpu_submission_ms", r.frame_job_gpu_ms},
+                           {"frame_dispatches", r.frame_host.dispatches},
+                           {"frame_dependent_dispatches", r.frame_host.dependent_dispatches},
                            {"pipelined_frame_ms", r.pipelined_ms},
                            {"pipelined_readback_frame_ms", r.pipelined_readback_ms},
                            {"pipelined_fps", r.pipelined_ms > 0 ? 1000.0 / r.pipelined_ms : 0.0},

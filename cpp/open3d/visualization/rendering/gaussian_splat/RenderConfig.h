@@ -131,6 +131,11 @@ struct RenderStats {
     /// A batch reports its totals divided by its views. docs/perf/ has the breakdown.
     double host_record_ms = 0.0, host_submit_ms = 0.0, host_wait_ms = 0.0;
     double host_readback_ms = 0.0;
+    /// Compute dispatches one view's recording holds, and how many of them wait for the one
+    /// before through a barrier (the frame's chain of dependent steps). The Vulkan backend's
+    /// submission path (Render, batches: the recording's counts divided by its views); 0
+    /// elsewhere.
+    int dispatches = 0, dependent_dispatches = 0;
     /// Bytes the backend keeps on the GPU for the scene between frames (0 for the CPU).
     int64_t gpu_scene_bytes = 0;
     /// True when geometry stage was reused because neither the scene nor the view changed.

@@ -15,6 +15,7 @@
 #include "open3d/core/Exception.h"
 #include "open3d/visualization/rendering/gaussian_splat/DefaultScene.h"
 #include "open3d/visualization/rendering/gaussian_splat/cpu/CpuBackend.h"
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/CommandTally.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/GaussianSplatVulkanBackend.h"
 #include "visualization/rendering/gaussian_splat/vulkan/VulkanTestFixture.h"
 
@@ -350,6 +351,54 @@ TEST_F(SubmissionPath, FramesInFlightSurviveAResizeAndASceneChange) {
     backend->SetFramesInFlight(3);
     EXPECT_EQ(backend->GetFramesInFlight(), 3);
     ExpectSameImages(backend->Render(small, {}), fresh->Render(small, {}));
+}
+
+// The tally itself, without a device: a dispatch after a barrier starts a new dependent step,
+// dispatches between two barriers are one step, and an inner tally counts alone.
+TEST(CommandTally, CountsDispatchesBarriersAndDependentSteps) {
+    using vulkan::CommandTally;
+    CommandTally::NoteDispatch();  // no tally: nothing counted, nothing breaks
+    const CommandTally outer;
+    CommandTally::NoteDispatch();
+    CommandTally::NoteDispatch();
+    CommandTally::NoteBarrier();
+    CommandTally::NoteBarrier();
+    CommandTally::NoteDispatch();
+    {
+        const CommandTally inner;
+        CommandTally::NoteBarrier();
+        CommandTally::NoteDispatch();
+        EXPECT_EQ(inner.Counts().dispatches, 1);
+        EXPECT_EQ(inner.Counts().barriers, 1);
+        EXPECT_EQ(inner.Counts().dependent_dispatches, 1);
+    }
+    CommandTally::NoteDispatch();  // no barrier since the outer tally's last dispatch
+    EXPECT_EQ(outer.Counts().dispatches, 4);
+    EXPECT_EQ(outer.Counts().barriers, 2);
+    EXPECT_EQ(outer.Counts().dependent_dispatches, 2);
+}
+
+// A frame reports the dispatches of its recording: the same for a fresh recording, one
+// submitted again and each view of a batch (whose recording holds every view's dispatches).
+TEST_F(SubmissionPath, DispatchCountsAreTheRecordingsPerView) {
+    auto backend = MakeBackend();
+    backend->SetScene(CreateDefaultGaussianSplatScene());
+    const auto views = SlidingViews(3, 48, 32);
+    const RenderOutput first = backend->Render(views[0], {});
+    // A real frame: projection, sorts of several passes, scan, emit, tile ranges, composite.
+    EXPECT_GE(first.stats.dispatches, 8);
+    EXPECT_GE(first.stats.dependent_dispatches, 8);
+    EXPECT_LE(first.stats.dependent_dispatches, first.stats.dispatches);
+    for (int i = 0; i < 3; ++i) {  // each frame slot records once, then submits again
+        const RenderOutput again = backend->Render(views[1], {});
+        EXPECT_EQ(again.stats.dispatches, first.stats.dispatches);
+        EXPECT_EQ(again.stats.dependent_dispatches, first.stats.dependent_dispatches);
+    }
+    for (const RenderOutput& view : backend->RenderBatch(views, {}, BatchOptions{})) {
+        EXPECT_EQ(view.stats.dispatches, first.stats.dispatches);
+        // Each view of a batch waits for the one before: one barrier more per view.
+        EXPECT_GE(view.stats.dependent_dispatches, first.stats.dependent_dispatches);
+    }
 }
 
 }  // namespace

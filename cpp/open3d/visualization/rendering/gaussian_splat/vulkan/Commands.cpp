@@ -1,6 +1,7 @@
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/Commands.h"
 
 #include "open3d/core/WaitCallback.h"
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/CommandTally.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/VulkanContext.h"
 
 namespace open3d {
@@ -142,6 +143,7 @@ void RecordMemoryBarrier(VkCommandBuffer cmd, VkPipelineStageFlags2 src_stages,
     VkDependencyInfo dependency = MakeInfo<VkDependencyInfo>(VK_STRUCTURE_TYPE_DEPENDENCY_INFO);
     dependency.memoryBarrierCount = 1;
     dependency.pMemoryBarriers = &barrier;
+    CommandTally::NoteBarrier();
     vkCmdPipelineBarrier2(cmd, &dependency);
 }
 

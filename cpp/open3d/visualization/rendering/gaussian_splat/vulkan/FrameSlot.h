@@ -14,6 +14,7 @@
 #include "open3d/visualization/rendering/gaussian_splat/GaussianSplatBackend.h"
 #include "open3d/visualization/rendering/gaussian_splat/RenderConfig.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/Buffer.h"
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/CommandTally.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/Commands.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/GaussianCompositeStage.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/GaussianGeometryStageResources.h"
@@ -82,6 +83,7 @@ struct FrameSlot {
     GpuTimestamps job_timestamps;   ///< the whole job
     FrameRecordingKey recorded;
     bool has_recording = false;
+    CommandCounts recorded_counts;  ///< what `cmd` holds (dispatches, barriers)
     /// Earlier recordings of this slot for other keys, kept while its buffers stay (each part
     /// of a batch split over imported memory has its own destination, so the slots take
     /// several in turn): a submission whose key one of them matches swaps it with `cmd`
@@ -90,6 +92,7 @@ struct FrameSlot {
     struct SpareRecording {
         FrameRecordingKey key;
         CommandBuffer cmd;
+        CommandCounts counts;
     };
     std::vector<SpareRecording> spare_recordings;
 

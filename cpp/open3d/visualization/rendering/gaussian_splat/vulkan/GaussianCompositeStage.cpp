@@ -7,6 +7,7 @@
 #include "open3d/core/Exception.h"
 #include "open3d/visualization/rendering/gaussian_splat/RenderConfig.h"
 #include "open3d/visualization/rendering/gaussian_splat/cpu/Composite.h"
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/CommandTally.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/Commands.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/ComputePipeline.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/EmbeddedShaders.h"
@@ -330,14 +331,14 @@ void GaussianCompositeStage::RecordComposite(VkCommandBuffer cmd,
         (uint64_t(std::max(inputs.entry_capacity, 1u)) + kCompositeWorkgroupSize - 1) /
             kCompositeWorkgroupSize);
     vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, tile_ranges_.Get());
-    vkCmdDispatch(cmd, static_cast<uint32_t>(range_workgroups), 1, 1);
+    RecordDispatch(cmd, static_cast<uint32_t>(range_workgroups), 1, 1);
     RecordMemoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
                         VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
                         VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
                         VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
     vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE,
                       GetCompositePipeline(targets.color_format, params, color_buffer));
-    vkCmdDispatch(cmd, workgroups, 1, 1);
+    RecordDispatch(cmd, workgroups, 1, 1);
 }
 
 void GaussianCompositeStage::RecordDepthMerge(VkCommandBuffer cmd, const DepthMergeImages& images,
@@ -381,8 +382,8 @@ void GaussianCompositeStage::RecordDepthMerge(VkCommandBuffer cmd, const DepthMe
                                        kDepthMergeNumBindings, writes.data());
     vkCmdPushConstants(cmd, merge_layout_.Get(), VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(push),
                        &push);
-    vkCmdDispatch(cmd, (images.width + kDepthMergeWorkgroupSize - 1) / kDepthMergeWorkgroupSize,
-                  (images.height + kDepthMergeWorkgroupSize - 1) / kDepthMergeWorkgroupSize, 1);
+    RecordDispatch(cmd, (images.width + kDepthMergeWorkgroupSize - 1) / kDepthMergeWorkgroupSize,
+                   (images.height + kDepthMergeWorkgroupSize - 1) / kDepthMergeWorkgroupSize, 1);
 }
 
 }  // namespace vulkan

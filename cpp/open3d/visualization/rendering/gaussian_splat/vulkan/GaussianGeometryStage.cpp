@@ -7,6 +7,7 @@
 
 #include "open3d/core/Exception.h"
 #include "open3d/visualization/rendering/gaussian_splat/GaussianSplatLodPacking.h"
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/CommandTally.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/Commands.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/ComputePipeline.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/EmbeddedShaders.h"
@@ -273,7 +274,7 @@ void GaussianGeometryStage::Record(VkCommandBuffer cmd, const GeometryStageScene
                                          !packed_key, scene.lod));
     if (n > 0) {
         const uvec4 grid = DispatchGridFor(DivCeil(n, kProjectWorkgroupSize), max_groups_x);
-        vkCmdDispatch(cmd, grid.x, grid.y, 1);
+        RecordDispatch(cmd, grid.x, grid.y, 1);
     }
     ComputeBarrier(cmd);
 
@@ -287,7 +288,7 @@ void GaussianGeometryStage::Record(VkCommandBuffer cmd, const GeometryStageScene
         args.mode = kDispatchArgsAfterProject;
         vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, dispatch_args_.Get());
         vkCmdPushConstants(cmd, layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(args), &args);
-        vkCmdDispatch(cmd, 1, 1, 1);
+        RecordDispatch(cmd, 1, 1, 1);
         ComputeBarrier(cmd);
     }
     if (timestamps) {
@@ -335,10 +336,10 @@ void GaussianGeometryStage::Record(VkCommandBuffer cmd, const GeometryStageScene
         scan.sums_base = level + 1 < need.num_scan_levels ? need.scan_level_base[level + 1] : 0u;
         scan.write_total = level + 1 == need.num_scan_levels ? 1u : 0u;
         vkCmdPushConstants(cmd, layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(scan), &scan);
-        vkCmdDispatchIndirect(cmd, counters,
-                              counters_offset +
-                                  offsetof(GaussianGeometryStageCounters, scan_levels) +
-                                  level * sizeof(GaussianScanLevel));
+        RecordDispatchIndirect(cmd, counters,
+                               counters_offset +
+                                   offsetof(GaussianGeometryStageCounters, scan_levels) +
+                                   level * sizeof(GaussianScanLevel));
         ComputeBarrier(cmd);
     }
 
@@ -347,7 +348,7 @@ void GaussianGeometryStage::Record(VkCommandBuffer cmd, const GeometryStageScene
     args.sort_max_count = std::max(capacity, 1u);
     vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, dispatch_args_.Get());
     vkCmdPushConstants(cmd, layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(args), &args);
-    vkCmdDispatch(cmd, 1, 1, 1);
+    RecordDispatch(cmd, 1, 1, 1);
     ComputeBarrier(cmd);
 
     // 6. Emit (tile, splat) entries in list order at the scanned offsets: tile keys in
@@ -356,7 +357,7 @@ void GaussianGeometryStage::Record(VkCommandBuffer cmd, const GeometryStageScene
         counters_offset + offsetof(GaussianGeometryStageCounters, emit_dispatch_x);
     vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE,
                       packed_key ? emit_packed_.Get() : emit_.Get());
-    vkCmdDispatchIndirect(cmd, counters, emit_args);
+    RecordDispatchIndirect(cmd, counters, emit_args);
     ComputeBarrier(cmd);
 
     end(TimedPass::kScanEmit);
@@ -372,7 +373,7 @@ void GaussianGeometryStage::Record(VkCommandBuffer cmd, const GeometryStageScene
         ComputeBarrier(cmd);
         PushBindings(cmd, scene, buffers);  // the sort bound its own layout
         vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, unpack_keys_.Get());
-        vkCmdDispatchIndirect(cmd, counters, emit_args);
+        RecordDispatchIndirect(cmd, counters, emit_args);
     }
     end(TimedPass::kTileSort);
     end(TimedPass::kSort);

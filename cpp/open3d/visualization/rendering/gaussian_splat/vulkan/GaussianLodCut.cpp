@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "open3d/core/Exception.h"
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/CommandTally.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/Commands.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/ComputePipeline.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/EmbeddedShaders.h"
@@ -103,14 +104,14 @@ void GaussianLodCut::PushBindings(VkCommandBuffer cmd, const LodCutBuffers& buff
 void GaussianLodCut::Dispatch(VkCommandBuffer cmd, uint32_t pass, uint32_t groups) const {
     vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, passes_[pass].Get());
     const uvec4 grid = DispatchGridFor(groups, max_groups_x_);
-    vkCmdDispatch(cmd, grid.x, grid.y, 1);
+    RecordDispatch(cmd, grid.x, grid.y, 1);
 }
 
 void GaussianLodCut::RecordWalk(VkCommandBuffer cmd, const LodCutBuffers& buffers) const {
     const auto walk_indirect = [&](uint32_t pass, uint32_t args_word) {
         vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, passes_[pass].Get());
-        vkCmdDispatchIndirect(cmd, buffers.walk.buffer,
-                              buffers.walk.offset + VkDeviceSize(args_word) * 4);
+        RecordDispatchIndirect(cmd, buffers.walk.buffer,
+                               buffers.walk.offset + VkDeviceSize(args_word) * 4);
     };
     Dispatch(cmd, kLodPassWalkStart, 1);
     // Two rounds are recorded; a first round that finds the threshold turns the second's

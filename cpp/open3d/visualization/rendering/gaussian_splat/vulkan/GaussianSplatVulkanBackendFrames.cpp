@@ -364,10 +364,11 @@ bool GaussianSplatVulkanBackend::UseRecording(FrameSlot& slot, const FrameRecord
             slot.spare_recordings.erase(slot.spare_recordings.begin());
             spare = slot.spare_recordings.end();
         }
-        FrameSlot::SpareRecording parked{slot.recorded, std::move(slot.cmd)};
+        FrameSlot::SpareRecording parked{slot.recorded, std::move(slot.cmd), slot.recorded_counts};
         if (spare != slot.spare_recordings.end()) {
             slot.cmd = std::move(spare->cmd);
             slot.recorded = spare->key;
+            slot.recorded_counts = spare->counts;
             *spare = std::move(parked);
             slot.copied_color_target = VK_NULL_HANDLE;  // copy_cmd followed the other one
             return true;
@@ -382,6 +383,7 @@ void GaussianSplatVulkanBackend::RecordSlot(FrameSlot& slot, const FrameRecordin
     if (slot.cmd.Get() == VK_NULL_HANDLE) slot.cmd = pool_.Allocate();
     const VkCommandBuffer cmd = slot.cmd.Get();
     slot.cmd.Begin(/*one_time_submit=*/false);
+    const CommandTally tally;
     const bool one_view = key.views == 1;
     slot.job_timestamps.RecordReset(cmd);
     if (one_view) slot.pass_timestamps.RecordReset(cmd);
@@ -477,6 +479,7 @@ void GaussianSplatVulkanBackend::RecordSlot(FrameSlot& slot, const FrameRecordin
     slot.job_timestamps.RecordEnd(cmd, 0u);
     slot.cmd.End();
     slot.recorded = key;
+    slot.recorded_counts = tally.Counts();
     slot.has_recording = true;
     ++counters_.recordings;
 }
@@ -755,6 +758,9 @@ std::vector<RenderOutput> GaussianSplatVulkanBackend::WaitBatch(uint64_t ticket)
     for (RenderOutput& out : outputs) {
         RenderStats& s = out.stats;
         s.host_record_ms = slot.recording_reused ? 0.0 : slot.record_ms / views;
+        s.dispatches = slot.recorded_counts.dispatches / static_cast<int>(views);
+        s.dependent_dispatches =
+            slot.recorded_counts.dependent_dispatches / static_cast<int>(views);
         s.host_submit_ms = slot.submit_ms / views;
         s.host_wait_ms = wait_ms / views;
         s.host_readback_ms = readback_ms / views;

@@ -4,6 +4,7 @@
 #include <cstring>
 
 #include "open3d/core/Exception.h"
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/CommandTally.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/VulkanContext.h"
 
 namespace open3d {
@@ -169,6 +170,7 @@ void RecordImageBarrier(VkCommandBuffer cmd, VkImage image, VkImageAspectFlags a
     VkDependencyInfo dependency = MakeInfo<VkDependencyInfo>(VK_STRUCTURE_TYPE_DEPENDENCY_INFO);
     dependency.imageMemoryBarrierCount = 1;
     dependency.pImageMemoryBarriers = &barrier;
+    CommandTally::NoteBarrier();
     vkCmdPipelineBarrier2(cmd, &dependency);
 }
 

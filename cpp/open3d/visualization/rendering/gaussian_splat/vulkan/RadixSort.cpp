@@ -6,6 +6,7 @@
 #include "GaussianSplatRadixSortContract.h"
 #include "open3d/core/Exception.h"
 #include "open3d/visualization/rendering/gaussian_splat/RenderConfig.h"
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/CommandTally.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/Commands.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/ComputePipeline.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/EmbeddedShaders.h"
@@ -256,7 +257,7 @@ void RadixSort::Record(VkCommandBuffer cmd, const BufferRange& keys, const Buffe
         bind(keys, values, scratch.keys_alt, scratch.values_alt);
         push_constants();
         vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, setup_.Get());
-        vkCmdDispatch(cmd, 1, 1, 1);
+        RecordDispatch(cmd, 1, 1, 1);
         barrier();
     };
     if (params == Params::kSetupPass) setup();
@@ -285,19 +286,19 @@ void RadixSort::Record(VkCommandBuffer cmd, const BufferRange& keys, const Buffe
         push_constants();
         const VkDeviceSize blocks = pass_args(offsetof(RadixSortParams, pass_blocks), pass);
         vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, histogram_.Get());
-        vkCmdDispatchIndirect(cmd, params_buffer, blocks);
+        RecordDispatchIndirect(cmd, params_buffer, blocks);
         barrier();
         // One workgroup per digit; rows of digits above digit_bits are all zero.
         vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, scan_.Get());
         if (by_range && pass > 0) {
-            vkCmdDispatchIndirect(cmd, params_buffer,
-                                  pass_args(offsetof(RadixSortParams, pass_rows), pass));
+            RecordDispatchIndirect(cmd, params_buffer,
+                                   pass_args(offsetof(RadixSortParams, pass_rows), pass));
         } else {
-            vkCmdDispatch(cmd, kRadixSortBins, 1, 1);
+            RecordDispatch(cmd, kRadixSortBins, 1, 1);
         }
         barrier();
         vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, scatter_.Get());
-        vkCmdDispatchIndirect(cmd, params_buffer, blocks);
+        RecordDispatchIndirect(cmd, params_buffer, blocks);
         if (pass + 1 < num_passes || copies) barrier();
         if (pass == 0 && (drop || by_range)) {
             // The kept pairs are packed at the front of the scratch: the later passes (and
@@ -312,7 +313,7 @@ void RadixSort::Record(VkCommandBuffer cmd, const BufferRange& keys, const Buffe
     if (copies) {
         bind(scratch.keys_alt, scratch.values_alt, keys, values);
         vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, copy_.Get());
-        vkCmdDispatchIndirect(
+        RecordDispatchIndirect(
             cmd, params_buffer,
             by_range ? params_offset + offsetof(RadixSortParams, copy_blocks) : params_offset);
     }
