@@ -43,6 +43,9 @@ OPEN3D_SHADER_CONST uint kSpecIndexedList = 3u;
 // nodes (GaussianSplatLodContract.h) and slot i projects node list[i] when i is below
 // GaussianGeometryStageCounters::lod_cut_nodes; 0: slot i projects splat i if its bit is set.
 OPEN3D_SHADER_CONST uint kSpecCutList = 4u;
+// 1 (per-tile bins, SortMode::kExact): a visible splat also adds 1 to the count of every
+// tile it will emit into, in the tile ranges binding (GaussianSplatTileListContract.h).
+OPEN3D_SHADER_CONST uint kSpecBinTiles = 5u;
 
 // Descriptor set 0 of every geometry stage projection pipeline (one push-descriptor layout; each
 // shader declares only the bindings it uses). The positions, the shape and SH words and the
@@ -60,7 +63,10 @@ OPEN3D_SHADER_CONST uint kGeometryStageEntryKeysBinding = 6u;    // uint[capacit
 OPEN3D_SHADER_CONST uint kGeometryStageEntryValuesBinding = 7u;  // uint[capacity]: splat index
 OPEN3D_SHADER_CONST uint kGeometryStageSortParamsBinding = 8u;   // RadixSortParams of the next sort
 OPEN3D_SHADER_CONST uint kGeometryStageTileCountsBinding = 9u;   // uint[N]: tiles of splat i
-OPEN3D_SHADER_CONST uint kGeometryStageNumBindings = 10u;
+// The composite's state (GaussianCompositeState, then uvec2 [begin, end) per tile): the
+// per-tile bins' counts, cursors and finally the ranges the composite reads.
+OPEN3D_SHADER_CONST uint kGeometryStageTileRangesBinding = 10u;
+OPEN3D_SHADER_CONST uint kGeometryStageNumBindings = 11u;
 
 // The buffers a splat count can grow past the range one storage binding reaches
 // (maxStorageBufferRange: 4 GiB on NVIDIA, 128 MiB on lavapipe; 98M splats of degree 3 have

@@ -36,6 +36,23 @@ OPEN3D_SHADER_CONST uint kSpecEmitMode = 0u;
 OPEN3D_SHADER_CONST uint kEmitTileKeys = 0u;    // exact order: key = tile index
 OPEN3D_SHADER_CONST uint kEmitPackedKeys = 1u;  // packed option: key = PackedSortKey(...)
 OPEN3D_SHADER_CONST uint kEmitUnpackKeys = 2u;  // after the packed sort: key >>= depth bits
+OPEN3D_SHADER_CONST uint kEmitBinned = 3u;  // per-tile bins: (depth key, slot) at the tile's cursor
+
+// ---- Per-tile bins (SortMode::kExact) ----
+// project (counts per tile) -> gaussian_bin_scan (one workgroup: each tile's begin, the
+// entries that fit) -> emit (kEmitBinned: (depth key, slot) at an atomic cursor of each tile)
+// -> gaussian_bin_sort (a workgroup per tile sorts its entries by (depth key, slot), which
+// is unique, so the order does not depend on the atomics). The bins live in the composite's
+// state buffer after its GaussianCompositeState: word kBinRangesWordOffset + 2 t holds tile
+// t's begin and the next word its count, then its cursor, then its end.
+OPEN3D_SHADER_CONST uint kBinRangesWordOffset = 4u;
+OPEN3D_SHADER_CONST uint kBinScanWorkgroupSize = 256u;
+OPEN3D_SHADER_CONST uint kBinSortWorkgroupSize = 256u;
+// Specialisation constant of gaussian_bin_sort.comp: entries a tile sorts in shared memory
+// (a power of two, 8 bytes each); longer tiles sort in place in the entry buffers.
+OPEN3D_SHADER_CONST uint kSpecBinSortCapacity = 0u;
+OPEN3D_SHADER_CONST uint kBinSortCapacitySmall = 2048u;  // 16 KiB: devices with < 40 KiB
+OPEN3D_SHADER_CONST uint kBinSortCapacityLarge = 4096u;  // 32 KiB
 
 // uint indices into GaussianGeometryStageCounters, used as the radix sorter's count_index.
 OPEN3D_SHADER_CONST uint kCounterVisibleIndex = 0u;

@@ -24,6 +24,7 @@ layout(constant_id = kSpecAntialias) const uint kAntialias = 0u;
 layout(constant_id = kSpecPrecision) const uint kPrecision = kPrecisionExact;
 layout(constant_id = kSpecIndexedList) const uint kIndexedList = 1u;
 layout(constant_id = kSpecCutList) const uint kCutList = 0u;
+layout(constant_id = kSpecBinTiles) const uint kBinTiles = 0u;
 
 layout(std430, set = 0, binding = kGeometryStageViewBinding) readonly buffer ViewBlock {
     GaussianViewParams view;
@@ -60,6 +61,12 @@ layout(std430, set = 0, binding = kGeometryStageSplatIndexBinding) writeonly buf
 // the GPU's L2 cache where a field of the 64-byte projected records did not.
 layout(std430, set = 0, binding = kGeometryStageTileCountsBinding) writeonly buffer TileCountsBlock {
     uint tile_counts[];
+};
+
+// Per-tile bins: word kBinRangesWordOffset + 2 t + 1 counts tile t's entries (zeroed by the
+// recorder).
+layout(std430, set = 0, binding = kGeometryStageTileRangesBinding) buffer TileRangesBlock {
+    uint tile_bins[];
 };
 
 const float kSH_C0 = 0.28209479177387814;
@@ -292,6 +299,22 @@ bool Project(uint i, uint slot, out float depth, out uint entries) {
     for (uint ty = rect_min.y; ty < rect_max.y; ++ty) {
         num_tiles += TileSpanCount(TileRowSpan(px, py, conic.x, conic.y, conic.z, det_q, cull_t,
                                                ty, rect_min.x, rect_max.x));
+    }
+
+    // Per-tile bins: the same spans again, one count per tile the emit pass will fill. A
+    // splat over max_tiles_per_splat emits nothing (the bin scan raises the flag).
+    if (kBinTiles != 0u && num_tiles > view.max_tiles_per_splat) {
+        atomicOr(counters.error_flags, kErrorEntriesDropped);
+    } else if (kBinTiles != 0u && num_tiles > 0u) {
+        bool whole_rect = num_tiles == (rect_max.x - rect_min.x) * (rect_max.y - rect_min.y);
+        for (uint ty = rect_min.y; ty < rect_max.y; ++ty) {
+            uint span = whole_rect ? rect_min.x | (rect_max.x << 16u)
+                                   : TileRowSpan(px, py, conic.x, conic.y, conic.z, det_q,
+                                                 cull_t, ty, rect_min.x, rect_max.x);
+            for (uint tx = span & 0xFFFFu; tx < (span >> 16u); ++tx) {
+                atomicAdd(tile_bins[kBinRangesWordOffset + 2u * (ty * tiles_x + tx) + 1u], 1u);
+            }
+        }
     }
 
     vec3 color = ShColor(i, rel);

@@ -113,8 +113,9 @@ def ours_view(gs_render, scene, entry, extra, tmp):
 
 def run_gs_bench(args, scenes, resolutions, out_dir):
     """gs-bench on the same scenes, view 0, at the same sizes: one run for the cameras.json
-    scenes, one per grid. Returns (rows of knob 'default', run records)."""
-    common = ["--views", "0", "--knobs", "default", "--repeat", str(args.repeat),
+    scenes, one per grid. Returns (rows of knob 'default', run records); the JSON files keep
+    every knob of --knobs."""
+    common = ["--views", "0", "--knobs", args.knobs, "--repeat", str(args.repeat),
               "--reference-max-splats", "0"]
     for w, h in resolutions:
         common += ["--resolution", f"{w}x{h}"]
@@ -251,6 +252,8 @@ def parse_args(argv):
                         help="seconds of warm-up calls at most")
     parser.add_argument("--no-psnr", action="store_true", help="skip the view-0 PSNR")
     parser.add_argument("--gs-bench", help="also time these scenes with this gs-bench")
+    parser.add_argument("--knobs", default="default",
+                        help="gs-bench knobs to time (the table compares 'default')")
     parser.add_argument("--gs-bench-args", default="",
                         help="extra gs-bench arguments (one shell-quoted string)")
     parser.add_argument("--gs-render",

@@ -35,6 +35,24 @@ camera::PinholeCamera SupersampledView(const camera::PinholeCamera& view, int s)
     return cam;
 }
 
+t::geometry::PointCloud FirstSplats(const t::geometry::PointCloud& cloud, int64_t n) {
+    const int64_t total = cloud.NumPoints();
+    if (n < 1 || n > total) {
+        core::ThrowError("--first {}: the scene has {} splats", n, total);
+    }
+    t::geometry::PointCloud out;
+    for (const std::string& name : cloud.GetPointAttrNames()) {
+        const core::Tensor& attr = cloud.GetPointAttr(name);
+        core::SizeVector shape = attr.GetShape();
+        shape.at(0) = n;
+        core::Tensor head(shape, attr.GetDtype());
+        const auto* src = static_cast<const uint8_t*>(attr.RawData());
+        std::copy(src, src + head.NumBytes(), static_cast<uint8_t*>(head.RawData()));
+        out.SetPointAttr(name, std::move(head));
+    }
+    return out;
+}
+
 t::geometry::PointCloud MakeGridScene(const t::geometry::PointCloud& tile, int k, double* spacing) {
     if (k < 1) core::ThrowError("--grid needs K >= 1, got {}", k);
     tile.ValidateGaussianSplat();

@@ -19,6 +19,10 @@ camera::PinholeCamera ScaleViewTo(const camera::PinholeCamera& view, int width, 
 /// (c' = s (c + 0.5) - 0.5). Image::BoxDownsample(s) of its render is back at `view`'s size.
 camera::PinholeCamera SupersampledView(const camera::PinholeCamera& view, int s);
 
+/// The first `n` splats of `cloud` (every attribute's first n rows): a scene of one or a
+/// thousand splats times what a frame costs when there is almost nothing to draw.
+t::geometry::PointCloud FirstSplats(const t::geometry::PointCloud& cloud, int64_t n);
+
 /// K x K copies of `tile` (e.g. playbot_125k) offset by multiples of
 /// s = 1.1 * max(extent_x, extent_z) of its bounding box along x and z, centred on it.
 /// Returns s through `spacing`.

@@ -47,6 +47,7 @@ struct Options {
     std::vector<std::string> resolutions;
     std::string backend = "vulkan";
     int grid = 0;
+    int64_t first = 0;  // --first: only the first splats of each input
     std::string json;
     int repeat = 10;
     std::string knobs = "all";
@@ -75,6 +76,8 @@ struct Knob {
 
 const std::vector<Knob> kKnobs = {
     {"default", [](rendering::RenderConfig&) {}},
+    {"global-sorts",
+     [](rendering::RenderConfig& c) { c.sort_mode = rendering::SortMode::kExactGlobalSorts; }},
     {"packed-key",
      [](rendering::RenderConfig& c) { c.sort_mode = rendering::SortMode::kPackedKey32; }},
     {"compact", [](rendering::RenderConfig& c) { c.compact_storage = true; }},
@@ -586,6 +589,9 @@ int Run(const Options& opt) {
     rendering::vulkan::RegisterVulkanBackend();
     std::vector<SceneJob> jobs;
     if (opt.inputs.empty()) core::ThrowError("--input is required (a .ply or .splat scene)");
+    if (opt.grid > 0 && opt.first > 0) {
+        core::ThrowError("--first takes the first splats of each --input; --grid tiles a whole one");
+    }
     if (opt.grid > 0) {
         if (opt.cameras.empty())
             core::ThrowError("--grid needs --cameras (view 0 sets the rotation)");
@@ -613,6 +619,10 @@ int Run(const Options& opt) {
             t::io::ReadPointCloud(opt.inputs[i], job.cloud);
             t::io::RequireGaussianSplat(opt.inputs[i], job.cloud);
             job.name = std::filesystem::path(opt.inputs[i]).filename().string();
+            if (opt.first > 0) {
+                job.cloud = bench::FirstSplats(job.cloud, opt.first);
+                job.name += fmt::format("[first {}]", opt.first);
+            }
             std::vector<camera::PinholeCamera> views;
             for (const auto& v : camera::ReadCamerasJson(opt.cameras[i])) views.push_back(v.camera);
             const std::vector<int> chosen = ParseViews(opt.views, static_cast<int>(views.size()));
@@ -919,7 +929,7 @@ int main(int argc, char** argv) {
         "Real scenes: one --cameras per --input, views from --views at each --resolution\n"
         "(fx = fy = fx_json * H / H_json, principal point at the centre). --grid K builds\n"
         "K x K copies of the first --input with the camera defined in docs/benchmark.md.\n"
-        "Knobs: default, packed-key, compact, sh<=1, antialias, camera-relative. The error\n"
+        "Knobs: default, global-sorts, packed-key, compact, sh<=1, antialias, camera-relative. The error\n"
         "columns compare the colour with the CPU reference (default knobs but the SH cap and\n"
         "antialias) rendered in the same run (worst view).",
         "gs-bench"};
@@ -934,6 +944,9 @@ int main(int argc, char** argv) {
     app.add_option("--backend", opt.backend, "Backend to time")
         ->check(CLI::IsMember({"vulkan", "cpu"}))
         ->capture_default_str();
+    app.add_option("--first", opt.first,
+                   "Only the first N splats of each input (1 or 1000: a frame's fixed cost)")
+        ->check(CLI::PositiveNumber);
     app.add_option("--grid", opt.grid, "Tiled large scene: K x K copies of the first input")
         ->check(CLI::Range(1, 64));
     app.add_option("--json", opt.json,

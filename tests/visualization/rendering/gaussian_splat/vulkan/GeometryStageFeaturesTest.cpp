@@ -175,6 +175,13 @@ std::vector<std::vector<uint32_t>> GpuLists(const GeometryStageReadback& gpu,
     return tiles;
 }
 
+// The two global sorts: a capacity drops the farthest splats (the prefix rule).
+RenderConfig GlobalSorts() {
+    RenderConfig config;
+    config.sort_mode = SortMode::kExactGlobalSorts;
+    return config;
+}
+
 TEST_F(GeometryStageFeatures, CapacityOverflowDropsEntriesFlagsAndWarnsOnce) {
     const auto cloud = CreateDefaultGaussianSplatScene();
     // 9,696 entries (measured; 12,228 tiles in the splats' rectangles before tile culling)
@@ -197,12 +204,12 @@ TEST_F(GeometryStageFeatures, CapacityOverflowDropsEntriesFlagsAndWarnsOnce) {
     {
         GaussianGeometryStageRunner runner(Context(), packed, 4096);
         for (int frame = 0; frame < 3; ++frame) {
-            const GeometryStageReadback gpu = runner.Run(cam, RenderConfig{});
+            const GeometryStageReadback gpu = runner.Run(cam, GlobalSorts());
             EXPECT_EQ(gpu.counters.error_flags, kEntriesDropped | kCountsClamped);
             EXPECT_LE(gpu.counters.entry_count, 4096u);
             EXPECT_GT(gpu.counters.entry_count, 4000u);
             EXPECT_EQ(gpu.counters.requested_entries, 9696u);
-            EXPECT_EQ(GpuLists(gpu, grid), PrefixRuleLists(gpu, ref, grid, RenderConfig{}, 4096));
+            EXPECT_EQ(GpuLists(gpu, grid), PrefixRuleLists(gpu, ref, grid, GlobalSorts(), 4096));
         }
     }
     EXPECT_EQ(warnings, 2) << "one warning per flag bit for the view, not one per frame";
@@ -210,7 +217,7 @@ TEST_F(GeometryStageFeatures, CapacityOverflowDropsEntriesFlagsAndWarnsOnce) {
     // (b) RenderConfig::max_tile_entries_total is the limit: bit 0 only.
     warnings = 0;
     {
-        RenderConfig config;
+        RenderConfig config = GlobalSorts();
         config.max_tile_entries_total = 5000;
         GaussianGeometryStageRunner runner(Context(), packed, 1u << 16);
         const GeometryStageReadback gpu = runner.Run(cam, config);
@@ -268,6 +275,42 @@ TEST_F(GeometryStageFeatures, CapacityCutsTheListWhereTheScanSaysAcrossScanLevel
     for (auto& tile : want) {
         std::erase_if(tile, [&](uint32_t splat) { return !kept[splat]; });
     }
+    GaussianGeometryStageRunner cut_runner(Context(), packed, capacity);
+    const GeometryStageReadback gpu = cut_runner.Run(cam, GlobalSorts());
+    EXPECT_EQ(gpu.counters.error_flags, kEntriesDropped | kCountsClamped);
+    EXPECT_EQ(gpu.counters.requested_entries, uncut.counters.entry_count);
+    EXPECT_EQ(gpu.counters.entry_count, total);
+    EXPECT_EQ(GpuLists(gpu, grid), want);
+}
+
+TEST_F(GeometryStageFeatures, BinsKeepWholeTilesUpToTheCapacity) {
+    // Per-tile bins (the default): tiles in row-major order keep all their entries while
+    // their running total fits; from the first that does not, tiles get none. Expected:
+    // the uncut run's lists (which equal the global sorts', checked here too) cut that way.
+    OPEN3D_REQUIRE_DATA("playbot/playbot_31k.ply");
+    OPEN3D_REQUIRE_DATA("playbot/cameras.json");
+    const auto cloud = ReadScene("playbot/playbot_31k.ply");
+    const auto cam = PlaybotView0(128, 96);
+    const auto grid = cpu::TileGrid::ForImage(cam.width, cam.height);
+    const PackedGaussianSplats packed = PackGaussianSplatAttrs(cloud);
+    GaussianGeometryStageRunner uncut_runner(Context(), packed, 1u << 20);
+    const GeometryStageReadback uncut = uncut_runner.Run(cam, RenderConfig{});
+    ASSERT_EQ(uncut.counters.error_flags, 0u);
+    EXPECT_EQ(GpuLists(uncut, grid), GpuLists(uncut_runner.Run(cam, GlobalSorts()), grid));
+    std::vector<std::vector<uint32_t>> want = GpuLists(uncut, grid);
+    const uint32_t capacity = uncut.counters.entry_count / 2;
+    uint32_t total = 0;
+    size_t first_cut = want.size();
+    for (size_t t = 0; t < want.size(); ++t) {
+        if (first_cut == want.size() && total + want[t].size() <= capacity) {
+            total += static_cast<uint32_t>(want[t].size());
+        } else {
+            if (first_cut == want.size()) first_cut = t;
+            want[t].clear();
+        }
+    }
+    ASSERT_GT(first_cut, 0u);
+    ASSERT_LT(first_cut, want.size() - 1);
     GaussianGeometryStageRunner cut_runner(Context(), packed, capacity);
     const GeometryStageReadback gpu = cut_runner.Run(cam, RenderConfig{});
     EXPECT_EQ(gpu.counters.error_flags, kEntriesDropped | kCountsClamped);

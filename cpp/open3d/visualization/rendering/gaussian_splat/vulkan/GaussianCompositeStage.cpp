@@ -265,7 +265,15 @@ void GaussianCompositeStage::RecordComposite(VkCommandBuffer cmd,
         std::min<uint64_t>(num_tiles, std::min(max_workgroups, kMaxWorkgroupsPerDispatch)));
 
     // Work stealing starts from tile 0 in every dispatch; tiles without entries keep [0, 0).
-    vkCmdFillBuffer(cmd, state.buffer, state.offset, state_bytes, 0u);
+    // Ranges left by the geometry stage's bins were written by its compute passes, which the
+    // fill of the tile counter (the same binding to them) must follow.
+    if (inputs.ranges_written) {
+        RecordMemoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                            VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, VK_PIPELINE_STAGE_2_TRANSFER_BIT,
+                            VK_ACCESS_2_TRANSFER_WRITE_BIT);
+    }
+    vkCmdFillBuffer(cmd, state.buffer, state.offset,
+                    inputs.ranges_written ? sizeof(GaussianCompositeState) : state_bytes, 0u);
     RecordMemoryBarrier(cmd, VK_PIPELINE_STAGE_2_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
                         VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
                         VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
@@ -330,12 +338,14 @@ void GaussianCompositeStage::RecordComposite(VkCommandBuffer cmd,
         kMaxRangeWorkgroups,
         (uint64_t(std::max(inputs.entry_capacity, 1u)) + kCompositeWorkgroupSize - 1) /
             kCompositeWorkgroupSize);
-    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, tile_ranges_.Get());
-    RecordDispatch(cmd, static_cast<uint32_t>(range_workgroups), 1, 1);
-    RecordMemoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
-                        VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
-                        VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
-                        VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
+    if (!inputs.ranges_written) {
+        vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, tile_ranges_.Get());
+        RecordDispatch(cmd, static_cast<uint32_t>(range_workgroups), 1, 1);
+        RecordMemoryBarrier(
+            cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
+            VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+            VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
+    }
     vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE,
                       GetCompositePipeline(targets.color_format, params, color_buffer));
     RecordDispatch(cmd, workgroups, 1, 1);

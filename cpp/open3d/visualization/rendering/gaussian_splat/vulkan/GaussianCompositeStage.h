@@ -61,6 +61,10 @@ struct CompositeStageInputs {
     /// GaussianGeometryStageCounters::entry_count. Counts above `entry_capacity` are clamped.
     BufferRange entry_count;
     uint32_t entry_capacity = 0;
+    /// The geometry stage's per-tile bins left every tile's [begin, end) in the state
+    /// buffer passed to RecordComposite (GeometryStageViewBuffers::tile_ranges): the
+    /// ranges pass is skipped and only the tile counter is zeroed.
+    bool ranges_written = false;
 };
 
 /// The composite's outputs, width x height, in VK_IMAGE_LAYOUT_GENERAL.

@@ -65,6 +65,22 @@ GaussianGeometryStage::GaussianGeometryStage(const VulkanContext& context)
                                          "gaussian_emit (packed keys)", &packed_info);
     unpack_keys_ = CreateComputePipeline(context, layout, spirv::kGaussianEmit,
                                          "gaussian_emit (unpack keys)", &unpack_info);
+    const uint32_t binned_mode = kEmitBinned;
+    const VkSpecializationInfo binned_info{1, &emit_entry, sizeof(uint32_t), &binned_mode};
+    emit_binned_ = CreateComputePipeline(context, layout, spirv::kGaussianEmit,
+                                         "gaussian_emit (bins)", &binned_info);
+    bin_scan_ =
+        CreateComputePipeline(context, layout, spirv::kGaussianBinScan, "gaussian_bin_scan");
+    // A tile sorts in shared memory up to 8-byte pairs filling 32 KiB where the device has
+    // room for them beside nothing else (NVIDIA: 48 KiB), else 16 KiB (lavapipe: 32 KiB).
+    const uint32_t sort_capacity =
+        context.GetDeviceInfo().max_compute_shared_memory >= 40u * 1024u
+            ? kBinSortCapacityLarge
+            : kBinSortCapacitySmall;
+    const VkSpecializationMapEntry sort_entry{kSpecBinSortCapacity, 0, sizeof(uint32_t)};
+    const VkSpecializationInfo sort_info{1, &sort_entry, sizeof(uint32_t), &sort_capacity};
+    bin_sort_ = CreateComputePipeline(context, layout, spirv::kGaussianBinSort,
+                                      "gaussian_bin_sort", &sort_info);
 }
 
 GeometryStageStorageRequirements GaussianGeometryStage::GetStorageRequirements(
@@ -101,21 +117,27 @@ GeometryStageStorageRequirements GaussianGeometryStage::GetStorageRequirements(
 
 VkPipeline GaussianGeometryStage::GetProjectPipeline(uint32_t sh_degree, bool antialias,
                                                      SplatPrecision precision, bool indexed_list,
-                                                     bool cut_list) {
+                                                     bool cut_list, bool bin_tiles) {
     const uint32_t precision_value =
         precision == SplatPrecision::kExact ? kPrecisionExact : kPrecisionCompact;
     const uint32_t key = sh_degree | (antialias ? 4u : 0u) | (precision_value << 3) |
-                         (indexed_list ? 16u : 0u) | (cut_list ? 32u : 0u);
+                         (indexed_list ? 16u : 0u) | (cut_list ? 32u : 0u) |
+                         (bin_tiles ? 64u : 0u);
     auto it = project_.find(key);
     if (it != project_.end()) return it->second.Get();
-    const std::array<uint32_t, 5> values{sh_degree, antialias ? 1u : 0u, precision_value,
-                                         indexed_list ? 1u : 0u, cut_list ? 1u : 0u};
-    const std::array<VkSpecializationMapEntry, 5> entries{{{kSpecShDegree, 0, 4},
+    const std::array<uint32_t, 6> values{sh_degree,
+                                         antialias ? 1u : 0u,
+                                         precision_value,
+                                         indexed_list ? 1u : 0u,
+                                         cut_list ? 1u : 0u,
+                                         bin_tiles ? 1u : 0u};
+    const std::array<VkSpecializationMapEntry, 6> entries{{{kSpecShDegree, 0, 4},
                                                            {kSpecAntialias, 4, 4},
                                                            {kSpecPrecision, 8, 4},
                                                            {kSpecIndexedList, 12, 4},
-                                                           {kSpecCutList, 16, 4}}};
-    const VkSpecializationInfo info{5, entries.data(), sizeof(values), values.data()};
+                                                           {kSpecCutList, 16, 4},
+                                                           {kSpecBinTiles, 20, 4}}};
+    const VkSpecializationInfo info{6, entries.data(), sizeof(values), values.data()};
     UniquePipeline pipeline = CreateComputePipeline(
         context_, pipeline_layout_.Get(), spirv::kGaussianProject, "gaussian_project", &info);
     return project_.emplace(key, std::move(pipeline)).first->second.Get();
@@ -124,17 +146,22 @@ VkPipeline GaussianGeometryStage::GetProjectPipeline(uint32_t sh_degree, bool an
 void GaussianGeometryStage::PushBindings(VkCommandBuffer cmd,
                                          const GeometryStageSceneBuffers& scene,
                                          const GeometryStageViewBuffers& buffers) const {
+    // Without bins the tile ranges binding is never used but must name a buffer.
+    const BufferRange* tile_ranges =
+        buffers.tile_ranges.buffer != VK_NULL_HANDLE ? &buffers.tile_ranges : &buffers.counters;
     const std::array<const BufferRange*, kGeometryStageNumBindings> ranges{
         &buffers.view_params, &scene.visibility,      &buffers.counters,
         &buffers.depth_keys,  &buffers.splat_indices, &buffers.scan,
         &buffers.entry_keys,  &buffers.entry_values,  &buffers.sort_scratch.params,
-        &buffers.tile_counts};
+        &buffers.tile_counts, tile_ranges};
     static_assert(kGeometryStageViewBinding == 0 && kGeometryStageVisibilityBinding == 1 &&
                       kGeometryStageCountersBinding == 2 && kGeometryStageDepthKeysBinding == 3 &&
                       kGeometryStageSplatIndexBinding == 4 && kGeometryStageScanBinding == 5 &&
                       kGeometryStageEntryKeysBinding == 6 &&
                       kGeometryStageEntryValuesBinding == 7 &&
-                      kGeometryStageSortParamsBinding == 8 && kGeometryStageTileCountsBinding == 9,
+                      kGeometryStageSortParamsBinding == 8 &&
+                      kGeometryStageTileCountsBinding == 9 &&
+                      kGeometryStageTileRangesBinding == 10,
                   "ranges above are listed in binding order");
     std::array<VkDescriptorBufferInfo, kGeometryStageNumBindings> infos{};
     std::array<VkWriteDescriptorSet, kGeometryStageNumBindings> writes{};
@@ -231,6 +258,22 @@ void GaussianGeometryStage::Record(VkCommandBuffer cmd, const GeometryStageScene
                           buffers.sort_scratch.params.offset, sizeof(depth_sort), &depth_sort);
     }
     vkCmdUpdateBuffer(cmd, counters, counters_offset, sizeof(initial_counters), &initial_counters);
+    if (choices.binned) {
+        // Every tile's count starts at 0 (and the composite's tile counter, which it zeroes
+        // again itself).
+        const VkDeviceSize bins_bytes =
+            4 * (kBinRangesWordOffset + 2 * VkDeviceSize(choices.num_tiles));
+        if (buffers.tile_ranges.buffer == VK_NULL_HANDLE ||
+            (buffers.tile_ranges.size != VK_WHOLE_SIZE && buffers.tile_ranges.size < bins_bytes)) {
+            core::ThrowError(
+                "GaussianGeometryStage: per-tile bins of {} tiles need {} bytes of tile "
+                "ranges (the composite's state), {} given",
+                choices.num_tiles, bins_bytes,
+                buffers.tile_ranges.buffer == VK_NULL_HANDLE ? 0 : buffers.tile_ranges.size);
+        }
+        vkCmdFillBuffer(cmd, buffers.tile_ranges.buffer, buffers.tile_ranges.offset, bins_bytes,
+                        0u);
+    }
     RecordMemoryBarrier(
         cmd, VK_PIPELINE_STAGE_2_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
         VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_DRAW_INDIRECT_BIT,
@@ -271,7 +314,7 @@ void GaussianGeometryStage::Record(VkCommandBuffer cmd, const GeometryStageScene
     PushBindings(cmd, scene, buffers);
     vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE,
                       GetProjectPipeline(choices.sh_degree, choices.antialias, scene.precision,
-                                         !packed_key, scene.lod));
+                                         !packed_key, scene.lod, choices.binned));
     if (n > 0) {
         const uvec4 grid = DispatchGridFor(DivCeil(n, kProjectWorkgroupSize), max_groups_x);
         RecordDispatch(cmd, grid.x, grid.y, 1);
@@ -294,6 +337,11 @@ void GaussianGeometryStage::Record(VkCommandBuffer cmd, const GeometryStageScene
     if (timestamps) {
         timestamps->RecordEnd(cmd, TimedPass::kProject);
         timestamps->RecordBegin(cmd, TimedPass::kSort);
+    }
+    if (choices.binned) {
+        RecordBins(cmd, view, timestamps);
+        if (timestamps) timestamps->RecordEnd(cmd, TimedPass::kSort);
+        return;
     }
 
     // 3. Exact depth order with ties by splat index: slot i of the list holds splat i (culled
@@ -377,6 +425,38 @@ void GaussianGeometryStage::Record(VkCommandBuffer cmd, const GeometryStageScene
     }
     end(TimedPass::kTileSort);
     end(TimedPass::kSort);
+}
+
+void GaussianGeometryStage::RecordBins(VkCommandBuffer cmd, const PackedView& view,
+                                       const GpuTimestamps* timestamps) {
+    const uint32_t n = view.choices.num_splats;
+    const uint32_t tiles = view.choices.num_tiles;
+    const uint32_t max_groups_x = sort_.GetMaxGroupsX();
+    const auto begin = [&](TimedPass pass) {
+        if (timestamps) timestamps->RecordBegin(cmd, pass);
+    };
+    const auto end = [&](TimedPass pass) {
+        if (timestamps) timestamps->RecordEnd(cmd, pass);
+    };
+    // The projection counted each tile's entries. One workgroup scans them into begins.
+    begin(TimedPass::kScanEmit);
+    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, bin_scan_.Get());
+    RecordDispatch(cmd, 1, 1, 1);
+    ComputeBarrier(cmd);
+    // Every visible slot writes (depth key, slot) into the bins of its tiles.
+    if (n > 0) {
+        vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, emit_binned_.Get());
+        const uvec4 grid = DispatchGridFor(DivCeil(n, kEmitWorkgroupSize), max_groups_x);
+        RecordDispatch(cmd, grid.x, grid.y, 1);
+        ComputeBarrier(cmd);
+    }
+    end(TimedPass::kScanEmit);
+    // A workgroup per tile orders its bin.
+    begin(TimedPass::kTileSort);
+    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, bin_sort_.Get());
+    const uvec4 grid = DispatchGridFor(std::max(tiles, 1u), max_groups_x);
+    RecordDispatch(cmd, grid.x, grid.y, 1);
+    end(TimedPass::kTileSort);
 }
 
 }  // namespace vulkan

@@ -89,6 +89,11 @@ struct GeometryStageViewBuffers {
     BufferRange entry_values;   ///< after Record: splat index per entry, front to back
     RadixSortScratch sort_scratch;
     BufferRange tile_counts;  ///< scratch: each visible splat's tile count, by splat index
+    /// The composite's state buffer (GaussianCompositeStage::StateBytes of the view's size,
+    /// from its start): with per-tile bins (view.choices.binned) the stage counts, fills and
+    /// leaves each tile's [begin, end) there, and the composite reads it as it is
+    /// (CompositeStageInputs::ranges_written). Unused otherwise (may be empty).
+    BufferRange tile_ranges;
     /// A hierarchy's cut (GaussianLodCut; unused otherwise): effective size buckets, their
     /// histogram, the cut as bits, their counts per group, and the list of the cut's nodes
     /// the projection reads.
@@ -118,6 +123,11 @@ public:
     /// this scene and a capacity <= the one the buffers were sized for. Pipelines and passes
     /// are picked from view.choices, the host's own values, not read back from view.params.
     ///
+    /// With per-tile bins (view.choices.binned, the default exact order): project (also
+    /// counting each tile's entries in buffers.tile_ranges) -> bin scan (each tile's begin,
+    /// the entries that fit) -> emit (depth key, slot) into the bins -> sort each tile by
+    /// (depth key, slot); the keys end as tile indices, the ranges stay in tile_ranges.
+    ///
     /// With the packed key (view.choices.packed_key): no sort of the visible list (scan
     /// and emit follow the append order, sized by a dispatch-args pass), entries keyed by
     /// shader::PackedSortKey, one stable 32-bit sort, then the keys are shifted back to tile
@@ -141,7 +151,10 @@ public:
 private:
     /// `cut_list`: slot i projects the node the cut's list holds (shader::kSpecCutList).
     VkPipeline GetProjectPipeline(uint32_t sh_degree, bool antialias, SplatPrecision precision,
-                                  bool indexed_list, bool cut_list);
+                                  bool indexed_list, bool cut_list, bool bin_tiles);
+    /// The per-tile bins' passes after the projection (RenderConfig SortMode::kExact).
+    /// Bindings and push constants are the projection's, still bound.
+    void RecordBins(VkCommandBuffer cmd, const PackedView& view, const GpuTimestamps* timestamps);
     void PushBindings(VkCommandBuffer cmd, const GeometryStageSceneBuffers& scene,
                       const GeometryStageViewBuffers& buffers) const;
 
@@ -156,8 +169,11 @@ private:
     UniquePipeline emit_;
     UniquePipeline emit_packed_;  // kEmitPackedKeys
     UniquePipeline unpack_keys_;  // kEmitUnpackKeys
+    UniquePipeline emit_binned_;  // kEmitBinned
+    UniquePipeline bin_scan_;
+    UniquePipeline bin_sort_;
     std::map<uint32_t, UniquePipeline>
-        project_;  // key: degree | antialias << 2 | precision << 3 | indexed << 4
+        project_;  // key: degree | antialias << 2 | precision << 3 | indexed << 4 | cut << 5 | bins << 6
 };
 
 }  // namespace vulkan

@@ -329,6 +329,7 @@ void GaussianSplatVulkanBackend::EnsureTargets(uint32_t width, uint32_t height) 
     median_ = Image(*context_, width, height, need.scalar_format, usage);
     composite_state_ = Buffer(*context_, GaussianCompositeStage::StateBytes(width, height),
                               need.state_usage, MemoryUsage::kDevice);
+    stage_recording_valid_ = false;  // its per-tile bins name the old state buffer
     width_ = width;
     height_ = height;
 }
@@ -380,6 +381,9 @@ void GaussianSplatVulkanBackend::RenderGeometryStage(const camera::PinholeCamera
     }
     if (geometry_.in_flight) Wait(*context_, geometry_stage_fence_.Get());
     CheckViewFits(static_cast<uint32_t>(camera.width), static_cast<uint32_t>(camera.height));
+    // Per-tile bins leave each tile's range in the composite's state: it must be this
+    // size's before the geometry stage is recorded.
+    EnsureTargets(static_cast<uint32_t>(camera.width), static_cast<uint32_t>(camera.height));
 
     EnsureViewBuffers(static_cast<uint32_t>(
         std::min<uint64_t>(MaxEntryCapacity(config, SortMaxCount()), initial_entry_capacity_)));
@@ -411,9 +415,10 @@ void GaussianSplatVulkanBackend::RenderGeometryStage(const camera::PinholeCamera
         geometry_stage_cmd_.Begin(/*one_time_submit=*/false);
         geometry_stage_timestamps_.RecordReset(cmd);
         const BufferRange source = stage_params_upload_.Range();
-        geometry_stage_.Record(cmd, geometry_stage_resources_.Scene(),
-                               geometry_stage_resources_.View(), view, &geometry_stage_timestamps_,
-                               &source);
+        GeometryStageViewBuffers buffers = geometry_stage_resources_.View();
+        buffers.tile_ranges = composite_state_.Range();
+        geometry_stage_.Record(cmd, geometry_stage_resources_.Scene(), buffers, view,
+                               &geometry_stage_timestamps_, &source);
         // The counters reach the host with the geometry stage's fence: composite stage can
         // skip an empty frame.
         RecordMemoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
@@ -644,6 +649,7 @@ RenderStats GaussianSplatVulkanBackend::RenderComposite(CompositeSink& sink) {
         inputs.entry_count = geometry_stage_resources_.ViewResources().counters.Range(
             offsetof(shader::GaussianGeometryStageCounters, entry_count), sizeof(uint32_t));
         inputs.entry_capacity = geometry_stage_resources_.EntryCapacity();
+        inputs.ranges_written = geometry_.config.sort_mode == SortMode::kExact;
         CompositeStageTargets targets;
         targets.width = w;
         targets.height = h;

@@ -31,8 +31,8 @@ constexpr VkBufferUsageFlags kTransfer =
 
 bool SameChoices(const GeometryStageChoices& a, const GeometryStageChoices& b) {
     return a.num_splats == b.num_splats && a.sh_degree == b.sh_degree &&
-           a.antialias == b.antialias && a.packed_key == b.packed_key &&
-           a.tile_bits == b.tile_bits && a.entry_capacity == b.entry_capacity &&
+           a.antialias == b.antialias && a.packed_key == b.packed_key && a.binned == b.binned &&
+           a.tile_bits == b.tile_bits && a.num_tiles == b.num_tiles && a.entry_capacity == b.entry_capacity &&
            a.entry_capacity_allocated == b.entry_capacity_allocated &&
            a.lod_cut_search == b.lod_cut_search;
 }
@@ -390,7 +390,8 @@ void GaussianSplatVulkanBackend::RecordSlot(FrameSlot& slot, const FrameRecordin
     slot.job_timestamps.RecordBegin(cmd, 0u);
 
     const GeometryStageSceneBuffers scene = geometry_stage_resources_.Scene();
-    const GeometryStageViewBuffers buffers = slot.view.Buffers();
+    GeometryStageViewBuffers buffers = slot.view.Buffers();
+    buffers.tile_ranges = slot.composite_state.Range();
     PackedView view;  // the parameters come from params_upload; the choices pick pipelines
     view.choices = key.choices;
 
@@ -405,6 +406,7 @@ void GaussianSplatVulkanBackend::RecordSlot(FrameSlot& slot, const FrameRecordin
     inputs.entry_count = slot.view.counters.Range(
         offsetof(GaussianGeometryStageCounters, entry_count), sizeof(uint32_t));
     inputs.entry_capacity = slot.view.EntryCapacity();
+    inputs.ranges_written = key.choices.binned;
     CompositeStageTargets targets;
     targets.width = key.width;
     targets.height = key.height;

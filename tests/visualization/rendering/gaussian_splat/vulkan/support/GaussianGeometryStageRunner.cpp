@@ -1,11 +1,14 @@
 #include "visualization/rendering/gaussian_splat/vulkan/support/GaussianGeometryStageRunner.h"
 #include "open3d/core/Timer.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cstring>
+#include <utility>
 
 #include "open3d/core/Exception.h"
 #include "open3d/core/Logging.h"
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/GaussianCompositeStage.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/VulkanContext.h"
 
 namespace open3d {
@@ -81,7 +84,14 @@ GeometryStageReadback GaussianGeometryStageRunner::Run(const camera::PinholeCame
                                                        bool read_projected) {
     const PackedView packed_view = resources_.ViewParams(camera, config);
     const GeometryStageSceneBuffers scene = resources_.Scene();
-    const GeometryStageViewBuffers view = resources_.View();
+    GeometryStageViewBuffers view = resources_.View();
+    // Per-tile bins leave their ranges in the composite's state buffer.
+    Buffer tile_ranges(context_,
+                       GaussianCompositeStage::StateBytes(uint32_t(camera.width),
+                                                          uint32_t(camera.height)),
+                       GaussianCompositeStage::GetStorageRequirements().state_usage,
+                       MemoryUsage::kDevice);
+    view.tile_ranges = tile_ranges.Range();
 
     GeometryStageReadback out;
     out.num_splats = resources_.Layout().num_splats;
@@ -113,13 +123,19 @@ GeometryStageReadback GaussianGeometryStageRunner::Run(const camera::PinholeCame
     // Second copy with the sizes now known: only the live part of each buffer.
     const uint32_t visible = out.counters.visible_count;
     const uint32_t entries = out.counters.entry_count;
-    out.visible_in_depth_order.resize(visible);
+    // Per-tile bins sort no visible list: slot i's depth key is ~0u unless it is visible.
+    const bool binned = packed_view.choices.binned;
+    std::vector<uint32_t> depth_keys(binned ? packed_view.choices.num_splats : 0);
+    out.visible_in_depth_order.resize(binned ? 0 : visible);
     out.entry_tiles.resize(entries);
     out.entry_splats.resize(entries);
     if (read_projected) out.projected.resize(resources_.Layout().num_splats);
     SubmitAndWait(context_, pool_, [&](VkCommandBuffer cmd) {
         RecordCopy(context_, cmd, resources_.ViewResources().splat_indices,
-                   VkDeviceSize(visible) * 4, out.visible_in_depth_order.data(), pending);
+                   VkDeviceSize(out.visible_in_depth_order.size()) * 4,
+                   out.visible_in_depth_order.data(), pending);
+        RecordCopy(context_, cmd, resources_.ViewResources().depth_keys,
+                   VkDeviceSize(depth_keys.size()) * 4, depth_keys.data(), pending);
         RecordCopy(context_, cmd, resources_.ViewResources().entry_keys, VkDeviceSize(entries) * 4,
                    out.entry_tiles.data(), pending);
         RecordCopy(context_, cmd, resources_.ViewResources().entry_values,
@@ -134,6 +150,16 @@ GeometryStageReadback GaussianGeometryStageRunner::Run(const camera::PinholeCame
     // The list's values carry entry counts above the splat index (shader::PackListValue).
     for (uint32_t& value : out.visible_in_depth_order) {
         value = shader::ListValueSplat(value, resources_.Layout().num_splats);
+    }
+    if (binned) {
+        // The visible slots are the GPU's; their order here is the host's sort of the GPU's
+        // depth keys (the bins order each tile's entries, which the tests compare).
+        std::vector<std::pair<uint32_t, uint32_t>> keyed;
+        for (uint32_t i = 0; i < depth_keys.size(); ++i) {
+            if (depth_keys[i] != 0xFFFFFFFFu) keyed.emplace_back(depth_keys[i], i);
+        }
+        std::sort(keyed.begin(), keyed.end());
+        for (const auto& [key, slot] : keyed) out.visible_in_depth_order.push_back(slot);
     }
     return out;
 }
