@@ -590,7 +590,8 @@ int Run(const Options& opt) {
     std::vector<SceneJob> jobs;
     if (opt.inputs.empty()) core::ThrowError("--input is required (a .ply or .splat scene)");
     if (opt.grid > 0 && opt.first > 0) {
-        core::ThrowError("--first takes the first splats of each --input; --grid tiles a whole one");
+        core::ThrowError(
+            "--first takes the first splats of each --input; --grid tiles a whole one");
     }
     if (opt.grid > 0) {
         if (opt.cameras.empty())
@@ -929,7 +930,8 @@ int main(int argc, char** argv) {
         "Real scenes: one --cameras per --input, views from --views at each --resolution\n"
         "(fx = fy = fx_json * H / H_json, principal point at the centre). --grid K builds\n"
         "K x K copies of the first --input with the camera defined in docs/benchmark.md.\n"
-        "Knobs: default, global-sorts, packed-key, compact, sh<=1, antialias, camera-relative. The error\n"
+        "Knobs: default, global-sorts, packed-key, compact, sh<=1, antialias, camera-relative. The "
+        "error\n"
         "columns compare the colour with the CPU reference (default knobs but the SH cap and\n"
         "antialias) rendered in the same run (worst view).",
         "gs-bench"};

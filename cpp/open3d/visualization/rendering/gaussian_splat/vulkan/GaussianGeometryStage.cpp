@@ -73,14 +73,13 @@ GaussianGeometryStage::GaussianGeometryStage(const VulkanContext& context)
         CreateComputePipeline(context, layout, spirv::kGaussianBinScan, "gaussian_bin_scan");
     // A tile sorts in shared memory up to 8-byte pairs filling 32 KiB where the device has
     // room for them beside nothing else (NVIDIA: 48 KiB), else 16 KiB (lavapipe: 32 KiB).
-    const uint32_t sort_capacity =
-        context.GetDeviceInfo().max_compute_shared_memory >= 40u * 1024u
-            ? kBinSortCapacityLarge
-            : kBinSortCapacitySmall;
+    const uint32_t sort_capacity = context.GetDeviceInfo().max_compute_shared_memory >= 40u * 1024u
+                                       ? kBinSortCapacityLarge
+                                       : kBinSortCapacitySmall;
     const VkSpecializationMapEntry sort_entry{kSpecBinSortCapacity, 0, sizeof(uint32_t)};
     const VkSpecializationInfo sort_info{1, &sort_entry, sizeof(uint32_t), &sort_capacity};
-    bin_sort_ = CreateComputePipeline(context, layout, spirv::kGaussianBinSort,
-                                      "gaussian_bin_sort", &sort_info);
+    bin_sort_ = CreateComputePipeline(context, layout, spirv::kGaussianBinSort, "gaussian_bin_sort",
+                                      &sort_info);
 }
 
 GeometryStageStorageRequirements GaussianGeometryStage::GetStorageRequirements(
@@ -121,16 +120,12 @@ VkPipeline GaussianGeometryStage::GetProjectPipeline(uint32_t sh_degree, bool an
     const uint32_t precision_value =
         precision == SplatPrecision::kExact ? kPrecisionExact : kPrecisionCompact;
     const uint32_t key = sh_degree | (antialias ? 4u : 0u) | (precision_value << 3) |
-                         (indexed_list ? 16u : 0u) | (cut_list ? 32u : 0u) |
-                         (bin_tiles ? 64u : 0u);
+                         (indexed_list ? 16u : 0u) | (cut_list ? 32u : 0u) | (bin_tiles ? 64u : 0u);
     auto it = project_.find(key);
     if (it != project_.end()) return it->second.Get();
-    const std::array<uint32_t, 6> values{sh_degree,
-                                         antialias ? 1u : 0u,
-                                         precision_value,
-                                         indexed_list ? 1u : 0u,
-                                         cut_list ? 1u : 0u,
-                                         bin_tiles ? 1u : 0u};
+    const std::array<uint32_t, 6> values{sh_degree,          antialias ? 1u : 0u,
+                                         precision_value,    indexed_list ? 1u : 0u,
+                                         cut_list ? 1u : 0u, bin_tiles ? 1u : 0u};
     const std::array<VkSpecializationMapEntry, 6> entries{{{kSpecShDegree, 0, 4},
                                                            {kSpecAntialias, 4, 4},
                                                            {kSpecPrecision, 8, 4},
@@ -150,18 +145,24 @@ void GaussianGeometryStage::PushBindings(VkCommandBuffer cmd,
     const BufferRange* tile_ranges =
         buffers.tile_ranges.buffer != VK_NULL_HANDLE ? &buffers.tile_ranges : &buffers.counters;
     const std::array<const BufferRange*, kGeometryStageNumBindings> ranges{
-        &buffers.view_params, &scene.visibility,      &buffers.counters,
-        &buffers.depth_keys,  &buffers.splat_indices, &buffers.scan,
-        &buffers.entry_keys,  &buffers.entry_values,  &buffers.sort_scratch.params,
-        &buffers.tile_counts, tile_ranges};
+        &buffers.view_params,
+        &scene.visibility,
+        &buffers.counters,
+        &buffers.depth_keys,
+        &buffers.splat_indices,
+        &buffers.scan,
+        &buffers.entry_keys,
+        &buffers.entry_values,
+        &buffers.sort_scratch.params,
+        &buffers.tile_counts,
+        tile_ranges};
     static_assert(kGeometryStageViewBinding == 0 && kGeometryStageVisibilityBinding == 1 &&
                       kGeometryStageCountersBinding == 2 && kGeometryStageDepthKeysBinding == 3 &&
                       kGeometryStageSplatIndexBinding == 4 && kGeometryStageScanBinding == 5 &&
                       kGeometryStageEntryKeysBinding == 6 &&
                       kGeometryStageEntryValuesBinding == 7 &&
                       kGeometryStageSortParamsBinding == 8 &&
-                      kGeometryStageTileCountsBinding == 9 &&
-                      kGeometryStageTileRangesBinding == 10,
+                      kGeometryStageTileCountsBinding == 9 && kGeometryStageTileRangesBinding == 10,
                   "ranges above are listed in binding order");
     std::array<VkDescriptorBufferInfo, kGeometryStageNumBindings> infos{};
     std::array<VkWriteDescriptorSet, kGeometryStageNumBindings> writes{};

@@ -172,8 +172,8 @@ private:
     UniquePipeline emit_binned_;  // kEmitBinned
     UniquePipeline bin_scan_;
     UniquePipeline bin_sort_;
-    std::map<uint32_t, UniquePipeline>
-        project_;  // key: degree | antialias << 2 | precision << 3 | indexed << 4 | cut << 5 | bins << 6
+    std::map<uint32_t, UniquePipeline> project_;  // key: degree | antialias << 2 | precision << 3 |
+                                                  // indexed << 4 | cut << 5 | bins << 6
 };
 
 }  // namespace vulkan

@@ -32,7 +32,8 @@ constexpr VkBufferUsageFlags kTransfer =
 bool SameChoices(const GeometryStageChoices& a, const GeometryStageChoices& b) {
     return a.num_splats == b.num_splats && a.sh_degree == b.sh_degree &&
            a.antialias == b.antialias && a.packed_key == b.packed_key && a.binned == b.binned &&
-           a.tile_bits == b.tile_bits && a.num_tiles == b.num_tiles && a.entry_capacity == b.entry_capacity &&
+           a.tile_bits == b.tile_bits && a.num_tiles == b.num_tiles &&
+           a.entry_capacity == b.entry_capacity &&
            a.entry_capacity_allocated == b.entry_capacity_allocated &&
            a.lod_cut_search == b.lod_cut_search;
 }

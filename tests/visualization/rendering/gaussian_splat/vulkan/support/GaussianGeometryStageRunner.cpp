@@ -86,11 +86,10 @@ GeometryStageReadback GaussianGeometryStageRunner::Run(const camera::PinholeCame
     const GeometryStageSceneBuffers scene = resources_.Scene();
     GeometryStageViewBuffers view = resources_.View();
     // Per-tile bins leave their ranges in the composite's state buffer.
-    Buffer tile_ranges(context_,
-                       GaussianCompositeStage::StateBytes(uint32_t(camera.width),
-                                                          uint32_t(camera.height)),
-                       GaussianCompositeStage::GetStorageRequirements().state_usage,
-                       MemoryUsage::kDevice);
+    Buffer tile_ranges(
+        context_,
+        GaussianCompositeStage::StateBytes(uint32_t(camera.width), uint32_t(camera.height)),
+        GaussianCompositeStage::GetStorageRequirements().state_usage, MemoryUsage::kDevice);
     view.tile_ranges = tile_ranges.Range();
 
     GeometryStageReadback out;
