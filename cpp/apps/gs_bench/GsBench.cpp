@@ -76,8 +76,8 @@ struct Knob {
 
 const std::vector<Knob> kKnobs = {
     {"default", [](rendering::RenderConfig&) {}},
-    {"global-sorts",
-     [](rendering::RenderConfig& c) { c.sort_mode = rendering::SortMode::kExactGlobalSorts; }},
+    {"tile-bins",
+     [](rendering::RenderConfig& c) { c.sort_mode = rendering::SortMode::kExactTileBins; }},
     {"packed-key",
      [](rendering::RenderConfig& c) { c.sort_mode = rendering::SortMode::kPackedKey32; }},
     {"compact", [](rendering::RenderConfig& c) { c.compact_storage = true; }},
@@ -930,7 +930,7 @@ int main(int argc, char** argv) {
         "Real scenes: one --cameras per --input, views from --views at each --resolution\n"
         "(fx = fy = fx_json * H / H_json, principal point at the centre). --grid K builds\n"
         "K x K copies of the first --input with the camera defined in docs/benchmark.md.\n"
-        "Knobs: default, global-sorts, packed-key, compact, sh<=1, antialias, camera-relative. The "
+        "Knobs: default, tile-bins, packed-key, compact, sh<=1, antialias, camera-relative. The "
         "error\n"
         "columns compare the colour with the CPU reference (default knobs but the SH cap and\n"
         "antialias) rendered in the same run (worst view).",

@@ -243,7 +243,7 @@ GeometryStageChoices ChooseGeometryStage(const camera::PinholeCamera& camera,
     choices.sh_degree = uint32_t(EvaluatedShDegree(config, inputs.packed_sh_degree));
     choices.antialias = config.antialias;
     choices.packed_key = UsesPackedSortKey(config);
-    choices.binned = config.sort_mode == SortMode::kExact;
+    choices.binned = config.sort_mode == SortMode::kExactTileBins;
     choices.num_tiles = static_cast<uint32_t>(grid.NumTiles());
     choices.tile_bits = SortKeyTileBits(static_cast<uint64_t>(grid.NumTiles()));
     choices.entry_capacity = std::min(config_limit, inputs.entry_capacity);

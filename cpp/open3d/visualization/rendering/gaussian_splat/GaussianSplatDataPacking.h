@@ -113,7 +113,7 @@ struct GeometryStageChoices {
     uint32_t sh_degree = 0;  ///< evaluated: EvaluatedShDegree
     bool antialias = false;
     bool packed_key = false;  ///< config.sort_mode == kPackedKey32
-    bool binned = false;      ///< config.sort_mode == kExact: per-tile bins
+    bool binned = false;      ///< config.sort_mode == kExactTileBins
     uint32_t tile_bits = 0;   ///< SortKeyTileBits of the frame's tile count
     uint32_t num_tiles = 0;   ///< the frame's tiles (tiles_x * tiles_y)
     /// Tile entries used: min(allocated, max_tile_entries_total), below shader::kScanSaturation.

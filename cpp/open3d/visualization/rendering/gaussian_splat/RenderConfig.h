@@ -15,15 +15,17 @@ inline constexpr int kTileSize = 16;
 
 /// Depth order of each tile's splats (GPU backends; the CPU reference is always exact).
 enum class SortMode {
-    /// Exact float32 view depth, ties by splat index: the reference's order. Entries go
-    /// into per-tile bins and each tile is sorted by (depth, splat index) on its own
-    /// (docs/vulkan.md "Per-tile bins"): five dependent passes to the composite.
+    /// Exact float32 view depth, ties by splat index: the reference's order, from one stable
+    /// sort of the visible splats by depth and one stable sort of the entries by tile (radix
+    /// sorts over the whole frame). When the entries pass the capacity the farthest splats
+    /// are dropped everywhere.
     kExact,
-    /// The same order from one stable sort of the visible splats by depth and one stable
-    /// sort of the entries by tile (radix sorts over the whole frame): the earlier design,
-    /// kept to measure against. When the entries pass the capacity it drops the farthest
-    /// splats everywhere, where the bins drop whole tiles from the last row up.
-    kExactGlobalSorts,
+    /// The same order from per-tile bins: the projection counts each tile's entries, the
+    /// entries go into their tile's bin and each tile is sorted by (depth, splat index) on
+    /// its own (docs/vulkan.md "Per-tile bins"): five dependent passes in place of about 25,
+    /// but slower on real scenes as built today (docs/perf/h100.md). When the entries pass
+    /// the capacity, whole tiles are dropped from the first that does not fit.
+    kExactTileBins,
     /// The seed's single 32-bit key per entry: tile index in the top ceil(log2(tiles)) bits,
     /// the truncated bits of the normalised depth below, ties in the projection's
     /// (nondeterministic) append order. Only 7-11 mantissa bits of depth at 1080p-8K, so
@@ -77,8 +79,8 @@ struct RenderConfig {
     uint64_t max_tile_entries_total = 1ull << 26;
     /// Which depth orders the splats and culls them at the near plane; see DepthOrder.
     DepthOrder depth_order = DepthOrder::kReference;
-    /// Exact depth order in per-tile bins (default), by two global sorts, or the seed's packed
-    /// 32-bit key; see SortMode.
+    /// Exact depth order by two global sorts (default) or in per-tile bins, or the seed's
+    /// packed 32-bit key; see SortMode.
     SortMode sort_mode = SortMode::kExact;
     /// GPU storage of the splat attributes: false = `exact` (fp32 where it matters), true =
     /// `compact` (fp16 scale, rotation, colour and SH; <= 140 B/splat at SH degree 3). GPU

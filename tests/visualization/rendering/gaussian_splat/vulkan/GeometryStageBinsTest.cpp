@@ -1,6 +1,6 @@
-// Per-tile bins (SortMode::kExact): tiles longer than the bin sort's shared-memory run, depth
-// ties, and the order the atomics fill a bin in must all give the CPU reference's lists
-// entry for entry (cpu::BuildTileLists: ascending float32 depth, ties by splat index).
+// Per-tile bins (SortMode::kExactTileBins): tiles longer than the bin sort's shared-memory run,
+// depth ties, and the order the atomics fill a bin in must all give the CPU reference's lists entry
+// for entry (cpu::BuildTileLists: ascending float32 depth, ties by splat index).
 #include <gtest/gtest.h>
 
 #include <random>
@@ -23,6 +23,12 @@ using visualization::rendering::vulkan::GaussianGeometryStageRunner;
 using visualization::rendering::vulkan::GeometryStageReadback;
 
 class GeometryStageBins : public VulkanTest {};
+
+RenderConfig TileBins() {
+    RenderConfig config;
+    config.sort_mode = SortMode::kExactTileBins;
+    return config;
+}
 
 using TileListsByTile = std::vector<std::vector<uint32_t>>;
 
@@ -70,7 +76,7 @@ TEST_F(GeometryStageBins, LongTilesAndTiesGiveTheReferenceLists) {
     const auto cloud = CrowdedScene(24000, 7, 11);
     const auto cam = MakeTestCamera(48, 32);
     GaussianGeometryStageRunner runner(Context(), PackGaussianSplatAttrs(cloud), 1u << 16);
-    const GeometryStageReadback gpu = runner.Run(cam, RenderConfig{});
+    const GeometryStageReadback gpu = runner.Run(cam, TileBins());
     ASSERT_EQ(gpu.counters.error_flags, 0u);
     const TileListsByTile want = CpuLists(cloud, cam, RenderConfig{});
     size_t longest = 0;
@@ -86,7 +92,7 @@ TEST_F(GeometryStageBins, ShortTilesOfEverySizeGiveTheReferenceLists) {
         const auto cloud = CrowdedScene(count, 3, 100 + count);
         const auto cam = MakeTestCamera(48, 32);
         GaussianGeometryStageRunner runner(Context(), PackGaussianSplatAttrs(cloud), 1u << 16);
-        const GeometryStageReadback gpu = runner.Run(cam, RenderConfig{});
+        const GeometryStageReadback gpu = runner.Run(cam, TileBins());
         const TileListsByTile want = CpuLists(cloud, cam, RenderConfig{});
         EXPECT_EQ(GpuLists(gpu, want.size()), want) << count << " splats";
     }

@@ -175,10 +175,10 @@ std::vector<std::vector<uint32_t>> GpuLists(const GeometryStageReadback& gpu,
     return tiles;
 }
 
-// The two global sorts: a capacity drops the farthest splats (the prefix rule).
-RenderConfig GlobalSorts() {
+// Per-tile bins: a capacity drops whole tiles from the first that does not fit.
+RenderConfig TileBins() {
     RenderConfig config;
-    config.sort_mode = SortMode::kExactGlobalSorts;
+    config.sort_mode = SortMode::kExactTileBins;
     return config;
 }
 
@@ -204,12 +204,12 @@ TEST_F(GeometryStageFeatures, CapacityOverflowDropsEntriesFlagsAndWarnsOnce) {
     {
         GaussianGeometryStageRunner runner(Context(), packed, 4096);
         for (int frame = 0; frame < 3; ++frame) {
-            const GeometryStageReadback gpu = runner.Run(cam, GlobalSorts());
+            const GeometryStageReadback gpu = runner.Run(cam, RenderConfig{});
             EXPECT_EQ(gpu.counters.error_flags, kEntriesDropped | kCountsClamped);
             EXPECT_LE(gpu.counters.entry_count, 4096u);
             EXPECT_GT(gpu.counters.entry_count, 4000u);
             EXPECT_EQ(gpu.counters.requested_entries, 9696u);
-            EXPECT_EQ(GpuLists(gpu, grid), PrefixRuleLists(gpu, ref, grid, GlobalSorts(), 4096));
+            EXPECT_EQ(GpuLists(gpu, grid), PrefixRuleLists(gpu, ref, grid, RenderConfig{}, 4096));
         }
     }
     EXPECT_EQ(warnings, 2) << "one warning per flag bit for the view, not one per frame";
@@ -217,7 +217,7 @@ TEST_F(GeometryStageFeatures, CapacityOverflowDropsEntriesFlagsAndWarnsOnce) {
     // (b) RenderConfig::max_tile_entries_total is the limit: bit 0 only.
     warnings = 0;
     {
-        RenderConfig config = GlobalSorts();
+        RenderConfig config;
         config.max_tile_entries_total = 5000;
         GaussianGeometryStageRunner runner(Context(), packed, 1u << 16);
         const GeometryStageReadback gpu = runner.Run(cam, config);
@@ -276,7 +276,7 @@ TEST_F(GeometryStageFeatures, CapacityCutsTheListWhereTheScanSaysAcrossScanLevel
         std::erase_if(tile, [&](uint32_t splat) { return !kept[splat]; });
     }
     GaussianGeometryStageRunner cut_runner(Context(), packed, capacity);
-    const GeometryStageReadback gpu = cut_runner.Run(cam, GlobalSorts());
+    const GeometryStageReadback gpu = cut_runner.Run(cam, RenderConfig{});
     EXPECT_EQ(gpu.counters.error_flags, kEntriesDropped | kCountsClamped);
     EXPECT_EQ(gpu.counters.requested_entries, uncut.counters.entry_count);
     EXPECT_EQ(gpu.counters.entry_count, total);
@@ -284,9 +284,9 @@ TEST_F(GeometryStageFeatures, CapacityCutsTheListWhereTheScanSaysAcrossScanLevel
 }
 
 TEST_F(GeometryStageFeatures, BinsKeepWholeTilesUpToTheCapacity) {
-    // Per-tile bins (the default): tiles in row-major order keep all their entries while
-    // their running total fits; from the first that does not, tiles get none. Expected:
-    // the uncut run's lists (which equal the global sorts', checked here too) cut that way.
+    // Per-tile bins: tiles in row-major order keep all their entries while their running
+    // total fits; from the first that does not, tiles get none. Expected: the uncut run's
+    // lists (which equal the global sorts', checked here too) cut that way.
     OPEN3D_REQUIRE_DATA("playbot/playbot_31k.ply");
     OPEN3D_REQUIRE_DATA("playbot/cameras.json");
     const auto cloud = ReadScene("playbot/playbot_31k.ply");
@@ -294,9 +294,9 @@ TEST_F(GeometryStageFeatures, BinsKeepWholeTilesUpToTheCapacity) {
     const auto grid = cpu::TileGrid::ForImage(cam.width, cam.height);
     const PackedGaussianSplats packed = PackGaussianSplatAttrs(cloud);
     GaussianGeometryStageRunner uncut_runner(Context(), packed, 1u << 20);
-    const GeometryStageReadback uncut = uncut_runner.Run(cam, RenderConfig{});
+    const GeometryStageReadback uncut = uncut_runner.Run(cam, TileBins());
     ASSERT_EQ(uncut.counters.error_flags, 0u);
-    EXPECT_EQ(GpuLists(uncut, grid), GpuLists(uncut_runner.Run(cam, GlobalSorts()), grid));
+    EXPECT_EQ(GpuLists(uncut, grid), GpuLists(uncut_runner.Run(cam, RenderConfig{}), grid));
     std::vector<std::vector<uint32_t>> want = GpuLists(uncut, grid);
     const uint32_t capacity = uncut.counters.entry_count / 2;
     uint32_t total = 0;
@@ -312,7 +312,7 @@ TEST_F(GeometryStageFeatures, BinsKeepWholeTilesUpToTheCapacity) {
     ASSERT_GT(first_cut, 0u);
     ASSERT_LT(first_cut, want.size() - 1);
     GaussianGeometryStageRunner cut_runner(Context(), packed, capacity);
-    const GeometryStageReadback gpu = cut_runner.Run(cam, RenderConfig{});
+    const GeometryStageReadback gpu = cut_runner.Run(cam, TileBins());
     EXPECT_EQ(gpu.counters.error_flags, kEntriesDropped | kCountsClamped);
     EXPECT_EQ(gpu.counters.requested_entries, uncut.counters.entry_count);
     EXPECT_EQ(gpu.counters.entry_count, total);

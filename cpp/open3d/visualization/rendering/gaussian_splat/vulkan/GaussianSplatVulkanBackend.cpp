@@ -649,7 +649,7 @@ RenderStats GaussianSplatVulkanBackend::RenderComposite(CompositeSink& sink) {
         inputs.entry_count = geometry_stage_resources_.ViewResources().counters.Range(
             offsetof(shader::GaussianGeometryStageCounters, entry_count), sizeof(uint32_t));
         inputs.entry_capacity = geometry_stage_resources_.EntryCapacity();
-        inputs.ranges_written = geometry_.config.sort_mode == SortMode::kExact;
+        inputs.ranges_written = geometry_.config.sort_mode == SortMode::kExactTileBins;
         CompositeStageTargets targets;
         targets.width = w;
         targets.height = h;
