@@ -114,6 +114,32 @@ TEST_F(VulkanBackend, UnchangedViewReusesGeometryStageAndGivesTheSameImage) {
     EXPECT_EQ(backend->GetCounters().skipped_composites, 0);
 }
 
+TEST_F(VulkanBackend, AReusedGeometryStageCompositesOverTheNewBackground) {
+    // The background is a composite setting: a frame that reuses the geometry stage must
+    // still blend over the background it was given, as the CPU backend does.
+    auto backend = MakeBackend();
+    backend->SetScene(CreateDefaultGaussianSplatScene());
+    const camera::PinholeCamera cam = GetDefaultSceneCamera().Resized(80, 60);
+    RenderConfig config;
+    config.background = Eigen::Vector3d(0.0, 0.0, 0.0);
+    RenderStages(*backend, cam, config);
+    config.background = Eigen::Vector3d(1.0, 0.5, 0.25);
+    const RenderOutput white = RenderStages(*backend, cam, config);
+    ASSERT_TRUE(white.stats.geometry_reused);
+    cpu::CpuBackend reference;
+    reference.SetScene(CreateDefaultGaussianSplatScene());
+    reference.RenderGeometryStage(cam, config);
+    RenderOutput want;
+    reference.RenderCompositeStage(want, {});
+    // The corner pixel lies outside every splat of the default scene: the background alone.
+    const float* got = white.color.Data<float>();
+    const float* expected = want.color.Data<float>();
+    for (int c = 0; c < 3; ++c) {
+        EXPECT_EQ(got[c], expected[c]) << "channel " << c;
+        EXPECT_EQ(got[c], static_cast<float>(config.background[c])) << "channel " << c;
+    }
+}
+
 TEST_F(VulkanBackend, DepthImagesAreComputedOnlyWhenAskedFor) {
     // Each depth output is a specialisation of the composite that only drops arithmetic: the
     // colour, and every depth image that is asked for, must equal the full composite's bit for

@@ -375,6 +375,8 @@ void GaussianSplatVulkanBackend::RenderGeometryStage(const camera::PinholeCamera
     }
     if (config.reuse_geometry && geometry_.valid && SameCamera(camera, geometry_.camera) &&
         SameGeometryConfig(config, geometry_.config)) {
+        // The composite's settings (the background) are this frame's, not the last run's.
+        geometry_.config = config;
         geometry_.reused = true;
         ++counters_.geometry_reuses;
         return;
