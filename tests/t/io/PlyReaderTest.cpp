@@ -237,6 +237,28 @@ TEST(PlyReader, NonFiniteValuesRefusedOrDropped) {
     EXPECT_EQ(p[6], 3.0f);
 }
 
+TEST(PlyReader, AsciiNumbersPastDoubleRangeAreInfiniteOrZero) {
+    // 1e999 overflows double: it must read as infinity and be refused like 1e300 in a float
+    // property, not become 0; 1e-999 underflows to 0, the nearest double.
+    const std::string dir = tests::TempDir();
+    const std::string header =
+        "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\n"
+        "property float z\nend_header\n";
+    for (const std::string big : {"1e999", "-1e999", "1e300"}) {
+        SCOPED_TRACE(big);
+        WriteText(dir + "/big.ply", header + "1e-999 0 0\n" + big + " 0 0\n");
+        ExpectReadError(dir + "/big.ply", {"splat 1", "non-finite", "position[0]"});
+    }
+    WriteText(dir + "/tiny.ply", header + "1e-999 -1e-999 2\n0.5 0 0\n");
+    PointCloud cloud;
+    ReadPointCloud(dir + "/tiny.ply", cloud);
+    ASSERT_EQ(cloud.NumPoints(), 2);
+    const float* p = cloud.GetPointPositions().Data<float>();
+    EXPECT_EQ(p[0], 0.0f);
+    EXPECT_EQ(p[1], 0.0f);
+    EXPECT_EQ(p[2], 2.0f);
+}
+
 TEST(PlyReader, LogScaleOverflowCountsAsNonFinite) {
     const std::string path = tests::TempDir() + "/big.ply";
     const auto names = GaussianPropertyNames(0);

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cctype>
 #include <charconv>
+#include <cstdlib>
 #include <cstring>
 
 #include "open3d/core/Exception.h"
@@ -212,6 +213,12 @@ void ReadAsciiVertices(const std::string& filename, const PlyElement& vertex,
                 (ec != std::errc() && ec != std::errc::result_out_of_range)) {
                 core::ThrowError("'{}': vertex {} property '{}': cannot parse '{}' as a number",
                                  filename, i, vertex.properties[p].name, token);
+            }
+            // from_chars leaves the value unset when it is out of double's range: strtod
+            // gives +-HUGE_VAL for an overflow (refused below as non-finite, as 1e300 is in
+            // a float property) and the rounded tiny value or 0 for an underflow.
+            if (ec == std::errc::result_out_of_range) {
+                value = std::strtod(std::string(token).c_str(), nullptr);
             }
             for (int f : targets[p]) Store(fields[f], i, value);
         }
