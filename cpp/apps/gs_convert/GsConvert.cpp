@@ -132,16 +132,24 @@ int main(int argc, char** argv) {
         // Written beside the output and renamed when complete: a failed write leaves no
         // partial file, and --force onto the input never truncates what is being read.
         t::io::OutputFileSet files;
-        t::io::WritePointCloud(files.Add(output), cloud);
+        const std::string written_output = files.Add(output);
+        t::io::WritePointCloud(written_output, cloud);
         int64_t lod_nodes = 0;
-        if (lod || pages) {
-            // Built from the cloud as read: a lossy output format's splats differ slightly
-            // from the leaves it was built on (the paged file holds the leaves themselves).
-            const t::geometry::SplatHierarchy hierarchy = t::geometry::BuildSplatHierarchy(cloud);
-            if (lod) t::io::WriteSplatHierarchy(files.Add(lod_path), hierarchy);
-            if (pages)
-                t::io::WriteSplatPages(files.Add(pages_path), cloud, hierarchy, page_capacity);
+        if (lod) {
+            // The .lod's leaves are the output's splats as a reader will see them: a lossy or
+            // reordering format's differ from the input's, and the hierarchy's fingerprint
+            // must be theirs (gs-render refuses a hierarchy of another scene).
+            t::geometry::PointCloud as_written;
+            t::io::ReadPointCloud(written_output, as_written);
+            const t::geometry::SplatHierarchy hierarchy =
+                t::geometry::BuildSplatHierarchy(as_written);
+            t::io::WriteSplatHierarchy(files.Add(lod_path), hierarchy);
             lod_nodes = hierarchy.NumInner();
+        }
+        if (pages) {
+            // The paged file holds its leaves itself: built from the cloud as read.
+            const t::geometry::SplatHierarchy hierarchy = t::geometry::BuildSplatHierarchy(cloud);
+            t::io::WriteSplatPages(files.Add(pages_path), cloud, hierarchy, page_capacity);
         }
         files.Commit();
         progress.reset();

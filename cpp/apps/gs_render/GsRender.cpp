@@ -14,6 +14,7 @@
 #include "open3d/camera/CamerasJson.h"
 #include "open3d/camera/PinholeCamera.h"
 #include "open3d/core/Exception.h"
+#include "open3d/core/Logging.h"
 #include "open3d/core/ParallelFor.h"
 #include "open3d/core/Timer.h"
 #include "open3d/t/geometry/PointCloudStatistics.h"
@@ -226,9 +227,19 @@ t::geometry::SplatHierarchy LoadOrBuildHierarchy(const Options& opt,
     }
     if (!path.empty()) {
         t::geometry::SplatHierarchy hierarchy = t::io::ReadSplatHierarchy(path);
-        if (hierarchy.num_leaves != cloud.NumPoints()) {
-            core::ThrowError("--lod '{}': a hierarchy of {} leaves for a scene of {} splats", path,
-                             hierarchy.num_leaves, cloud.NumPoints());
+        const std::string mismatch = t::geometry::HierarchySourceMismatch(hierarchy, cloud);
+        if (!mismatch.empty()) {
+            core::ThrowError(
+                "{} '{}' was not built from --input '{}': {}. Rebuild it (gs-convert '{}' OUT "
+                "--lod writes OUT.lod) or remove it",
+                opt.lod.empty() ? "the hierarchy beside the scene" : "--lod", path, opt.input,
+                mismatch, opt.input);
+        }
+        if (hierarchy.scene_fingerprint == 0) {
+            core::LogWarning(
+                "'{}': a hierarchy file of version 1 carries no fingerprint of its scene: only "
+                "its leaf count and SH degree were checked against '{}'",
+                path, opt.input);
         }
         std::printf("level of detail: hierarchy of %lld nodes read from %s in %.1f ms\n",
                     static_cast<long long>(hierarchy.NumNodes()), path.c_str(),

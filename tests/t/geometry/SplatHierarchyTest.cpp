@@ -288,6 +288,39 @@ TEST(SplatHierarchy, ABudgetOfEveryLeafGivesTheSourceCloud) {
     EXPECT_THROW(ExtractSplatNodes(h, cloud, {h.NumNodes()}), core::Open3DError);
 }
 
+TEST(SplatHierarchy, AHierarchyOfAnotherSceneIsRefusedNotRead) {
+    // A stale .lod beside a scene (RandomSplats adds 20 copies of the first splat): the
+    // same count at another SH degree made ExtractSplatNodes
+    // copy f_rest rows the hierarchy does not have (a crash); the same count and degree with
+    // other positions drew another scene's inner nodes.
+    std::mt19937 rng(17);
+    const std::vector<Splat> splats = RandomSplats(rng, 16);
+    const PointCloud scene = Cloud(splats, 3);
+    const SplatHierarchy of_sh0 = BuildSplatHierarchy(Cloud(splats, 0));
+    ASSERT_GT(of_sh0.NumInner(), 0);
+    EXPECT_NE(HierarchySourceMismatch(of_sh0, scene).find("SH degree 0"), std::string::npos)
+        << HierarchySourceMismatch(of_sh0, scene);
+    EXPECT_THROW(ExtractSplatNodes(of_sh0, scene, {of_sh0.Root()}), core::Open3DError);
+    const SplatHierarchy of_fewer =
+        BuildSplatHierarchy(Cloud({splats.begin(), splats.end() - 1}, 3));
+    const std::string fewer = std::to_string(scene.NumPoints() - 1) + " leaves";
+    EXPECT_NE(HierarchySourceMismatch(of_fewer, scene).find(fewer), std::string::npos)
+        << HierarchySourceMismatch(of_fewer, scene);
+    std::vector<Splat> moved = splats;
+    moved[7].position.x() += 1e-3;
+    const SplatHierarchy of_moved = BuildSplatHierarchy(Cloud(moved, 3));
+    EXPECT_NE(HierarchySourceMismatch(of_moved, scene).find("another scene"), std::string::npos);
+    EXPECT_THROW(ExtractSplatNodes(of_moved, scene, {of_moved.Root()}), core::Open3DError);
+    // Its own scene fits; a hierarchy without a fingerprint (a version 1 file) is checked by
+    // count and degree alone.
+    const SplatHierarchy own = BuildSplatHierarchy(scene);
+    EXPECT_EQ(HierarchySourceMismatch(own, scene), "");
+    EXPECT_EQ(own.scene_fingerprint, SplatSceneFingerprint(scene));
+    SplatHierarchy unknown = of_moved;
+    unknown.scene_fingerprint = 0;
+    EXPECT_EQ(HierarchySourceMismatch(unknown, scene), "");
+}
+
 TEST(SplatHierarchy, ReportsProgressByLeavesPlaced) {
     // 2^17 + 20 splats: reports at 1/2 and 1 (every 2^16 leaves), then 1 at the end; never
     // going back.

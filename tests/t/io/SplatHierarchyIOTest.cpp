@@ -43,6 +43,8 @@ TEST(SplatHierarchyFile, RoundTripsBitForBit) {
         WriteSplatHierarchy(path, built);
         const SplatHierarchy read = ReadSplatHierarchy(path);
         EXPECT_EQ(read.num_leaves, built.num_leaves);
+        EXPECT_NE(built.scene_fingerprint, 0u);
+        EXPECT_EQ(read.scene_fingerprint, built.scene_fingerprint);
         EXPECT_EQ(read.child_offsets, built.child_offsets);
         EXPECT_EQ(read.children, built.children);
         EXPECT_TRUE(read.inner == built.inner);
@@ -65,10 +67,11 @@ TEST(SplatHierarchyFile, AFileWrittenFromTheDocumentedLayoutIsRead) {
     // tests/fuzz/seeds/two_levels_sh1.lod was written by a short Python script from the
     // layout in docs/lod.md, not by WriteSplatHierarchy: 4 leaves, inner node 0 = {0, 1},
     // inner node 1 (the root) = {4, 2, 3}, SH degree 1, inner node k at x = 0.1 k, every
-    // f_rest 0.01.
+    // f_rest 0.01. It is a version 1 file: no scene fingerprint.
     const SplatHierarchy h =
         ReadSplatHierarchy(std::string(OPEN3D_TEST_SOURCE_DIR) + "/fuzz/seeds/two_levels_sh1.lod");
     EXPECT_EQ(h.num_leaves, 4);
+    EXPECT_EQ(h.scene_fingerprint, 0u);
     EXPECT_EQ(h.child_offsets, (std::vector<int64_t>{0, 2, 5}));
     EXPECT_EQ(h.children, (std::vector<int64_t>{0, 1, 4, 2, 3}));
     ASSERT_EQ(h.inner.NumPoints(), 2);
@@ -92,8 +95,8 @@ TEST(SplatHierarchyFile, MalformedFilesAreRefusedNamingTheField) {
     };
     ExpectRefused(bad, {bytes.begin(), bytes.begin() + 20}, "magic");
     ExpectRefused(bad, patched(0, "PLYPLYPL", 8), "magic");
-    const uint32_t version = 2, degree = 4;
-    ExpectRefused(bad, patched(8, &version, 4), "version 2");
+    const uint32_t version = 3, degree = 4;
+    ExpectRefused(bad, patched(8, &version, 4), "version 3");
     ExpectRefused(bad, patched(12, &degree, 4), "sh_degree 4");
     ExpectRefused(bad, {bytes.begin(), bytes.end() - 4}, "the file has");
     std::vector<uint8_t> longer = bytes;
@@ -101,8 +104,8 @@ TEST(SplatHierarchyFile, MalformedFilesAreRefusedNamingTheField) {
     ExpectRefused(bad, longer, "the file has");
     const int64_t huge = int64_t(1) << 40;
     ExpectRefused(bad, patched(24, &huge, 8), "do not fit");
-    // The first child of inner node 0 (after the header and the offsets).
-    const size_t first_child = 40 + 8 * (built.NumInner() + 1);
+    // The first child of inner node 0 (after the header of version 2 and the offsets).
+    const size_t first_child = 48 + 8 * (built.NumInner() + 1);
     const int64_t outside = built.num_leaves + built.NumInner();
     ExpectRefused(bad, patched(first_child, &outside, 8), "is not a node built before it");
     const int64_t twice = built.children[1];  // the first child repeats the second

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstring>
 #include <numeric>
 #include <queue>
 #include <utility>
@@ -289,9 +290,54 @@ bool SplatOutsideView(const SplatCutView& view, const Eigen::Vector3d& c, double
                    view.fy);
 }
 
+uint64_t SplatSceneFingerprint(const PointCloud& splats) {
+    const GaussianSplatArrays a = splats.GetGaussianSplatArrays();
+    // One multiply-rotate step per 32-bit word: order-sensitive, ~1 ns a word.
+    uint64_t h = 0x243F6A8885A308D3ull;
+    const auto mix = [&h](uint64_t word) {
+        h = ((h << 27) | (h >> 37)) ^ word;
+        h *= 0x9E3779B97F4A7C15ull;
+    };
+    mix(static_cast<uint64_t>(a.num_points));
+    mix(static_cast<uint64_t>(a.sh_degree));
+    const auto mix_floats = [&mix](const float* values, int64_t count) {
+        for (int64_t i = 0; i < count; ++i) {
+            uint32_t bits = 0;
+            std::memcpy(&bits, values + i, 4);
+            mix(bits);
+        }
+    };
+    mix_floats(a.positions, 3 * a.num_points);
+    mix_floats(a.opacity, a.num_points);
+    return h == 0 ? 1 : h;  // 0 means "unknown"
+}
+
+std::string HierarchySourceMismatch(const SplatHierarchy& hierarchy, const PointCloud& source) {
+    const int64_t n = source.IsEmpty() ? 0 : source.NumPoints();
+    if (hierarchy.num_leaves != n) {
+        return fmt::format("it has {} leaves and the scene {} splats", hierarchy.num_leaves, n);
+    }
+    if (hierarchy.NumInner() > 0) {
+        const int inner_degree = hierarchy.inner.GaussianSplatGetSHOrder();
+        const int degree = source.GaussianSplatGetSHOrder();
+        if (inner_degree != degree) {
+            return fmt::format("its nodes have SH degree {} and the scene's splats {}",
+                               inner_degree, degree);
+        }
+    }
+    if (hierarchy.scene_fingerprint != 0 &&
+        hierarchy.scene_fingerprint != SplatSceneFingerprint(source)) {
+        return fmt::format(
+            "it was built from another scene of {} splats (the positions or opacities differ)", n);
+    }
+    return "";
+}
+
 SplatHierarchy BuildSplatHierarchy(const PointCloud& splats) {
     if (splats.IsEmpty()) core::ThrowError("BuildSplatHierarchy: the cloud has no splat");
-    return Builder(splats).Build();
+    SplatHierarchy hierarchy = Builder(splats).Build();
+    hierarchy.scene_fingerprint = SplatSceneFingerprint(splats);
+    return hierarchy;
 }
 
 std::vector<int64_t> CutSplatHierarchy(const SplatHierarchy& hierarchy, const SplatCutView& view,
@@ -343,11 +389,11 @@ std::vector<int64_t> CutSplatHierarchy(const SplatHierarchy& hierarchy, const Sp
 
 PointCloud ExtractSplatNodes(const SplatHierarchy& hierarchy, const PointCloud& source,
                              const std::vector<int64_t>& nodes) {
-    const GaussianSplatArrays leaves = source.GetGaussianSplatArrays();
-    if (leaves.num_points != hierarchy.num_leaves) {
-        core::ThrowError("ExtractSplatNodes: the source has {} splats, the hierarchy {} leaves",
-                         leaves.num_points, hierarchy.num_leaves);
+    const std::string mismatch = HierarchySourceMismatch(hierarchy, source);
+    if (!mismatch.empty()) {
+        core::ThrowError("ExtractSplatNodes: the hierarchy does not fit its source: {}", mismatch);
     }
+    const GaussianSplatArrays leaves = source.GetGaussianSplatArrays();
     const GaussianSplatArrays inner = InnerArrays(hierarchy);
     const int64_t n = static_cast<int64_t>(nodes.size());
     const int rest = leaves.num_rest;

@@ -7,6 +7,7 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "open3d/t/geometry/PointCloud.h"
@@ -20,6 +21,9 @@ namespace geometry {
 /// one splat). Every inner node has 2 to 8 children.
 struct SplatHierarchy {
     int64_t num_leaves = 0;
+    /// SplatSceneFingerprint of the cloud it was built from (0: unknown, a file of version
+    /// 1): a hierarchy file left beside a scene that changed since is recognised by it.
+    uint64_t scene_fingerprint = 0;
     /// The inner nodes' Gaussians, with the source's attributes (positions, scale, rot,
     /// opacity, f_dc and f_rest when the source has it).
     PointCloud inner;
@@ -31,6 +35,15 @@ struct SplatHierarchy {
     int64_t NumNodes() const { return num_leaves + NumInner(); }
     int64_t Root() const { return NumNodes() - 1; }
 };
+
+/// A 64-bit hash of a splat cloud's count, SH degree, positions and opacities: what tells a
+/// hierarchy built from this cloud from one built from another (docs/lod.md "File").
+uint64_t SplatSceneFingerprint(const PointCloud& splats);
+
+/// Why `hierarchy` cannot have been built from `source` (its leaf count, its inner nodes'
+/// SH degree, or a known fingerprint differs), or "" when it fits. ExtractSplatNodes and the
+/// renderers refuse a hierarchy that does not fit; tools name the files with the reason.
+std::string HierarchySourceMismatch(const SplatHierarchy& hierarchy, const PointCloud& source);
 
 /// Builds the hierarchy of a valid, non-empty splat cloud. The octree splits the cloud's
 /// bounding cube by the splats' Morton codes (21 bits per axis); a cell with one occupied

@@ -18,9 +18,12 @@ static_assert(std::endian::native == std::endian::little,
               "the hierarchy file is little-endian and read by memcpy");
 
 constexpr char kMagic[8] = {'O', '3', 'D', 'G', 'S', 'L', 'O', 'D'};
-constexpr uint32_t kVersion = 1;
+// Version 2 adds the scene's fingerprint after the counts; version 1 files are still read
+// (fingerprint 0: only the leaf count and SH degree can be checked against a scene).
+constexpr uint32_t kVersion = 2;
 constexpr int kMaxChildren = 8;
-constexpr size_t kHeaderBytes = 8 + 4 + 4 + 3 * 8;
+constexpr size_t kHeaderBytesV1 = 8 + 4 + 4 + 3 * 8;
+constexpr size_t kHeaderBytes = kHeaderBytesV1 + 8;
 
 template <typename T>
 void Append(std::vector<uint8_t>& bytes, const T* values, size_t count) {
@@ -42,6 +45,7 @@ void WriteSplatHierarchy(const std::string& filename, const geometry::SplatHiera
     const uint32_t sh_degree = static_cast<uint32_t>(degree);
     Append(bytes, &sh_degree, 1);
     Append(bytes, counts, 3);
+    Append(bytes, &hierarchy.scene_fingerprint, 1);
     Append(bytes, hierarchy.child_offsets.data(), hierarchy.child_offsets.size());
     Append(bytes, hierarchy.children.data(), hierarchy.children.size());
     if (k > 0) {
@@ -62,7 +66,7 @@ geometry::SplatHierarchy ReadSplatHierarchy(const std::string& filename) {
         core::ThrowError("'{}': not a splat hierarchy file written by this version: {}", filename,
                          why);
     };
-    if (size < kHeaderBytes || std::memcmp(data, kMagic, 8) != 0) {
+    if (size < kHeaderBytesV1 || std::memcmp(data, kMagic, 8) != 0) {
         fail("it does not start with the magic 'O3DGSLOD' and a full header");
     }
     uint32_t version = 0, sh_degree = 0;
@@ -70,7 +74,13 @@ geometry::SplatHierarchy ReadSplatHierarchy(const std::string& filename) {
     std::memcpy(&version, data + 8, 4);
     std::memcpy(&sh_degree, data + 12, 4);
     std::memcpy(counts, data + 16, 24);
-    if (version != kVersion) fail("version " + std::to_string(version) + ", not 1");
+    if (version != 1 && version != kVersion) {
+        fail("version " + std::to_string(version) + ", not 1 or 2");
+    }
+    const size_t header_bytes = version == 1 ? kHeaderBytesV1 : kHeaderBytes;
+    if (size < header_bytes) fail("it ends inside its header");
+    uint64_t fingerprint = 0;
+    if (version >= 2) std::memcpy(&fingerprint, data + kHeaderBytesV1, 8);
     if (sh_degree > 3) fail("sh_degree " + std::to_string(sh_degree) + " (0..3)");
     const int64_t leaves = counts[0], inner = counts[1], links = counts[2];
     // Every count bounded by the file before any product is formed.
@@ -84,7 +94,7 @@ geometry::SplatHierarchy ReadSplatHierarchy(const std::string& filename) {
     const int num_rest = geometry::NumSHRestCoeffs(static_cast<int>(sh_degree));
     int64_t floats_per_node = 0;
     for (const SplatAttribute& a : SplatAttributesInFileOrder(num_rest)) floats_per_node += a.width;
-    const uint64_t expected = kHeaderBytes + 8 * uint64_t(inner + 1) + 8 * uint64_t(links) +
+    const uint64_t expected = header_bytes + 8 * uint64_t(inner + 1) + 8 * uint64_t(links) +
                               4 * uint64_t(inner) * uint64_t(floats_per_node);
     if (expected != size) {
         fail("the counts need " + std::to_string(expected) + " bytes, the file has " +
@@ -93,9 +103,10 @@ geometry::SplatHierarchy ReadSplatHierarchy(const std::string& filename) {
 
     geometry::SplatHierarchy h;
     h.num_leaves = leaves;
+    h.scene_fingerprint = fingerprint;
     h.child_offsets = std::vector<int64_t>(static_cast<size_t>(inner + 1));
     h.children = std::vector<int64_t>(static_cast<size_t>(links));
-    const uint8_t* at = data + kHeaderBytes;
+    const uint8_t* at = data + header_bytes;
     std::memcpy(h.child_offsets.data(), at, 8 * (inner + 1));
     at += 8 * (inner + 1);
     if (links > 0) std::memcpy(h.children.data(), at, 8 * links);
