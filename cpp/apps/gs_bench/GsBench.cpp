@@ -465,11 +465,12 @@ void PrintTable(const std::vector<Row>& rows) {
 // (a full disk) fails the run and leaves no truncated file.
 void WriteJson(const std::string& path, const nlohmann::json& rows) {
     t::io::OutputFileSet files;
-    const std::string temporary = files.Add(path);
-    std::ofstream out(temporary);
-    out << rows.dump(2) << "\n";
-    out.close();
-    if (!out) core::ThrowError("--json '{}': writing failed", path);
+    files.Write(path, [&](const std::string& temporary) {
+        std::ofstream out(temporary);
+        out << rows.dump(2) << "\n";
+        out.close();
+        if (!out) core::ThrowError("--json '{}': writing failed", path);
+    });
     files.Commit();
 }
 
@@ -576,6 +577,16 @@ int Run(const Options& opt) {
             core::ThrowError("--json '{}': the file name must end in .json", opt.json);
         }
         t::io::CheckOutputPath("--json", opt.json);
+    }
+    if (!opt.stream.empty()) t::io::CheckOutputPath("--stream", opt.stream);
+    std::vector<t::io::NamedInput> inputs;
+    for (const std::string& path : opt.inputs) inputs.push_back({"--input", path});
+    for (const std::string& path : opt.cameras) inputs.push_back({"--cameras", path});
+    t::io::CheckOutputIsNotAnInput("--json", opt.json, inputs);
+    t::io::CheckOutputIsNotAnInput("--stream", opt.stream, inputs);
+    if (!opt.json.empty() && !opt.stream.empty() && t::io::SameOutputPath(opt.json, opt.stream)) {
+        core::ThrowError("--json and --stream are the same file '{}'; give each its own path",
+                         opt.json);
     }
     if (opt.batch > 0 && opt.backend != "vulkan") {
         core::ThrowError("--batch measures the Vulkan backend's batches: use --backend vulkan");

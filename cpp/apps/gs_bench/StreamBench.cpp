@@ -12,6 +12,7 @@
 #include "open3d/core/Exception.h"
 #include "open3d/core/Timer.h"
 #include "open3d/t/geometry/ImageMetrics.h"
+#include "open3d/t/io/OutputFiles.h"
 #include "open3d/t/io/SplatPageFile.h"
 #include "open3d/visualization/rendering/gaussian_splat/SplatStreamSession.h"
 #include "open3d/visualization/rendering/gaussian_splat/SplatStreamer.h"
@@ -31,7 +32,13 @@ StreamBenchResult RunStreamBench(const t::geometry::PointCloud& scene,
                                  const StreamBenchOptions& options) {
     {
         const auto start = std::chrono::steady_clock::now();
-        t::io::WriteSplatPages(options.path, scene, hierarchy, options.page_capacity);
+        // Through a temporary renamed when complete: a failed write (a full disk) leaves
+        // no partial file where the path was.
+        t::io::OutputFileSet files;
+        files.Write(options.path, [&](const std::string& path) {
+            t::io::WriteSplatPages(path, scene, hierarchy, options.page_capacity);
+        });
+        files.Commit();
         std::printf("stream: wrote %s (%lld nodes, pages of %lld) in %.0f ms\n",
                     options.path.c_str(), static_cast<long long>(hierarchy.NumNodes()),
                     static_cast<long long>(options.page_capacity), core::MillisecondsSince(start));

@@ -79,7 +79,8 @@ int main(int argc, char** argv) {
     app.add_flag("--drop-non-finite", drop_non_finite,
                  "Drop splats with NaN or Inf values instead of refusing the file");
     app.add_flag("-f,--force", force,
-                 "Overwrite the output (and its .lod and .gspages) if it exists");
+                 "Overwrite the output (and its .lod and .gspages) if it exists; never the "
+                 "input");
     app.add_flag("--lod", lod,
                  "Also build the level-of-detail hierarchy (docs/lod.md) and write it beside "
                  "the output as <output>.lod");
@@ -104,6 +105,8 @@ int main(int argc, char** argv) {
         if (pages) outputs.push_back(pages_path);
         std::error_code ec;
         for (const std::string& path : outputs) {
+            t::io::CheckOutputIsNotAnInput(path == output ? "output" : "the output beside it", path,
+                                           {{"input", input}});
             if (!force && std::filesystem::exists(path, ec)) {
                 core::ThrowError("'{}' exists; pass --force to overwrite it", path);
             }
@@ -130,10 +133,13 @@ int main(int argc, char** argv) {
                              lod ? "--lod" : "--pages", input);
         }
         // Written beside the output and renamed when complete: a failed write leaves no
-        // partial file, and --force onto the input never truncates what is being read.
+        // partial file, and error messages name the output, not the temporary.
         t::io::OutputFileSet files;
-        const std::string written_output = files.Add(output);
-        t::io::WritePointCloud(written_output, cloud);
+        std::string written_output;
+        files.Write(output, [&](const std::string& path) {
+            written_output = path;
+            t::io::WritePointCloud(path, cloud);
+        });
         int64_t lod_nodes = 0;
         if (lod) {
             // The .lod's leaves are the output's splats as a reader will see them: a lossy or
@@ -143,13 +149,17 @@ int main(int argc, char** argv) {
             t::io::ReadPointCloud(written_output, as_written);
             const t::geometry::SplatHierarchy hierarchy =
                 t::geometry::BuildSplatHierarchy(as_written);
-            t::io::WriteSplatHierarchy(files.Add(lod_path), hierarchy);
+            files.Write(lod_path, [&](const std::string& path) {
+                t::io::WriteSplatHierarchy(path, hierarchy);
+            });
             lod_nodes = hierarchy.NumInner();
         }
         if (pages) {
             // The paged file holds its leaves itself: built from the cloud as read.
             const t::geometry::SplatHierarchy hierarchy = t::geometry::BuildSplatHierarchy(cloud);
-            t::io::WriteSplatPages(files.Add(pages_path), cloud, hierarchy, page_capacity);
+            files.Write(pages_path, [&](const std::string& path) {
+                t::io::WriteSplatPages(path, cloud, hierarchy, page_capacity);
+            });
         }
         files.Commit();
         progress.reset();

@@ -107,6 +107,9 @@ void CheckOutputs(const Options& opt) {
         const Output& o = outputs[i];
         if (o.path.empty() && i > 0) continue;  // optional outputs not asked for
         t::io::CheckOutputPath(o.flag, o.path);
+        t::io::CheckOutputIsNotAnInput(
+            o.flag, o.path,
+            {{"--input", opt.input}, {"--cameras", opt.cameras}, {"--lod", opt.lod}});
         const std::string ext = t::io::LowerCaseExtension(o.path);
         if (std::find(o.extensions.begin(), o.extensions.end(), ext) == o.extensions.end()) {
             core::ThrowError("{} '{}': unknown extension '{}'; use {}", o.flag, o.path,
@@ -132,17 +135,22 @@ void WriteOutputs(const Options& opt, const t::geometry::Image& color,
                   const t::geometry::Image* depth, const std::string& depth_what,
                   const t::geometry::Image* float_color) {
     t::io::OutputFileSet files;
-    t::io::WriteImage(files.Add(opt.output), color);
+    files.Write(opt.output, [&](const std::string& path) { t::io::WriteImage(path, color); });
     int64_t saturated = 0;
     const bool depth_npy = t::io::LowerCaseExtension(opt.depth_output) == "npy";
     if (depth != nullptr) {
-        if (depth_npy) {
-            t::io::WriteNpy(files.Add(opt.depth_output), *depth);
-        } else {
-            saturated = t::io::WritePNG16(files.Add(opt.depth_output), *depth, opt.depth_scale);
-        }
+        files.Write(opt.depth_output, [&](const std::string& path) {
+            if (depth_npy) {
+                t::io::WriteNpy(path, *depth);
+            } else {
+                saturated = t::io::WritePNG16(path, *depth, opt.depth_scale);
+            }
+        });
     }
-    if (float_color != nullptr) t::io::WriteNpy(files.Add(opt.float_output), *float_color);
+    if (float_color != nullptr) {
+        files.Write(opt.float_output,
+                    [&](const std::string& path) { t::io::WriteNpy(path, *float_color); });
+    }
     files.Commit();
     std::printf("wrote %s\n", opt.output.c_str());
     if (depth != nullptr) {

@@ -94,6 +94,46 @@ TEST(OutputFiles, FailedWriteLeavesNoFile) {
     EXPECT_EQ(CountEntries(dir), 0u) << "the colour image of a failed set was left behind";
 }
 
+TEST(OutputFiles, WriteErrorsNameTheOutputNotTheTemporary) {
+    const std::string dir = tests::TempDir();
+    OutputFileSet files;
+    try {
+        files.Write(dir + "/o.spz", [](const std::string& temporary) {
+            core::ThrowError("Cannot write '{}' ({}): No space left on device", temporary,
+                             fs::path(temporary).filename().string());
+        });
+        ADD_FAILURE() << "the writer's error was swallowed";
+    } catch (const core::Open3DError& e) {
+        EXPECT_EQ(std::string(e.what()),
+                  "Cannot write '" + dir + "/o.spz' (o.spz): No space left on device");
+    }
+    files.Commit();
+    EXPECT_EQ(CountEntries(dir), 0u);
+}
+
+TEST(OutputFiles, AnOutputThatIsAnInputIsRefused) {
+    const std::string dir = tests::TempDir();
+    const std::string input = dir + "/in.ply";
+    std::ofstream(input) << "ply";
+    fs::create_symlink(input, dir + "/link.ply");
+    fs::create_hard_link(input, dir + "/hard.ply");
+    const std::vector<NamedInput> inputs = {{"--cameras", ""}, {"--input", input}};
+    for (const std::string& output :
+         {input, dir + "/./in.ply", dir + "/link.ply", dir + "/hard.ply"}) {
+        SCOPED_TRACE(output);
+        try {
+            CheckOutputIsNotAnInput("--out", output, inputs);
+            ADD_FAILURE() << "accepted";
+        } catch (const core::Open3DError& e) {
+            EXPECT_NE(std::string(e.what()).find("--out '" + output + "' is the --input file"),
+                      std::string::npos)
+                << e.what();
+        }
+    }
+    EXPECT_NO_THROW(CheckOutputIsNotAnInput("--out", dir + "/other.ply", inputs));
+    EXPECT_NO_THROW(CheckOutputIsNotAnInput("--out", "", inputs));
+}
+
 }  // namespace
 }  // namespace io
 }  // namespace t

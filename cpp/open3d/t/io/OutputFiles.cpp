@@ -63,6 +63,24 @@ bool SameOutputPath(const std::string& a, const std::string& b) {
     return pa == pb;
 }
 
+void CheckOutputIsNotAnInput(const std::string& what, const std::string& output,
+                             const std::vector<NamedInput>& inputs) {
+    if (output.empty()) return;
+    for (const NamedInput& input : inputs) {
+        if (input.path.empty()) continue;
+        std::error_code ec;
+        // equivalent() also catches a hard link; it needs both files to exist.
+        const bool same = SameOutputPath(output, input.path) ||
+                          (fs::exists(output, ec) && fs::equivalent(output, input.path, ec));
+        if (same) {
+            core::ThrowError(
+                "{} '{}' is the {} file '{}': an input is never overwritten; write the output "
+                "elsewhere",
+                what, output, input.flag, input.path);
+        }
+    }
+}
+
 OutputFileSet::~OutputFileSet() {
     for (const auto& [temporary, final_path] : files_) std::remove(temporary.c_str());
 }
@@ -90,6 +108,30 @@ std::string OutputFileSet::Add(const std::string& final_path) {
     }
     core::ThrowError("cannot create a temporary file in '{}' for '{}': too many exist",
                      folder.string(), final_path);
+}
+
+void OutputFileSet::Write(const std::string& final_path,
+                          const std::function<void(const std::string& temporary)>& write) {
+    const std::string temporary = Add(final_path);
+    try {
+        write(temporary);
+    } catch (const core::Open3DError& e) {
+        // The failed output leaves the set: a later Commit must not publish its remains.
+        std::remove(temporary.c_str());
+        files_.pop_back();
+        std::string message = e.what();
+        const auto replace_all = [&message](const std::string& from, const std::string& to) {
+            for (size_t at = message.find(from); at != std::string::npos;
+                 at = message.find(from, at + to.size())) {
+                message.replace(at, from.size(), to);
+            }
+        };
+        // The whole path first, then a bare file name (some writers name only that).
+        replace_all(temporary, final_path);
+        replace_all(fs::path(temporary).filename().string(),
+                    fs::path(final_path).filename().string());
+        throw core::Open3DError(message);
+    }
 }
 
 void OutputFileSet::Commit() {

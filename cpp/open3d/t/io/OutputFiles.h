@@ -3,6 +3,7 @@
 // all (a temporary beside each output, renamed when every output of the run is complete).
 #pragma once
 
+#include <functional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -22,6 +23,18 @@ std::string LowerCaseExtension(const std::string& path);
 /// resolving the parts that exist, so "x.png" and "./x.png" are the same).
 bool SameOutputPath(const std::string& a, const std::string& b);
 
+/// A file a tool reads, by the flag that names it (e.g. {"--input", "scene.ply"}).
+struct NamedInput {
+    std::string flag;
+    std::string path;
+};
+
+/// Throws naming both flags and the path when `output` is one of `inputs` (the same file:
+/// the same path after resolving links, or a hard link to it; empty paths are skipped). A
+/// tool calls it for every output before any work, so no input is ever overwritten.
+void CheckOutputIsNotAnInput(const std::string& what, const std::string& output,
+                             const std::vector<NamedInput>& inputs);
+
 /// A set of outputs written through temporaries: Add gives the path to write each output
 /// to (in the output's folder, so the final rename does not cross file systems), Commit
 /// renames them all once every one is written. Without Commit (an exception on the way)
@@ -36,6 +49,11 @@ public:
     /// Reserves a fresh temporary beside `final_path` and returns it. Its name ends with
     /// the final file name, so writers that pick the format by extension still do.
     std::string Add(const std::string& final_path);
+    /// Add, then `write(temporary)`: an Open3DError it throws is thrown again with the
+    /// temporary's name replaced by `final_path`, so messages name the user's file, and
+    /// the temporary is removed from the set (a later Commit does not publish it).
+    void Write(const std::string& final_path,
+               const std::function<void(const std::string& temporary)>& write);
     /// Renames every temporary to its final path (replacing existing files).
     void Commit();
 
