@@ -38,7 +38,7 @@ OPEN3D_SHADER_CONST uint kEmitPackedKeys = 1u;  // packed option: key = PackedSo
 OPEN3D_SHADER_CONST uint kEmitUnpackKeys = 2u;  // after the packed sort: key >>= depth bits
 OPEN3D_SHADER_CONST uint kEmitBinned = 3u;  // per-tile bins: (depth key, slot) at the tile's cursor
 
-// ---- Per-tile bins (SortMode::kExact) ----
+// ---- Per-tile bins (SortMode::kExactTileBins) ----
 // project (counts per tile) -> gaussian_bin_scan (one workgroup: each tile's begin, the
 // entries that fit) -> emit (kEmitBinned: (depth key, slot) at an atomic cursor of each tile)
 // -> gaussian_bin_sort (a workgroup per tile sorts its entries by (depth key, slot), which
