@@ -11,6 +11,7 @@
 #include <fstream>
 #include <limits>
 #include <map>
+#include <new>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
@@ -1051,6 +1052,12 @@ int main(int argc, char** argv) {
     }
     try {
         return Run(opt);
+    } catch (const std::bad_alloc&) {
+        std::fprintf(
+            stderr,
+            "gs-bench: error: out of memory (std::bad_alloc): the scene or the images asked "
+            "for need more host memory than this machine gives (docs/memory.md)\n");
+        return 1;
     } catch (const std::exception& e) {
         std::fprintf(stderr, "gs-bench: error: %s\n", e.what());
         return 1;

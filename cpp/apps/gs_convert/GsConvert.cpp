@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <new>
 #include <optional>
 #include <string>
 #include <vector>
@@ -181,6 +182,15 @@ int main(int argc, char** argv) {
                         static_cast<unsigned long long>(paged.FileBytes()));
         }
     } catch (const core::Open3DError& e) {
+        std::fprintf(stderr, "gs-convert: error: %s\n", e.what());
+        return 1;
+    } catch (const std::bad_alloc&) {
+        std::fprintf(stderr,
+                     "gs-convert: error: out of memory (std::bad_alloc) while converting '%s': "
+                     "it needs more host memory than this machine gives (docs/memory.md)\n",
+                     input.c_str());
+        return 1;
+    } catch (const std::exception& e) {
         std::fprintf(stderr, "gs-convert: error: %s\n", e.what());
         return 1;
     }

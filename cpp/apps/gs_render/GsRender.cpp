@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <new>
 #include <optional>
 #include <string>
 #include <vector>
@@ -489,6 +490,12 @@ int main(int argc, char** argv) {
     opt.backend_given = backend_option->count() > 0;
     try {
         return Run(opt);
+    } catch (const std::bad_alloc&) {
+        std::fprintf(
+            stderr,
+            "gs-render: error: out of memory (std::bad_alloc): the scene or the images asked "
+            "for need more host memory than this machine gives (docs/memory.md)\n");
+        return 1;
     } catch (const std::exception& e) {
         std::fprintf(stderr, "gs-render: error: %s\n", e.what());
         return 1;
