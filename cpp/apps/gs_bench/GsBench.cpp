@@ -579,7 +579,10 @@ int Run(const Options& opt) {
         }
         t::io::CheckOutputPath("--json", opt.json);
     }
-    if (!opt.stream.empty()) t::io::CheckOutputPath("--stream", opt.stream);
+    if (!opt.stream.empty()) {
+        t::io::CheckOutputPath("--stream", opt.stream);
+        visualization::rendering::ParseByteSize(opt.gpu_budget, "--gpu-budget");
+    }
     std::vector<t::io::NamedInput> inputs;
     for (const std::string& path : opt.inputs) inputs.push_back({"--input", path});
     for (const std::string& path : opt.cameras) inputs.push_back({"--cameras", path});
@@ -698,7 +701,8 @@ int Run(const Options& opt) {
             const rendering::RenderConfig config = TimedConfig(opt);
             bench::StreamBenchOptions stream;
             stream.path = opt.stream;
-            stream.gpu_budget = visualization::rendering::ParseByteSize(opt.gpu_budget);
+            stream.gpu_budget =
+                visualization::rendering::ParseByteSize(opt.gpu_budget, "--gpu-budget");
             stream.splat_budget =
                 opt.stream_budget.empty() ? 0 : bench::ParseBudgets(opt.stream_budget).at(0);
             stream.page_capacity = opt.page_capacity;

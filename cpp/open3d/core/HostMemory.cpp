@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <fstream>
 #include <limits>
@@ -67,12 +68,25 @@ uint64_t ReadLimitVariable() {
 std::optional<uint64_t> ReadByteCountVariable(const char* name) {
     const char* text = std::getenv(name);
     if (text == nullptr || text[0] == '\0') return std::nullopt;
+    return ParseByteCount(text, name);
+}
+
+uint64_t ParseByteCount(const std::string& text, const std::string& what) {
     char* end = nullptr;
-    const unsigned long long value = std::strtoull(text, &end, 10);
-    if (end == text || *end != '\0') {
-        ThrowError("{}={}: expected a number of bytes", name, text);
+    const double value = std::strtod(text.c_str(), &end);
+    const std::string suffix = end ? std::string(end) : "";
+    double unit = -1.0;
+    if (suffix.empty()) unit = 1.0;
+    if (suffix == "K" || suffix == "k") unit = 1024.0;
+    if (suffix == "M") unit = 1024.0 * 1024.0;
+    if (suffix == "G") unit = 1024.0 * 1024.0 * 1024.0;
+    if (suffix == "T") unit = 1024.0 * 1024.0 * 1024.0 * 1024.0;
+    if (text.empty() || end == text.c_str() || unit < 0 || !(value * unit >= 1.0) ||
+        !std::isfinite(value * unit) || value * unit > 1.8e19) {
+        ThrowError("{}: '{}' is not a size in bytes (for example 2G, 512M, 1.5G, 123456)", what,
+                   text);
     }
-    return value;
+    return static_cast<uint64_t>(value * unit);
 }
 
 uint64_t AvailableHostMemory() {

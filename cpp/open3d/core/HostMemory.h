@@ -17,9 +17,15 @@ namespace core {
 /// nothing is known (no /proc).
 uint64_t AvailableHostMemory();
 
+/// A size in bytes as every flag and variable of the project spells it: a number with an
+/// optional suffix K, M, G, T (powers of 1024; k = K), e.g. 2G, 512M, 1.5G, 123456. Throws
+/// core::Open3DError naming `what` (a flag or variable) unless it is at least 1 byte and
+/// finite.
+uint64_t ParseByteCount(const std::string& text, const std::string& what);
+
 /// The number of bytes an environment variable holds (OPEN3D_HOST_MEMORY_LIMIT,
-/// OPEN3D_DEVICE_MEMORY_LIMIT), nothing when it is unset or empty; throws core::Open3DError
-/// naming the variable when it is not a plain number.
+/// OPEN3D_DEVICE_MEMORY_LIMIT) through ParseByteCount, nothing when it is unset or empty;
+/// throws core::Open3DError naming the variable when it is not a size.
 std::optional<uint64_t> ReadByteCountVariable(const char* name);
 
 /// "1.23 GB" (powers of 1000, as free(1) -h and file managers show sizes).

@@ -7,6 +7,7 @@
 
 #include "TestUtility.h"
 #include "open3d/core/Exception.h"
+#include "open3d/core/HostMemory.h"
 #include "open3d/t/io/PointCloudIO.h"
 
 namespace open3d {
@@ -31,6 +32,25 @@ TEST(ReaderMemoryCheck, RefusesWithTheNumbers) {
                       "degree fit (17857 of SH degree 0)");
     }
     EXPECT_EQ(cloud.NumPoints(), 0);
+}
+
+TEST(ReaderMemoryCheck, LimitsTakeTheSizesOfEveryFlag) {
+    // The variables take what --gpu-budget takes (1G was "not a number of bytes", and the
+    // Vulkan device was then given up silently).
+    {
+        ScopedEnvironment limit("OPEN3D_HOST_MEMORY_LIMIT", "1G");
+        EXPECT_EQ(core::ReadByteCountVariable("OPEN3D_HOST_MEMORY_LIMIT"), uint64_t(1) << 30);
+        EXPECT_LE(core::AvailableHostMemory(), uint64_t(1) << 30);
+    }
+    ScopedEnvironment bad("OPEN3D_DEVICE_MEMORY_LIMIT", "1Gjunk");
+    try {
+        core::ReadByteCountVariable("OPEN3D_DEVICE_MEMORY_LIMIT");
+        ADD_FAILURE() << "accepted";
+    } catch (const core::Open3DError& e) {
+        EXPECT_NE(std::string(e.what()).find("OPEN3D_DEVICE_MEMORY_LIMIT: '1Gjunk' is not a size"),
+                  std::string::npos)
+            << e.what();
+    }
 }
 
 TEST(ReaderMemoryCheck, ReadsWhatFits) {

@@ -7,6 +7,7 @@
 #include <cstdlib>
 
 #include "open3d/core/Exception.h"
+#include "open3d/core/HostMemory.h"
 #include "open3d/visualization/rendering/gaussian_splat/GaussianSplatDataPacking.h"
 
 namespace open3d {
@@ -39,25 +40,12 @@ std::string FormatStreamProgress(const SplatStreamProgress& p) {
     return line;
 }
 
-uint64_t ParseByteSize(const std::string& text) {
-    char* end = nullptr;
-    const double value = std::strtod(text.c_str(), &end);
-    const std::string suffix = end ? std::string(end) : "";
-    double unit = -1.0;
-    if (suffix.empty()) unit = 1.0;
-    if (suffix == "K" || suffix == "k") unit = 1024.0;
-    if (suffix == "M") unit = 1024.0 * 1024.0;
-    if (suffix == "G") unit = 1024.0 * 1024.0 * 1024.0;
-    if (suffix == "T") unit = 1024.0 * 1024.0 * 1024.0 * 1024.0;
-    if (text.empty() || end == text.c_str() || unit < 0 || !(value * unit >= 1.0) ||
-        !std::isfinite(value * unit) || value * unit > 1.8e19) {
-        core::ThrowError("'{}' is not a size in bytes (for example 2G, 512M, 1.5G, 123456)", text);
-    }
-    return static_cast<uint64_t>(value * unit);
+uint64_t ParseByteSize(const std::string& text, const std::string& what) {
+    return core::ParseByteCount(text, what);
 }
 
-uint64_t ParseGpuBudget(const std::string& text) {
-    return text == "auto" ? 0 : ParseByteSize(text);
+uint64_t ParseGpuBudget(const std::string& text, const std::string& what) {
+    return text == "auto" ? 0 : ParseByteSize(text, what);
 }
 
 double StreamPoolBytesPerSplat(int sh_degree, bool compact_storage) {

@@ -57,12 +57,13 @@ struct SplatStreamProgress {
 /// "...; stopped: WHY").
 std::string FormatStreamProgress(const SplatStreamProgress& progress);
 
-/// Bytes from "2G", "512M", "1.5G", "123456" (K, M, G, T are powers of 1024). Throws
-/// core::Open3DError naming the text when it is not one.
-uint64_t ParseByteSize(const std::string& text);
+/// Bytes from "2G", "512M", "1.5G", "123456": core::ParseByteCount, the one parser of sizes
+/// (K, M, G, T are powers of 1024). Throws core::Open3DError naming `what` (the flag) and
+/// the text when it is not one.
+uint64_t ParseByteSize(const std::string& text, const std::string& what = "size");
 /// SplatStreamOptions::gpu_budget from text: "auto" is 0 (the default pool), anything else
 /// ParseByteSize's bytes.
-uint64_t ParseGpuBudget(const std::string& text);
+uint64_t ParseGpuBudget(const std::string& text, const std::string& what = "gpu_budget");
 
 /// Bytes a splat of SH degree `sh_degree` takes in a pool: its packed words (exact, or half
 /// precision with `compact_storage`) and its visibility bit.
