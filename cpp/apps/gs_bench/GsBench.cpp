@@ -152,10 +152,12 @@ std::vector<std::pair<std::string, rendering::LodCutSearch>> ParseLodCutSearches
 }
 
 std::pair<int, int> ParseResolution(const std::string& text) {
-    int w = 0, h = 0;
+    int w = 0, h = 0, used = 0;
     char x = 0;
-    if (std::sscanf(text.c_str(), "%d%c%d", &w, &x, &h) != 3 || (x != 'x' && x != 'X') || w < 1 ||
-        h < 1 || w > 16384 || h > 16384) {
+    // %n: the whole text must be the size ("64x64junk" is refused, not read as 64x64).
+    if (std::sscanf(text.c_str(), "%d%c%d%n", &w, &x, &h, &used) != 3 ||
+        used != static_cast<int>(text.size()) || (x != 'x' && x != 'X') || w < 1 || h < 1 ||
+        w > 16384 || h > 16384) {
         core::ThrowError("--resolution '{}' must look like 1920x1080 (1..16384)", text);
     }
     return {w, h};
@@ -579,6 +581,7 @@ int Run(const Options& opt) {
         }
         t::io::CheckOutputPath("--json", opt.json);
     }
+    for (const auto& r : opt.resolutions) ParseResolution(r);  // refused before any scene loads
     if (!opt.stream.empty()) {
         t::io::CheckOutputPath("--stream", opt.stream);
         visualization::rendering::ParseByteSize(opt.gpu_budget, "--gpu-budget");

@@ -3,6 +3,7 @@
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -81,8 +82,10 @@ CLI::Validator NumberCheck(bool (*accept)(double), const std::string& requiremen
         },
         help);
 }
-const CLI::Validator kPositive =
-    NumberCheck([](double v) { return v > 0.0; }, "must be > 0", "POSITIVE");
+const CLI::Validator kPositive = NumberCheck([](double v) { return v > 0.0 && std::isfinite(v); },
+                                             "must be finite and > 0", "POSITIVE");
+const CLI::Validator kFinite =
+    NumberCheck([](double v) { return std::isfinite(v); }, "must be a finite number", "FINITE");
 const CLI::Validator kUnit =
     NumberCheck([](double v) { return v >= 0.0 && v <= 1.0; }, "must be in 0..1", "0..1");
 
@@ -452,13 +455,23 @@ int main(int argc, char** argv) {
                    "docs/accuracy.md)")
         ->check(CLI::IsMember({"reference", "camera-relative"}))
         ->capture_default_str();
-    app.add_option("--eye", opt.eye, "Look-at camera position x,y,z")->delimiter(',')->expected(3);
-    app.add_option("--center", opt.center, "Look-at target x,y,z")->delimiter(',')->expected(3);
-    app.add_option("--up", opt.up, "Look-at up vector x,y,z")->delimiter(',')->expected(3);
+    app.add_option("--eye", opt.eye, "Look-at camera position x,y,z")
+        ->delimiter(',')
+        ->expected(3)
+        ->check(kFinite);
+    app.add_option("--center", opt.center, "Look-at target x,y,z")
+        ->delimiter(',')
+        ->expected(3)
+        ->check(kFinite);
+    app.add_option("--up", opt.up, "Look-at up vector x,y,z")
+        ->delimiter(',')
+        ->expected(3)
+        ->check(kFinite);
     app.add_option("--fov", opt.fov, "Look-at vertical field of view in degrees")
         ->check(CLI::Range(1.0, 179.0));
     app.add_option("--orbit-angle", opt.orbit_angle,
-                   "Rotate the eye about --up through --center by this many degrees");
+                   "Rotate the eye about --up through --center by this many degrees")
+        ->check(kFinite);
     app.add_option("--lod-budget", opt.lod_budget,
                    "Draw the scene's level-of-detail cut of at most this many splats (docs/lod.md; "
                    "0: the whole scene)")
