@@ -606,6 +606,9 @@ TEST(SpzFormat, MalformedFiles) {
     Bytes degree = good;
     degree[12] = 5;
     ExpectReadError(write("degree.spz", degree), {"'shDegree' is 5"});
+    Bytes fractional = good;
+    fractional[13] = 40;  // every position would round to the origin
+    ExpectReadError(write("fractional.spz", fractional), {"'fractionalBits' is 40", "0..30"});
     Bytes streams = good;
     streams[15] = 6;
     ExpectReadError(write("streams.spz", streams), {"'numStreams' is 6"});

@@ -171,6 +171,13 @@ void CheckHeader(const std::string& filename, const Header& h) {
         core::ThrowError("'{}': SPZ header field 'shDegree' is {}; SPZ defines 0..4", filename,
                          h.sh_degree);
     }
+    // Positions are 24-bit fixed point over 2^fractionalBits; the reference reader divides by
+    // (1 << fractionalBits) in a 32-bit int, so 31 and more are no scale it can read (40
+    // would put every splat at the origin).
+    if (h.fractional_bits > 30) {
+        core::ThrowError("'{}': SPZ header field 'fractionalBits' is {}; SPZ positions take 0..30",
+                         filename, h.fractional_bits);
+    }
 }
 
 geometry::PointCloud ReadLegacy(const std::string& filename, const uint8_t* file, size_t size,
