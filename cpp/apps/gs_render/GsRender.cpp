@@ -16,6 +16,7 @@
 #include "open3d/camera/CamerasJson.h"
 #include "open3d/camera/PinholeCamera.h"
 #include "open3d/core/Exception.h"
+#include "open3d/core/HostMemory.h"
 #include "open3d/core/Logging.h"
 #include "open3d/core/ParallelFor.h"
 #include "open3d/core/Timer.h"
@@ -172,6 +173,29 @@ void WriteOutputs(const Options& opt, const t::geometry::Image& color,
     if (float_color != nullptr) std::printf("wrote %s (float RGBA)\n", opt.float_output.c_str());
 }
 
+// The render's images and every copy the outputs make, before anything is drawn: the
+// backends check their own images (colour RGBA32F and two float depths, 24 B/px), but the
+// 8-bit colour, the depth image and the float dump are more (a 30000x30000 view passed the
+// backend's check and was killed for memory writing them).
+void CheckImageMemory(const Options& opt, const camera::PinholeCamera& cam) {
+    uint64_t per_pixel = 4 * 4 + 4 + 4;  // the backend's images
+    per_pixel += 3;                      // 8-bit RGB for the PNG (or 12 B: float RGB .npy)
+    if (t::io::LowerCaseExtension(opt.output) == "npy") per_pixel += 9;
+    if (!opt.depth_output.empty()) per_pixel += 4;  // 16-bit PNG or float .npy
+    if (!opt.float_output.empty()) per_pixel += 16;
+    const uint64_t pixels = uint64_t(cam.width) * uint64_t(cam.height);
+    const uint64_t available = core::AvailableHostMemory();
+    const double scale = pixels * per_pixel > available
+                             ? std::sqrt(double(available) / double(pixels * per_pixel)) * 0.9
+                             : 1.0;
+    core::RequireHostMemory(
+        pixels * per_pixel,
+        fmt::format("gs-render: a {}x{} render and its outputs ({} bytes a pixel)", cam.width,
+                    cam.height, per_pixel),
+        fmt::format("{}x{} would fit", std::max(1, int(cam.width * scale)),
+                    std::max(1, int(cam.height * scale))));
+}
+
 camera::PinholeCamera ChooseCamera(const Options& opt, const t::geometry::PointCloud& cloud,
                                    bool default_scene) {
     const bool look_at_flags =
@@ -296,6 +320,7 @@ int Run(const Options& opt) {
                 load_ms);
 
     const camera::PinholeCamera cam = ChooseCamera(opt, cloud, default_scene);
+    CheckImageMemory(opt, cam);
     rendering::RenderConfig config;
     config.sh_degree = opt.sh_degree;
     config.antialias = opt.antialias;
