@@ -295,6 +295,14 @@ t::geometry::SplatHierarchy LoadOrBuildHierarchy(const Options& opt,
 
 int Run(const Options& opt) {
     CheckOutputs(opt);
+    if (!opt.cameras.empty()) {
+        // The view index is checked before the scene is read (seconds for a large one).
+        const size_t views = camera::ReadCamerasJson(opt.cameras).size();
+        if (opt.view < 0 || opt.view >= static_cast<int>(views)) {
+            core::ThrowError("bad view index {}: '{}' has {} views (0..{})", opt.view, opt.cameras,
+                             views, static_cast<int>(views) - 1);
+        }
+    }
     if (!opt.lod.empty() && opt.lod_budget == 0) {
         core::ThrowError("--lod '{}' is read for --lod-budget: give a budget too", opt.lod);
     }
