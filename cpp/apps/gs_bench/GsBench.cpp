@@ -19,6 +19,7 @@
 #include <utility>
 #include <vector>
 
+#include "../InputPathValidators.h"
 #include "BenchScenes.h"
 #include "LodBudgets.h"
 #include "StreamBench.h"
@@ -955,9 +956,10 @@ int main(int argc, char** argv) {
         "antialias) rendered in the same run (worst view).",
         "gs-bench"};
     app.add_option("-i,--input", opt.inputs, "Scene file(s) in any format gs-convert reads")
-        ->check(CLI::ExistingPath)
+        ->check(open3d::apps::ReadableInput(true))
         ->required();
-    app.add_option("--cameras", opt.cameras, "cameras.json per input")->check(CLI::ExistingFile);
+    app.add_option("--cameras", opt.cameras, "cameras.json per input")
+        ->check(open3d::apps::ReadableInput(false));
     app.add_option("--views", opt.views, "View indices, e.g. 0,5,9, or 'all'")
         ->capture_default_str();
     app.add_option("--resolution", opt.resolutions,

@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "../InputPathValidators.h"
 #include "FilamentRender.h"
 #include "open3d/camera/CamerasJson.h"
 #include "open3d/camera/PinholeCamera.h"
@@ -438,9 +439,9 @@ int main(int argc, char** argv) {
         "gs-render"};
     app.add_option("-i,--input", opt.input,
                    "Scene file in any format gs-convert reads (docs/formats.md)")
-        ->check(CLI::ExistingPath);
+        ->check(open3d::apps::ReadableInput(true));
     app.add_option("--cameras", opt.cameras, "3DGS cameras.json with the views")
-        ->check(CLI::ExistingFile);
+        ->check(open3d::apps::ReadableInput(false));
     app.add_option("--view", opt.view, "View index in cameras.json")->capture_default_str();
     app.add_option("--width", opt.width,
                    "Output width (default: the camera's; one of width/height keeps the aspect)")
@@ -512,7 +513,7 @@ int main(int argc, char** argv) {
     app.add_option("--lod", opt.lod,
                    "Hierarchy file for --lod-budget (default: <input>.lod as gs-convert --lod "
                    "writes it, else the hierarchy is built from the scene first)")
-        ->check(CLI::ExistingFile);
+        ->check(open3d::apps::ReadableInput(false));
     app.add_flag("--filament", opt.filament,
                  "Render through Filament (the Open3DScene offscreen path) instead of the "
                  "backend alone");
