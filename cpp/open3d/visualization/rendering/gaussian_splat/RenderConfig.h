@@ -22,14 +22,14 @@ enum class SortMode {
     kExact,
     /// The same order from per-tile bins: the projection counts each tile's entries, the
     /// entries go into their tile's bin and each tile is sorted by (depth, splat index) on
-    /// its own (docs/vulkan.md "Per-tile bins"): five dependent passes in place of about 25,
-    /// but slower on real scenes as built today (docs/perf/h100.md). When the entries pass
-    /// the capacity, whole tiles are dropped from the first that does not fit.
+    /// its own (docs/sort-options.md "Per-tile bins option"): five dependent passes in place
+    /// of about 25, but slower on real scenes as built today (docs/perf/h100.md). When the
+    /// entries pass the capacity, whole tiles are dropped from the first that does not fit.
     kExactTileBins,
     /// The seed's single 32-bit key per entry: tile index in the top ceil(log2(tiles)) bits,
     /// the truncated bits of the normalised depth below, ties in the projection's
     /// (nondeterministic) append order. Only 7-11 mantissa bits of depth at 1080p-8K, so
-    /// near splats can swap: a measured option (docs/vulkan.md, "Packed 32-bit key option").
+    /// near splats can swap: a measured option (docs/sort-options.md, "Packed 32-bit key option").
     kPackedKey32,
 };
 
