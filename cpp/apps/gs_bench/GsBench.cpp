@@ -11,7 +11,6 @@
 #include <fstream>
 #include <limits>
 #include <map>
-#include <new>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
@@ -20,6 +19,7 @@
 #include <vector>
 
 #include "../InputPathValidators.h"
+#include "../RunReportingErrors.h"
 #include "BenchScenes.h"
 #include "LodBudgets.h"
 #include "StreamBench.h"
@@ -582,10 +582,12 @@ int Run(const Options& opt) {
         }
         t::io::CheckOutputPath("--json", opt.json);
     }
-    for (const auto& r : opt.resolutions) ParseResolution(r);  // refused before any scene loads
+    std::vector<std::pair<int, int>> resolutions;  // refused before any scene loads
+    for (const auto& r : opt.resolutions) resolutions.push_back(ParseResolution(r));
+    uint64_t stream_gpu_budget = 0;
     if (!opt.stream.empty()) {
         t::io::CheckOutputPath("--stream", opt.stream);
-        visualization::rendering::ParseByteSize(opt.gpu_budget, "--gpu-budget");
+        stream_gpu_budget = visualization::rendering::ParseByteSize(opt.gpu_budget, "--gpu-budget");
     }
     std::vector<t::io::NamedInput> inputs;
     for (const std::string& path : opt.inputs) inputs.push_back({"--input", path});
@@ -655,8 +657,6 @@ int Run(const Options& opt) {
             jobs.push_back(std::move(job));
         }
     }
-    std::vector<std::pair<int, int>> resolutions;
-    for (const auto& r : opt.resolutions) resolutions.push_back(ParseResolution(r));
 
     std::vector<Knob> knobs;
     for (const Knob& k : kKnobs) {
@@ -705,8 +705,7 @@ int Run(const Options& opt) {
             const rendering::RenderConfig config = TimedConfig(opt);
             bench::StreamBenchOptions stream;
             stream.path = opt.stream;
-            stream.gpu_budget =
-                visualization::rendering::ParseByteSize(opt.gpu_budget, "--gpu-budget");
+            stream.gpu_budget = stream_gpu_budget;
             stream.splat_budget =
                 opt.stream_budget.empty() ? 0 : bench::ParseBudgets(opt.stream_budget).at(0);
             stream.page_capacity = opt.page_capacity;
@@ -1059,16 +1058,5 @@ int main(int argc, char** argv) {
     } catch (const CLI::ParseError& e) {
         return app.exit(e);
     }
-    try {
-        return Run(opt);
-    } catch (const std::bad_alloc&) {
-        std::fprintf(
-            stderr,
-            "gs-bench: error: out of memory (std::bad_alloc): the scene or the images asked "
-            "for need more host memory than this machine gives (docs/memory.md)\n");
-        return 1;
-    } catch (const std::exception& e) {
-        std::fprintf(stderr, "gs-bench: error: %s\n", e.what());
-        return 1;
-    }
+    return open3d::apps::RunReportingErrors("gs-bench", [&opt] { return Run(opt); });
 }

@@ -7,12 +7,12 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
-#include <new>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "../InputPathValidators.h"
+#include "../RunReportingErrors.h"
 #include "FilamentRender.h"
 #include "open3d/camera/CamerasJson.h"
 #include "open3d/camera/PinholeCamera.h"
@@ -197,19 +197,27 @@ void CheckImageMemory(const Options& opt, const camera::PinholeCamera& cam) {
                     std::max(1, int(cam.height * scale))));
 }
 
-camera::PinholeCamera ChooseCamera(const Options& opt, const t::geometry::PointCloud& cloud,
-                                   bool default_scene) {
+// --view of --cameras, read before the scene (a bad index fails at once, not after seconds of
+// loading); nothing without --cameras.
+std::optional<camera::PinholeCamera> ReadChosenView(const Options& opt) {
+    if (opt.cameras.empty()) return std::nullopt;
+    const auto views = camera::ReadCamerasJson(opt.cameras);
+    if (opt.view < 0 || opt.view >= static_cast<int>(views.size())) {
+        core::ThrowError("bad view index {}: '{}' has {} views (0..{})", opt.view, opt.cameras,
+                         views.size(), static_cast<int>(views.size()) - 1);
+    }
+    return views[opt.view].camera;
+}
+
+camera::PinholeCamera ChooseCamera(const Options& opt,
+                                   const std::optional<camera::PinholeCamera>& json_view,
+                                   const t::geometry::PointCloud& cloud, bool default_scene) {
     const bool look_at_flags =
         !opt.eye.empty() || !opt.center.empty() || !opt.up.empty() || opt.fov.has_value();
     camera::PinholeCamera cam;
     camera::LookAtCamera look_at;
-    if (!opt.cameras.empty()) {
-        const auto views = camera::ReadCamerasJson(opt.cameras);
-        if (opt.view < 0 || opt.view >= static_cast<int>(views.size())) {
-            core::ThrowError("bad view index {}: '{}' has {} views (0..{})", opt.view, opt.cameras,
-                             views.size(), static_cast<int>(views.size()) - 1);
-        }
-        cam = views[opt.view].camera;
+    if (json_view) {
+        cam = *json_view;
         // Look-at edits pivot on the point of the view axis nearest the scene centre.
         const Eigen::Vector3d forward = cam.GetRotation().row(2).transpose();
         const double distance =
@@ -296,14 +304,7 @@ t::geometry::SplatHierarchy LoadOrBuildHierarchy(const Options& opt,
 
 int Run(const Options& opt) {
     CheckOutputs(opt);
-    if (!opt.cameras.empty()) {
-        // The view index is checked before the scene is read (seconds for a large one).
-        const size_t views = camera::ReadCamerasJson(opt.cameras).size();
-        if (opt.view < 0 || opt.view >= static_cast<int>(views)) {
-            core::ThrowError("bad view index {}: '{}' has {} views (0..{})", opt.view, opt.cameras,
-                             views, static_cast<int>(views) - 1);
-        }
-    }
+    const std::optional<camera::PinholeCamera> json_view = ReadChosenView(opt);
     if (!opt.lod.empty() && opt.lod_budget == 0) {
         core::ThrowError("--lod '{}' is read for --lod-budget: give a budget too", opt.lod);
     }
@@ -328,7 +329,7 @@ int Run(const Options& opt) {
                 static_cast<long long>(cloud.NumPoints()), cloud.GaussianSplatGetSHOrder(),
                 load_ms);
 
-    const camera::PinholeCamera cam = ChooseCamera(opt, cloud, default_scene);
+    const camera::PinholeCamera cam = ChooseCamera(opt, json_view, cloud, default_scene);
     CheckImageMemory(opt, cam);
     rendering::RenderConfig config;
     config.sh_degree = opt.sh_degree;
@@ -535,16 +536,5 @@ int main(int argc, char** argv) {
         return app.exit(e);
     }
     opt.backend_given = backend_option->count() > 0;
-    try {
-        return Run(opt);
-    } catch (const std::bad_alloc&) {
-        std::fprintf(
-            stderr,
-            "gs-render: error: out of memory (std::bad_alloc): the scene or the images asked "
-            "for need more host memory than this machine gives (docs/memory.md)\n");
-        return 1;
-    } catch (const std::exception& e) {
-        std::fprintf(stderr, "gs-render: error: %s\n", e.what());
-        return 1;
-    }
+    return open3d::apps::RunReportingErrors("gs-render", [&opt] { return Run(opt); });
 }
