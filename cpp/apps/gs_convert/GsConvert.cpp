@@ -142,22 +142,27 @@ int main(int argc, char** argv) {
             t::io::WritePointCloud(path, cloud);
         });
         int64_t lod_nodes = 0;
+        std::optional<t::geometry::SplatHierarchy> lod_hierarchy;
+        bool lod_read_back_equal = false;  // the output holds exactly the splats read
         if (lod) {
             // The .lod's leaves are the output's splats as a reader will see them: a lossy or
             // reordering format's differ from the input's, and the hierarchy's fingerprint
             // must be theirs (gs-render refuses a hierarchy of another scene).
             t::geometry::PointCloud as_written;
             t::io::ReadPointCloud(written_output, as_written);
-            const t::geometry::SplatHierarchy hierarchy =
-                t::geometry::BuildSplatHierarchy(as_written);
+            lod_hierarchy = t::geometry::BuildSplatHierarchy(as_written);
+            lod_read_back_equal = as_written == cloud;
             files.Write(lod_path, [&](const std::string& path) {
-                t::io::WriteSplatHierarchy(path, hierarchy);
+                t::io::WriteSplatHierarchy(path, *lod_hierarchy);
             });
-            lod_nodes = hierarchy.NumInner();
+            lod_nodes = lod_hierarchy->NumInner();
         }
         if (pages) {
-            // The paged file holds its leaves itself: built from the cloud as read.
-            const t::geometry::SplatHierarchy hierarchy = t::geometry::BuildSplatHierarchy(cloud);
+            // The paged file holds its leaves itself: built from the cloud as read, which a
+            // lossless output leaves as it was (the .lod's hierarchy then serves both).
+            const t::geometry::SplatHierarchy hierarchy =
+                lod_read_back_equal ? std::move(*lod_hierarchy)
+                                    : t::geometry::BuildSplatHierarchy(cloud);
             files.Write(pages_path, [&](const std::string& path) {
                 t::io::WriteSplatPages(path, cloud, hierarchy, page_capacity);
             });
