@@ -108,7 +108,7 @@ def summarise(records):
     """One row per (scene, backend) over the views that rendered."""
     rows = []
     keys = sorted({(r["scene"], r["backend"]) for r in records},
-                  key=lambda k: (list(ro.SCENES).index(k[0]), k[1]))
+                  key=lambda k: ([*ro.SCENES, *ro.ORBIT_SCENES].index(k[0]), k[1]))
     for scene, backend in keys:
         group = [r for r in records if r["scene"] == scene and r["backend"] == backend]
         ok = [r for r in group if "error" not in r]
@@ -215,15 +215,14 @@ def crop_check(shared, original):
 class SceneCache:
     """Loads each scene and its cameras once."""
 
-    def __init__(self, shared):
+    def __init__(self, shared, cameras_dir):
         self.shared = shared
+        self.cameras_dir = cameras_dir  # where orbit scenes' generated cameras.json go
         self._scenes = {}
 
     def get(self, name):
         if name not in self._scenes:
-            scene_path, cameras_path = ro.scene_paths(self.shared, name)
-            self._scenes[name] = (scene_path, cameras_path, ro.load_scene(scene_path),
-                                  ro.load_cameras(cameras_path))
+            self._scenes[name] = ro.scene_and_cameras(self.shared, name, self.cameras_dir)
         return self._scenes[name]
 
 
@@ -264,7 +263,7 @@ def main(argv=None):
     if backends and not Path(args.gs_render).is_file():
         sys.exit(f"gs-render not found at {args.gs_render}")
     scenes = ro.parse_scenes(args.scenes)
-    cache = SceneCache(args.shared)
+    cache = SceneCache(args.shared, tempfile.mkdtemp(prefix="parity-cameras-"))
     module, peer_info = ro.build_peer(args.peer, args.build_dir, args.compat)
     renderer = ro.OriginalRenderer(module)
 

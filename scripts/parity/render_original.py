@@ -42,6 +42,13 @@ SCENES = {
     "chair": ("chair/chair.splat", "chair/cameras.json"),
     "biker_152k": ("biker/biker_152k.ply", "biker/cameras.json"),
 }
+# Scenes without a cameras.json: raw trainer outputs, viewed from orbit_cameras.py's 24 views.
+ORBIT_SCENES = {
+    "sh3_iter7000": "sh3_iter7000/point_cloud.ply",
+    "sh3_iter7000_splat": "sh3_iter7000/model.splat",
+    "train3": "train3/train_3points.ply",
+    "pc_short": "pc_short/pc_short.ply",
+}
 
 
 # --------------------------------------------------------------------------- scenes
@@ -273,17 +280,32 @@ def parse_views(spec, count):
 
 
 def parse_scenes(spec):
-    names = list(SCENES) if spec == "all" else [s.strip() for s in spec.split(",") if s.strip()]
+    known = [*SCENES, *ORBIT_SCENES]
+    names = known if spec == "all" else [s.strip() for s in spec.split(",") if s.strip()]
     for name in names:
-        if name not in SCENES:
-            raise ValueError(f"unknown scene '{name}' (known: {', '.join(SCENES)})")
+        if name not in known:
+            raise ValueError(f"unknown scene '{name}' (known: {', '.join(known)})")
     return names
 
 
 def scene_paths(shared, name):
-    scene, cameras = SCENES[name]
+    """(scene file, cameras.json), the latter None for ORBIT_SCENES (see orbit_cameras.py)."""
     data = Path(shared) / "data"
+    if name in ORBIT_SCENES:
+        return data / ORBIT_SCENES[name], None
+    scene, cameras = SCENES[name]
     return data / scene, data / cameras
+
+
+def scene_and_cameras(shared, name, cameras_dir):
+    """Paths and contents; an orbit scene's generated views are written to cameras_dir."""
+    scene_path, cameras_path = scene_paths(shared, name)
+    gaussians = load_scene(scene_path)
+    if cameras_path is None:
+        from orbit_cameras import write_orbit_cameras
+        cameras_path = Path(cameras_dir) / f"{name}_cameras.json"
+        write_orbit_cameras(gaussians.means, cameras_path)
+    return scene_path, cameras_path, gaussians, load_cameras(cameras_path)
 
 
 # ------------------------------------------------------------------ peer extension
@@ -490,7 +512,8 @@ def add_common_args(parser):
                         help="build from a patched copy even if the pristine sources should do")
     parser.add_argument("--shared", default=str(DEFAULT_SHARED),
                         help="shared folder with data/ (default: ../shared beside the repo)")
-    parser.add_argument("--scenes", default="all", help=f"all or a list of {', '.join(SCENES)}")
+    parser.add_argument("--scenes", default="all",
+                        help=f"all or a list of {', '.join([*SCENES, *ORBIT_SCENES])}")
     parser.add_argument("--views", default="all", help="all or a list such as 0,9")
 
 
@@ -505,9 +528,7 @@ def main(argv=None):
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     for name in parse_scenes(args.scenes):
-        scene_path, cameras_path = scene_paths(args.shared, name)
-        gaussians = load_scene(scene_path)
-        cameras = load_cameras(cameras_path)
+        _, _, gaussians, cameras = scene_and_cameras(args.shared, name, out)
         log(f"{name}: {len(gaussians.means)} splats, SH degree {gaussians.sh_degree}")
         for i in parse_views(args.views, len(cameras)):
             start = time.time()

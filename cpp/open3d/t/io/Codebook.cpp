@@ -7,6 +7,7 @@
 #include <random>
 #include <unordered_map>
 
+#include "open3d/core/Exception.h"
 #include "open3d/core/ParallelFor.h"
 #include "open3d/core/Progress.h"
 #include "open3d/t/io/SogLayout.h"
@@ -39,21 +40,41 @@ struct RowEqual {
 }  // namespace
 
 std::vector<float> Quantise1D(const std::vector<float>& values, std::vector<uint8_t>& labels,
-                              int iterations) {
-    std::vector<float> sorted = values;
-    std::sort(sorted.begin(), sorted.end());
+                              const std::vector<float>& weights, int iterations) {
+    const size_t n = values.size();
+    if (!weights.empty() && weights.size() != n) {
+        core::ThrowError("Quantise1D: {} weights for {} values", weights.size(), n);
+    }
+    // Values in ascending order with their weights (1 each when none are given).
+    std::vector<uint32_t> order(n);
+    for (size_t i = 0; i < n; ++i) order[i] = uint32_t(i);
+    std::sort(order.begin(), order.end(),
+              [&](uint32_t a, uint32_t b) { return values[a] < values[b]; });
+    std::vector<float> sorted(n);
+    for (size_t i = 0; i < n; ++i) sorted[i] = values[order[i]];
     std::vector<float> distinct = sorted;
     distinct.erase(std::unique(distinct.begin(), distinct.end()), distinct.end());
     std::vector<float> codebook;
     if (distinct.size() <= size_t(kCodebookSize)) {
         codebook = distinct;
     } else {
-        const size_t n = sorted.size();
-        std::vector<double> prefix(n + 1, 0.0);
-        for (size_t i = 0; i < n; ++i) prefix[i + 1] = prefix[i] + sorted[i];
+        // Prefix sums of w and w * v over the sorted values: a cluster's weighted mean is
+        // two differences, so a Lloyd iteration costs 256 binary searches.
+        std::vector<double> weight_prefix(n + 1, 0.0), moment_prefix(n + 1, 0.0);
+        for (size_t i = 0; i < n; ++i) {
+            const double w = weights.empty() ? 1.0 : double(weights[order[i]]);
+            weight_prefix[i + 1] = weight_prefix[i] + w;
+            moment_prefix[i + 1] = moment_prefix[i] + w * sorted[i];
+        }
+        // Seeds at the weighted quantiles (the plain quantiles without weights).
         std::vector<double> c(kCodebookSize);
-        for (int k = 0; k < kCodebookSize; ++k)
-            c[k] = sorted[((2 * k + 1) * n) / (2 * kCodebookSize)];
+        for (int k = 0; k < kCodebookSize; ++k) {
+            const double target = weight_prefix[n] * (2 * k + 1) / (2.0 * kCodebookSize);
+            const size_t at =
+                std::upper_bound(weight_prefix.begin() + 1, weight_prefix.end(), target) -
+                (weight_prefix.begin() + 1);
+            c[k] = sorted[std::min(at, n - 1)];
+        }
         std::vector<size_t> bounds(kCodebookSize + 1);
         for (int it = 0; it < iterations; ++it) {
             bounds[0] = 0;
@@ -65,9 +86,9 @@ std::vector<float> Quantise1D(const std::vector<float>& values, std::vector<uint
             }
             bool changed = false;
             for (int k = 0; k < kCodebookSize; ++k) {
-                if (bounds[k + 1] == bounds[k]) continue;  // empty: keep the centroid
-                const double mean =
-                    (prefix[bounds[k + 1]] - prefix[bounds[k]]) / double(bounds[k + 1] - bounds[k]);
+                const double w = weight_prefix[bounds[k + 1]] - weight_prefix[bounds[k]];
+                if (bounds[k + 1] == bounds[k] || !(w > 0.0)) continue;  // empty: keep it
+                const double mean = (moment_prefix[bounds[k + 1]] - moment_prefix[bounds[k]]) / w;
                 changed = changed || mean != c[k];
                 c[k] = mean;
             }

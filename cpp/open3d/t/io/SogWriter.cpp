@@ -174,7 +174,17 @@ void WriteSog(const std::string& filename, const geometry::PointCloud& cloud) {
         }
     }
     std::vector<uint8_t> scale_labels, dc_labels;
-    const std::vector<float> scale_codebook = Quantise1D(log_scales, scale_labels);
+    // The scale codebook weighs each log-scale by its splat's linear size relative to the
+    // largest (floored at 1/100): a plain k-means spends its entries where splats are many,
+    // the small ones, and rounds the few large splats down by up to half, which shows; tiny
+    // splats stay tiny at any rounding. docs/formats.md has the round trips before and after.
+    const float top_log_scale = *std::max_element(log_scales.begin(), log_scales.end());
+    std::vector<float> scale_weights(log_scales.size());
+    core::ParallelFor(int64_t(log_scales.size()), [&](int64_t k) {
+        scale_weights[k] = static_cast<float>(
+            std::max(std::exp(double(log_scales[k]) - double(top_log_scale)), 1e-2));
+    });
+    const std::vector<float> scale_codebook = Quantise1D(log_scales, scale_labels, scale_weights);
     const std::vector<float> dc_codebook = Quantise1D(dc, dc_labels);
     core::ParallelFor(n, [&](int64_t i) {
         for (int c = 0; c < 3; ++c) {
