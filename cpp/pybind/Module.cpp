@@ -2,6 +2,9 @@
 // backend registered once so that OffscreenRenderer(backend="vulkan") finds it.
 #include <pybind11/pybind11.h>
 
+#include <exception>
+#include <string>
+
 #include "Bindings.h"
 #include "open3d/core/Exception.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/VulkanBackendRegistry.h"
@@ -11,8 +14,27 @@ namespace py = pybind11;
 PYBIND11_MODULE(_core, m) {
     m.doc() = "open3d_gs: Gaussian splat scenes from Python (docs/python.md)";
     // The C++ library's errors arrive as open3d_gs.Open3DError (a RuntimeError) with the
-    // C++ message.
-    py::register_exception<open3d::core::Open3DError>(m, "Open3DError", PyExc_RuntimeError);
+    // C++ message. A message can hold bytes that are not UTF-8 (quoted from a file, e.g. a
+    // JSON parser's "last read"): pybind11's own translation decodes strictly and then gives
+    // an empty message, so undecodable bytes become \xNN escapes here instead.
+    static py::exception<open3d::core::Open3DError> open3d_error(m, "Open3DError",
+                                                                 PyExc_RuntimeError);
+    py::register_exception_translator([](std::exception_ptr p) {
+        try {
+            if (p) std::rethrow_exception(p);
+        } catch (const open3d::core::Open3DError& e) {
+            const std::string what = e.what();
+            PyObject* message =
+                PyUnicode_DecodeUTF8(what.data(), Py_ssize_t(what.size()), "backslashreplace");
+            if (message == nullptr) {  // only on memory exhaustion
+                PyErr_Clear();
+                PyErr_SetString(open3d_error.ptr(), "(the error message could not be decoded)");
+                return;
+            }
+            PyErr_SetObject(open3d_error.ptr(), message);
+            Py_DECREF(message);
+        }
+    });
     open3d::visualization::rendering::vulkan::RegisterVulkanBackend();
     py::module_ t = m.def_submodule("t", "Tensor-based geometry and I/O");
     py::module_ t_geometry = t.def_submodule("geometry", "PointCloud");

@@ -88,6 +88,17 @@ def test_errors_carry_the_cpp_messages(tmp_path):
         o3d.camera.read_cameras_json(str(tmp_path / "cameras.json"))
 
 
+def test_error_messages_with_bytes_that_are_not_utf8(tmp_path):
+    # The JSON parser quotes the byte it stopped at; 0xff is no UTF-8, and pybind11's own
+    # translation turned such a message into an empty one.
+    bad = tmp_path / "cameras.json"
+    bad.write_bytes(b'[{"id": "\xff"}]')
+    with pytest.raises(o3d.Open3DError) as info:
+        o3d.camera.read_cameras_json(str(bad))
+    assert "cameras.json: malformed JSON" in str(info.value)
+    assert "\\xff" in str(info.value)
+
+
 def test_cameras_three_ways(data):
     views = o3d.camera.read_cameras_json(str(data("playbot/cameras.json")))
     c = views[0].camera

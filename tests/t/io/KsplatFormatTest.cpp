@@ -405,6 +405,19 @@ TEST(Ksplat, MalformedFilesGiveCleanErrors) {
     ExpectReadError(path, {"section 0", "bucket centre"});
 }
 
+TEST(Ksplat, KsplatNamedSplatIsNamed) {
+    // Before, a .ksplat renamed to .splat read as "truncated .splat" (or, at a size that is a
+    // multiple of 32, as garbage splats).
+    const std::string good = BuildKsplat(1, TwoSections(2, 1));
+    const std::string path = tests::TempDir() + "/renamed.splat";
+    WriteBytes(path, good);
+    ExpectReadError(path, {"renamed.splat", "is a .ksplat file", "rename it to .ksplat"});
+    std::string padded = good;
+    padded.resize((padded.size() + 31) / 32 * 32, '\0');
+    WriteBytes(path, padded);
+    ExpectReadError(path, {"is a .ksplat file"});
+}
+
 // Regenerates the .ksplat fuzz seed (run with --gtest_also_run_disabled_tests).
 TEST(Ksplat, DISABLED_WriteFuzzSeed) {
     WriteBytes(std::string(OPEN3D_TEST_SOURCE_DIR) + "/fuzz/seeds/mode1_sh2.ksplat",

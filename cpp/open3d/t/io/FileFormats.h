@@ -52,6 +52,10 @@ void WriteGltf(const std::string& filename, const geometry::PointCloud& cloud, b
 /// mkkellogg's .ksplat, compression modes 0-2 (read only). KsplatFormat.cpp.
 geometry::PointCloud ReadKsplat(const std::string& filename, const ReadPointCloudOptions& options,
                                 ReadPointCloudReport& report);
+/// Whether `bytes` start like a .ksplat: version 0.1+, mode 0-2, a splat count, and the
+/// rest of the 4096-byte main header zero (GaussianSplats3D and splat-transform leave it so;
+/// 128 records of a .splat are not all zero there). Names a .ksplat renamed to .splat.
+bool LooksLikeKsplat(const uint8_t* bytes, uint64_t size);
 
 /// The float32 log-scale whose exp (computed as the reader does, in double) gives back
 /// `scale` exactly when such a value exists; otherwise the nearest one. Zero maps to a

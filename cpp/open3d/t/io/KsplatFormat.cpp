@@ -119,6 +119,12 @@ int RecordSHIndex(int k, int ch) { return k < 3 ? ch * 3 + k : 9 + ch * 5 + (k -
 
 }  // namespace
 
+bool LooksLikeKsplat(const uint8_t* bytes, uint64_t size) {
+    if (size < kMainHeaderBytes || bytes[0] != 0 || bytes[1] < 1) return false;
+    if (Load<uint16_t>(bytes + 20) > 2 || Load<uint32_t>(bytes + 16) == 0) return false;
+    return std::all_of(bytes + 44, bytes + kMainHeaderBytes, [](uint8_t b) { return b == 0; });
+}
+
 geometry::PointCloud ReadKsplat(const std::string& filename, const ReadPointCloudOptions& options,
                                 ReadPointCloudReport& report) {
     const MappedFile file(filename);

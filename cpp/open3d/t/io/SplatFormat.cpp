@@ -33,6 +33,12 @@ geometry::PointCloud ReadSplat(const std::string& filename, const ReadPointCloud
                                ReadPointCloudReport& report) {
     const MappedFile bytes(filename);
     const int64_t size = static_cast<int64_t>(bytes.size());
+    if (LooksLikeKsplat(bytes.data(), bytes.size())) {
+        core::ThrowError(
+            "'{}': this is a .ksplat file (GaussianSplats3D, version 0.{}) named .splat; "
+            "rename it to .ksplat to read it",
+            filename, int(bytes.data()[1]));
+    }
     if (size % kSplatBytes != 0) {
         core::ThrowError(
             "'{}': size {} bytes is not a multiple of 32 (.splat record size): the "
