@@ -2,6 +2,7 @@
 // from PLY within bounds derived from the quantisation, write -> read -> write -> read giving
 // the same values, the folder form, and malformed files failing with clean errors.
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
 #include <algorithm>
 #include <chrono>
@@ -523,7 +524,10 @@ TEST(SogFormat, MalformedFilesFailCleanly) {
     for (const auto& [name, entry] : Unzip(good)) {
         if (name != "sh0.webp") WriteFileBytes(folder + "/" + name, entry);
     }
-    ExpectError(folder, {"sh0.webp", "missing"});
+    ExpectError(folder, {"sh0.webp", "does not exist"});
+    // A FIFO in its place is named as one (it was "missing"), and never opened: that blocks.
+    ASSERT_EQ(::mkfifo((folder + "/sh0.webp").c_str(), 0600), 0);
+    ExpectError(folder, {"sh0.webp", "is a FIFO, not a regular file"});
 }
 
 // More than 65,536 distinct SH vectors: the palette comes from k-means (1024 entries at this

@@ -10,7 +10,8 @@ namespace io {
 
 /// "" when `path` names a readable file (or, with `folder_ok`, a readable folder: a SOG
 /// folder); else why not: "does not exist", "is a loop of symbolic links", "is a folder",
-/// "cannot be read (permission denied)", each after the quoted path.
+/// "is a FIFO, not a regular file" (or a socket, a device), "cannot be read (permission
+/// denied)", each after the quoted path.
 std::string InputPathProblem(const std::string& path, bool folder_ok);
 
 }  // namespace io

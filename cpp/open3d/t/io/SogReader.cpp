@@ -16,6 +16,7 @@
 #include "open3d/core/ParallelFor.h"
 #include "open3d/t/geometry/SphericalHarmonics.h"
 #include "open3d/t/io/FileFormats.h"
+#include "open3d/t/io/InputPaths.h"
 #include "open3d/t/io/SogLayout.h"
 #include "open3d/t/io/SplatColumns.h"
 #include "open3d/t/io/WebpImage.h"
@@ -71,9 +72,8 @@ public:
         }
         const fs::path path = folder_ / name;
         std::error_code ec;
-        if (!fs::is_regular_file(path, ec)) {
-            core::ThrowError("'{}': '{}' is missing (looked for '{}')", filename_, name,
-                             path.string());
+        if (const std::string problem = InputPathProblem(path.string(), false); !problem.empty()) {
+            core::ThrowError("'{}': its '{}' cannot be read: {}", filename_, name, problem);
         }
         const uintmax_t size = fs::file_size(path, ec);
         if (ec || size > max_size) {
