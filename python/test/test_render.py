@@ -181,6 +181,17 @@ def test_errors():
         r.setup_camera("front")
 
 
+def test_a_view_past_the_devices_image_limit_names_the_limit():
+    # Every Vulkan device limits a 2D image's side (lavapipe 16384, NVIDIA 32768); the message
+    # said only "cannot hold a 65536x1 image of format 109 with usage 0xb".
+    r = Renderer(65536, 1, "vulkan")
+    r.scene.add_geometry("cloud", small_cloud())
+    r.setup_camera(o3d.camera.PinholeCamera(65536, 1, 100.0, 100.0, 32767.5, 0.0))
+    with pytest.raises(o3d.Open3DError, match=r"65536x1 image .*largest image of this kind is "
+                                              r"\d+x\d+; render at most that size"):
+        r.render_to_image()
+
+
 def test_objects_can_go_in_any_order():
     pcd = small_cloud()
     r = Renderer(16, 16, "cpu")

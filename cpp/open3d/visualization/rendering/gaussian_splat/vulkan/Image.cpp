@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstring>
+#include <string>
 
 #include "open3d/core/Exception.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/CommandTally.h"
@@ -31,7 +32,9 @@ constexpr VkExternalMemoryHandleTypeFlagBits kExportHandleType =
 // Whether the device can make the image (and export its memory): asked first, so an
 // unsupported format, usage or export becomes an actionable error rather than a validation
 // message.
-bool CanCreate(const VulkanContext& context, const VkImageCreateInfo& info, bool exportable) {
+// "" when the device can create the image; else why not, in words a user can act on.
+std::string WhyNotCreatable(const VulkanContext& context, const VkImageCreateInfo& info,
+                            bool exportable) {
     VkPhysicalDeviceExternalImageFormatInfo external_info =
         MakeInfo<VkPhysicalDeviceExternalImageFormatInfo>(
             VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_EXTERNAL_IMAGE_FORMAT_INFO);
@@ -50,13 +53,20 @@ bool CanCreate(const VulkanContext& context, const VkImageCreateInfo& info, bool
     properties.pNext = exportable ? &external : nullptr;
     if (vkGetPhysicalDeviceImageFormatProperties2(context.GetPhysicalDevice(), &format_info,
                                                   &properties) != VK_SUCCESS) {
-        return false;
+        return "it does not support this format and usage";
+    }
+    if (exportable && (external.externalMemoryProperties.externalMemoryFeatures &
+                       VK_EXTERNAL_MEMORY_FEATURE_EXPORTABLE_BIT) == 0) {
+        return "it cannot export such an image's memory as an fd";
     }
     const VkExtent3D& max = properties.imageFormatProperties.maxExtent;
-    const bool export_ok =
-        !exportable || (external.externalMemoryProperties.externalMemoryFeatures &
-                        VK_EXTERNAL_MEMORY_FEATURE_EXPORTABLE_BIT) != 0;
-    return export_ok && max.width >= info.extent.width && max.height >= info.extent.height;
+    if (max.width < info.extent.width || max.height < info.extent.height) {
+        return fmt::format(
+            "its largest image of this kind is {}x{}; render at most that size (or with the "
+            "CPU backend, which has no such limit)",
+            max.width, max.height);
+    }
+    return "";
 }
 
 }  // namespace
@@ -85,11 +95,10 @@ Image::Image(const VulkanContext& context, uint32_t width, uint32_t height, VkFo
     info.usage = usage;
     info.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
     info.initialLayout = VK_IMAGE_LAYOUT_UNDEFINED;
-    if (!CanCreate(context, info, exportable_)) {
-        core::ThrowError("Vulkan: {} cannot hold a {}x{} image of format {} with usage {:#x}{}",
+    if (const std::string why = WhyNotCreatable(context, info, exportable_); !why.empty()) {
+        core::ThrowError("Vulkan: {} cannot make a {}x{} image (format {}, usage {:#x}{}): {}",
                          context.GetDeviceInfo().name, width, height, static_cast<int>(format),
-                         static_cast<uint32_t>(usage),
-                         exportable_ ? " and memory exportable as an fd" : "");
+                         static_cast<uint32_t>(usage), exportable_ ? ", exportable" : "", why);
     }
     VkImage image = VK_NULL_HANDLE;
     CheckVk(vkCreateImage(device, &info, nullptr, &image), "vkCreateImage");
