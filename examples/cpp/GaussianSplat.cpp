@@ -12,6 +12,7 @@
 #include <thread>
 #include <vector>
 
+#include "apps/NumberValidators.h"
 #include "open3d/camera/CamerasJson.h"
 #include "open3d/core/Exception.h"
 #include "open3d/core/Timer.h"
@@ -328,13 +329,14 @@ int main(int argc, char** argv) {
                    "World up x,y,z of the orbit camera (default 0,-1,0 for files, the 3DGS "
                    "convention; 0,1,0 for the built-in scene)")
         ->delimiter(',')
-        ->expected(3);
+        ->expected(3)
+        ->check(apps::kFinite);
     app.add_flag("--no-sphere", opt.no_sphere, "Do not add the red sphere");
     app.add_option("--sphere-radius", opt.sphere_radius,
                    "Sphere radius. The sphere is centred on the median splat position, with "
                    "radius 0.3 x the 80th-percentile splat distance from there by default (the "
                    "built-in scene has its own place and size for it)")
-        ->check(CLI::PositiveNumber);
+        ->check(apps::kPositive);
     app.add_flag("--hide-panel", opt.hide_panel, "Start with the settings panel hidden");
     app.add_option("--sh-degree", opt.sh_degree, "Initial SH degree cap")
         ->check(CLI::Range(0, 3))
@@ -352,7 +354,7 @@ int main(int argc, char** argv) {
         ->capture_default_str();
     app.add_option("--exit-after-seconds", opt.exit_after_seconds,
                    "Exit after this many seconds (0: no limit)")
-        ->check(CLI::NonNegativeNumber)
+        ->check(apps::kNonNegative)
         ->capture_default_str();
     app.add_flag("--screenshot-on-exit", opt.screenshot_on_exit,
                  "Draw one more frame at exit and save it as a screenshot");
@@ -360,7 +362,7 @@ int main(int argc, char** argv) {
                    "While the camera moves (drag, keys, wheel, --spin), frames whose full-size "
                    "time exceeded this are drawn at 1/2 or 1/4 of each side and scaled up; "
                    "the full-size frame follows when the motion stops (0: always full size)")
-        ->check(CLI::NonNegativeNumber)
+        ->check(apps::kNonNegative)
         ->capture_default_str();
     app.add_option("--gpu-budget", opt.gpu_budget,
                    "GPU memory for a streamed .gspages scene's pool (K, M, G, T: powers of "
@@ -374,6 +376,7 @@ int main(int argc, char** argv) {
     app.add_option("--spin", opt.spin_degrees,
                    "Orbit the camera by this many degrees every frame, drawing continuously "
                    "(timing: the splat geometry stage then runs every frame)")
+        ->check(apps::kFinite)
         ->capture_default_str();
     try {
         app.parse(argc, argv);

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "../InputPathValidators.h"
+#include "../NumberValidators.h"
 #include "../RunReportingErrors.h"
 #include "FilamentRender.h"
 #include "open3d/camera/CamerasJson.h"
@@ -69,27 +70,9 @@ struct Options {
 
 Eigen::Vector3d ToVec(const std::vector<double>& v) { return Eigen::Vector3d(v[0], v[1], v[2]); }
 
-// A number check that states the accepted range in words: CLI::PositiveNumber printed
-// "[2.22507e-308 - 1.79769e+308]" with every digit of the double limits.
-CLI::Validator NumberCheck(bool (*accept)(double), const std::string& requirement,
-                           const std::string& help) {
-    return CLI::Validator(
-        [accept, requirement](std::string& text) -> std::string {
-            char* end = nullptr;
-            const double v = std::strtod(text.c_str(), &end);
-            if (text.empty() || *end != '\0' || !accept(v)) {
-                return "'" + text + "' " + requirement;
-            }
-            return "";
-        },
-        help);
-}
-const CLI::Validator kPositive = NumberCheck([](double v) { return v > 0.0 && std::isfinite(v); },
-                                             "must be finite and > 0", "POSITIVE");
-const CLI::Validator kFinite =
-    NumberCheck([](double v) { return std::isfinite(v); }, "must be a finite number", "FINITE");
-const CLI::Validator kUnit =
-    NumberCheck([](double v) { return v >= 0.0 && v <= 1.0; }, "must be in 0..1", "0..1");
+using apps::kFinite;
+using apps::kPositive;
+using apps::kUnit;
 
 // Every output is checked before the scene is read: a run that cannot write its result
 // fails at once instead of after loading and rendering, and the extension decides the
