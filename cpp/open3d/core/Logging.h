@@ -6,6 +6,7 @@
 #include <functional>
 #include <string>
 #include <string_view>
+#include <utility>
 
 namespace open3d {
 namespace core {
@@ -23,6 +24,19 @@ LogLevel GetLogLevel();
 LogSink SetLogSink(LogSink sink);
 
 void LogMessage(LogLevel level, std::string_view message);
+
+/// While alive, every logged message has each `from` replaced by `to`: a writer that logs
+/// the temporary file it writes to (t::io::OutputFileSet) then names the user's file.
+class ScopedLogAlias {
+public:
+    ScopedLogAlias(std::string from, std::string to);
+    ~ScopedLogAlias();
+    ScopedLogAlias(const ScopedLogAlias&) = delete;
+    ScopedLogAlias& operator=(const ScopedLogAlias&) = delete;
+
+private:
+    size_t index_;
+};
 
 template <typename... Args>
 void LogDebug(fmt::format_string<Args...> format, Args&&... args) {

@@ -4,9 +4,13 @@
 
 #include <filesystem>
 #include <fstream>
+#include <string>
+#include <string_view>
+#include <vector>
 
 #include "TestUtility.h"
 #include "open3d/core/Exception.h"
+#include "open3d/core/Logging.h"
 #include "open3d/t/io/ImageIO.h"
 #include "open3d/t/io/OutputFiles.h"
 
@@ -109,6 +113,27 @@ TEST(OutputFiles, WriteErrorsNameTheOutputNotTheTemporary) {
     }
     files.Commit();
     EXPECT_EQ(CountEntries(dir), 0u);
+}
+
+TEST(OutputFiles, WriterWarningsNameTheOutputNotTheTemporary) {
+    // A writer's warning ("'.tmp-PID-0-0-o.splat': .splat holds SH degree 0 only") named
+    // the temporary the user never sees.
+    const std::string dir = tests::TempDir();
+    std::vector<std::string> messages;
+    core::LogSink previous = core::SetLogSink(
+        [&messages](core::LogLevel, std::string_view m) { messages.emplace_back(m); });
+    OutputFileSet files;
+    files.Write(dir + "/o.splat", [](const std::string& temporary) {
+        core::LogWarning("'{}' ({}): SH dropped", temporary,
+                         fs::path(temporary).filename().string());
+        std::ofstream(temporary) << "x";
+    });
+    core::LogWarning("after: '{}'", "o.splat");
+    core::SetLogSink(previous);
+    files.Commit();
+    ASSERT_EQ(messages.size(), 2u);
+    EXPECT_EQ(messages[0], "'" + dir + "/o.splat' (o.splat): SH dropped");
+    EXPECT_EQ(messages[1], "after: 'o.splat'");
 }
 
 TEST(OutputFiles, AnOutputThatIsAnInputIsRefused) {

@@ -11,6 +11,7 @@
 #include <filesystem>
 
 #include "open3d/core/Exception.h"
+#include "open3d/core/Logging.h"
 
 namespace open3d {
 namespace t {
@@ -114,6 +115,10 @@ void OutputFileSet::Write(const std::string& final_path,
                           const std::function<void(const std::string& temporary)>& write) {
     const std::string temporary = Add(final_path);
     try {
+        // Warnings the writer logs name the user's file too (whole path, then bare name).
+        const core::ScopedLogAlias path_alias(temporary, final_path);
+        const core::ScopedLogAlias name_alias(fs::path(temporary).filename().string(),
+                                              fs::path(final_path).filename().string());
         write(temporary);
     } catch (const core::Open3DError& e) {
         // The failed output leaves the set: a later Commit must not publish its remains.
