@@ -20,8 +20,10 @@ constexpr int kGzipWindow = 15 + 16;
 constexpr int kRawWindow = -15;
 
 // Inflates with `window_bits` until the stream ends; the output may not pass max_output.
+// With `more` set, reaching max_output stops without error and *more says whether the
+// stream goes on.
 std::vector<uint8_t> Inflate(const uint8_t* data, size_t size, size_t max_output, int window_bits,
-                             const std::string& what) {
+                             const std::string& what, bool* more = nullptr) {
     if (size > std::numeric_limits<uInt>::max()) core::ThrowError("{}: too large", what);
     z_stream zs{};
     if (inflateInit2(&zs, window_bits) != Z_OK) core::ThrowError("{}: zlib init failed", what);
@@ -33,6 +35,16 @@ std::vector<uint8_t> Inflate(const uint8_t* data, size_t size, size_t max_output
         if (zs.avail_out == 0) {  // grow the output, doubling, up to max_output
             const size_t used = out.size();
             if (used >= max_output) {
+                if (more != nullptr) {
+                    // One more byte tells whether the stream ends here.
+                    uint8_t probe = 0;
+                    zs.next_out = &probe;
+                    zs.avail_out = 1;
+                    const int status = inflate(&zs, Z_NO_FLUSH);
+                    *more = zs.avail_out == 0 || (status != Z_STREAM_END && status != Z_OK);
+                    zs.total_out = used;
+                    break;
+                }
                 error = fmt::format("decompresses to more than {} bytes", max_output);
                 break;
             }
@@ -78,6 +90,12 @@ std::vector<uint8_t> Deflate(const uint8_t* data, size_t size, int window_bits) 
 std::vector<uint8_t> GunzipBytes(const uint8_t* data, size_t size, size_t max_output,
                                  const std::string& what) {
     return Inflate(data, size, max_output, kGzipWindow, what);
+}
+
+std::vector<uint8_t> GunzipPrefixBytes(const uint8_t* data, size_t size, size_t max_output,
+                                       bool* more, const std::string& what) {
+    *more = false;
+    return Inflate(data, size, max_output, kGzipWindow, what, more);
 }
 
 std::vector<uint8_t> GzipBytes(const uint8_t* data, size_t size) {

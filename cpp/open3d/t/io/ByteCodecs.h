@@ -16,6 +16,12 @@ namespace io {
 /// A gzip member (RFC 1952) inflated; throws when it is malformed or inflates past max_output.
 std::vector<uint8_t> GunzipBytes(const uint8_t* data, size_t size, size_t max_output,
                                  const std::string& what);
+/// The first bytes of a gzip member, at most `max_output` of them: inflation stops there
+/// without error (a header can be read before the rest is allowed to take memory).
+/// `*more` tells whether the member holds more than was returned. Throws when what was
+/// inflated is malformed.
+std::vector<uint8_t> GunzipPrefixBytes(const uint8_t* data, size_t size, size_t max_output,
+                                       bool* more, const std::string& what);
 /// `data` as one gzip member (deflate level 6).
 std::vector<uint8_t> GzipBytes(const uint8_t* data, size_t size);
 

@@ -59,6 +59,9 @@ inline constexpr double kAlphaMargin = 1e-6;
 inline constexpr uint64_t kZstdMaxExpansion = 32768;
 // Deflate emits at most 258 bytes per 2 bits of input.
 inline constexpr uint64_t kDeflateMaxExpansion = 1032;
+// What a v1-3 gzip stream may hold after its attributes (the extensions, a few bytes each):
+// more is not inflated.
+inline constexpr uint64_t kMaxLegacyTailBytes = 1 << 20;
 inline constexpr uint32_t kExtensionCoordinateSystem = 0xADBE0003;  // SPZ_ADOBE_coordinate_system
 inline constexpr uint32_t kCoordinateRUB = 4, kCoordinateRDF = 6;   // spz::CoordinateSystem values
 

@@ -166,6 +166,15 @@ geometry::PointCloud DecodeSplats(const std::string& filename, const Header& h,
     return FinalizeColumns(filename, c, options, report);
 }
 
+// The decoded cloud and the `decoded_bytes` of decompressed streams held while it is filled
+// must fit before anything is decompressed: a 61 KB file of RLE zstd frames claiming 1e8
+// splats was refused only after 11 s of decoding at 2 GB.
+void CheckDecodeMemory(const std::string& filename, const Header& h, uint64_t decoded_bytes) {
+    CheckSplatColumnsMemory(filename, int64_t(h.num_points), /*gaussian=*/true,
+                            std::min(h.sh_degree, kMaxCloudSHDegree), decoded_bytes,
+                            fmt::format("{} decompressed bytes", decoded_bytes));
+}
+
 void CheckHeader(const std::string& filename, const Header& h) {
     if (h.sh_degree > kMaxFileSHDegree) {
         core::ThrowError("'{}': SPZ header field 'shDegree' is {}; SPZ defines 0..4", filename,
@@ -183,26 +192,29 @@ void CheckHeader(const std::string& filename, const Header& h) {
 geometry::PointCloud ReadLegacy(const std::string& filename, const uint8_t* file, size_t size,
                                 const ReadPointCloudOptions& options,
                                 ReadPointCloudReport& report) {
-    const std::vector<uint8_t> bytes = GunzipBytes(file, size, size * kDeflateMaxExpansion + 1024,
-                                                   fmt::format("'{}': SPZ gzip stream", filename));
-    if (bytes.size() < kLegacyHeaderBytes) {
+    // The header first, alone: numPoints bounds what the rest may inflate to, and the memory
+    // check runs before that (a 2 MB gzip bomb named .spz once inflated 2 GiB first).
+    bool more = false;
+    const std::vector<uint8_t> head = GunzipPrefixBytes(
+        file, size, kLegacyHeaderBytes, &more, fmt::format("'{}': SPZ gzip stream", filename));
+    if (head.size() < kLegacyHeaderBytes) {
         core::ThrowError(
             "'{}': truncated SPZ header: the gzip stream holds {} bytes, the v1-3 "
             "header needs {}",
-            filename, bytes.size(), kLegacyHeaderBytes);
+            filename, head.size(), kLegacyHeaderBytes);
     }
-    if (LoadU32(bytes.data()) != kMagic) {
+    if (LoadU32(head.data()) != kMagic) {
         core::ThrowError(
             "'{}': SPZ header field 'magic' is 0x{:08x} inside the gzip stream, "
             "expected 0x{:08x} (\"NGSP\")",
-            filename, LoadU32(bytes.data()), kMagic);
+            filename, LoadU32(head.data()), kMagic);
     }
     Header h;
-    h.version = LoadU32(bytes.data() + 4);
-    h.num_points = LoadU32(bytes.data() + 8);
-    h.sh_degree = bytes[12];
-    h.fractional_bits = bytes[13];
-    h.flags = bytes[14];
+    h.version = LoadU32(head.data() + 4);
+    h.num_points = LoadU32(head.data() + 8);
+    h.sh_degree = head[12];
+    h.fractional_bits = head[13];
+    h.flags = head[14];
     if (h.version < 1 || h.version > 3) {
         core::ThrowError(
             "'{}': SPZ header field 'version' is {} in a gzip stream; gzip holds "
@@ -210,6 +222,22 @@ geometry::PointCloud ReadLegacy(const std::string& filename, const uint8_t* file
             filename, h.version);
     }
     CheckHeader(filename, h);
+    uint64_t attribute_bytes = 0;
+    for (int k = 0; k < kNumStreams; ++k) attribute_bytes += h.StreamBytes(k);
+    CheckDecodeMemory(filename, h, kLegacyHeaderBytes + attribute_bytes);
+    // Extensions follow the attributes inside the stream; more than kMaxLegacyTailBytes
+    // after them is not read (a warning says so).
+    const uint64_t wanted =
+        std::min<uint64_t>(kLegacyHeaderBytes + attribute_bytes + kMaxLegacyTailBytes,
+                           uint64_t(size) * kDeflateMaxExpansion + 1024);
+    const std::vector<uint8_t> bytes = GunzipPrefixBytes(
+        file, size, size_t(wanted), &more, fmt::format("'{}': SPZ gzip stream", filename));
+    if (more) {
+        core::LogWarning(
+            "'{}': the gzip stream goes on past {} bytes after the SPZ attributes; "
+            "the rest is not read",
+            filename, kMaxLegacyTailBytes);
+    }
     uint64_t offset = kLegacyHeaderBytes, per_splat = 0;
     for (int k = 0; k < kNumStreams; ++k) {
         offset += h.StreamBytes(k);
@@ -316,6 +344,9 @@ geometry::PointCloud ReadV4(const std::string& filename, const uint8_t* file, si
                          size - offset);
         report.trailing_bytes = int64_t(size - offset);
     }
+    uint64_t decoded_bytes = 0;
+    for (int s = 0; s < num_streams; ++s) decoded_bytes += h.StreamBytes(present[s]);
+    CheckDecodeMemory(filename, h, decoded_bytes);
     std::array<std::vector<uint8_t>, kNumStreams> decoded;
     std::array<const uint8_t*, kNumStreams> streams{};
     for (int s = 0; s < num_streams; ++s) {
