@@ -28,27 +28,26 @@ namespace io {
 using geometry::NumSHRestCoeffs;
 
 void CheckSplatColumnsMemory(const std::string& filename, int64_t n, bool gaussian, int degree,
-                             uint64_t extra_bytes, const std::string& extra_what) {
+                             uint64_t extra_per_splat, const std::string& extra_what) {
     // Checked before the first byte is taken: a 1e8-splat file once grew past 18 GB of
     // resident memory before the kernel killed the process.
-    const uint64_t per_point =
+    const uint64_t columns_per_point =
         sizeof(float) * (gaussian ? 3 + 3 + 4 + 1 + 3 + 3 * NumSHRestCoeffs(degree) : 3);
+    const uint64_t per_point = columns_per_point + extra_per_splat;
     const uint64_t available = core::AvailableHostMemory();
-    const uint64_t room = available > extra_bytes ? available - extra_bytes : 0;
-    if (uint64_t(n) > room / per_point) {
+    if (uint64_t(n) > available / per_point) {
         const std::string what =
-            extra_bytes == 0 ? fmt::format("'{}': {} splats of SH degree {}", filename, n, degree)
-                             : fmt::format("'{}': {} splats of SH degree {} and {}", filename, n,
-                                           degree, extra_what);
-        const uint64_t needed = uint64_t(n) > (UINT64_MAX - extra_bytes) / per_point
-                                    ? UINT64_MAX
-                                    : uint64_t(n) * per_point + extra_bytes;
+            extra_per_splat == 0
+                ? fmt::format("'{}': {} splats of SH degree {}", filename, n, degree)
+                : fmt::format("'{}': {} splats of SH degree {} and {} {}", filename, n, degree,
+                              uint64_t(n) * extra_per_splat, extra_what);
+        const uint64_t sh0_per_point = sizeof(float) * 14 + extra_per_splat;
         core::RequireHostMemory(
-            needed, what,
+            uint64_t(n) * per_point, what,
             degree > 0 && gaussian
                 ? fmt::format("at most {} splats of this degree fit ({} of SH degree 0)",
-                              room / per_point, room / (sizeof(float) * 14))
-                : fmt::format("at most {} splats fit", room / per_point));
+                              available / per_point, available / sh0_per_point)
+                : fmt::format("at most {} splats fit", available / per_point));
     }
 }
 

@@ -15,11 +15,11 @@ namespace t {
 namespace io {
 
 /// Throws (core::RequireHostMemory) unless n splats of the given kind fit in host memory
-/// beside `extra_bytes` more (e.g. decoded streams a reader holds while it fills them; named
-/// by `extra_what`). SplatColumns::Allocate checks with extra 0; a reader of a compressed
-/// format calls it before decompressing.
+/// with `extra_per_splat` more bytes each (e.g. the decoded streams a reader holds while it
+/// fills the columns; named by `extra_what`). SplatColumns::Allocate checks with 0; a reader
+/// of a compressed format calls it before decompressing. n is at most 2^32 here.
 void CheckSplatColumnsMemory(const std::string& filename, int64_t n, bool gaussian, int degree,
-                             uint64_t extra_bytes, const std::string& extra_what);
+                             uint64_t extra_per_splat, const std::string& extra_what);
 
 struct SplatColumns {
     int64_t num_points = 0;

@@ -166,13 +166,15 @@ geometry::PointCloud DecodeSplats(const std::string& filename, const Header& h,
     return FinalizeColumns(filename, c, options, report);
 }
 
-// The decoded cloud and the `decoded_bytes` of decompressed streams held while it is filled
+// The decoded cloud and the decompressed streams held while it is filled
 // must fit before anything is decompressed: a 61 KB file of RLE zstd frames claiming 1e8
 // splats was refused only after 11 s of decoding at 2 GB.
-void CheckDecodeMemory(const std::string& filename, const Header& h, uint64_t decoded_bytes) {
+void CheckDecodeMemory(const std::string& filename, const Header& h) {
+    uint64_t stream_bytes_per_splat = 0;
+    for (int k = 0; k < kNumStreams; ++k) stream_bytes_per_splat += h.BytesPerSplat(k);
     CheckSplatColumnsMemory(filename, int64_t(h.num_points), /*gaussian=*/true,
-                            std::min(h.sh_degree, kMaxCloudSHDegree), decoded_bytes,
-                            fmt::format("{} decompressed bytes", decoded_bytes));
+                            std::min(h.sh_degree, kMaxCloudSHDegree), stream_bytes_per_splat,
+                            "bytes of decompressed streams");
 }
 
 void CheckHeader(const std::string& filename, const Header& h) {
@@ -224,7 +226,7 @@ geometry::PointCloud ReadLegacy(const std::string& filename, const uint8_t* file
     CheckHeader(filename, h);
     uint64_t attribute_bytes = 0;
     for (int k = 0; k < kNumStreams; ++k) attribute_bytes += h.StreamBytes(k);
-    CheckDecodeMemory(filename, h, kLegacyHeaderBytes + attribute_bytes);
+    CheckDecodeMemory(filename, h);
     // Extensions follow the attributes inside the stream; more than kMaxLegacyTailBytes
     // after them is not read (a warning says so).
     const uint64_t wanted =
@@ -344,9 +346,7 @@ geometry::PointCloud ReadV4(const std::string& filename, const uint8_t* file, si
                          size - offset);
         report.trailing_bytes = int64_t(size - offset);
     }
-    uint64_t decoded_bytes = 0;
-    for (int s = 0; s < num_streams; ++s) decoded_bytes += h.StreamBytes(present[s]);
-    CheckDecodeMemory(filename, h, decoded_bytes);
+    CheckDecodeMemory(filename, h);
     std::array<std::vector<uint8_t>, kNumStreams> decoded;
     std::array<const uint8_t*, kNumStreams> streams{};
     for (int s = 0; s < num_streams; ++s) {
