@@ -307,6 +307,33 @@ TEST(PlyReader, TrailingBytesLoadWithWarning) {
     EXPECT_EQ(cloud.NumPoints(), 2);
 }
 
+TEST(PlyReader, SecondVertexElementIsRefused) {
+    // The reader took the last 'vertex' element: 0 splats, a black image, exit status 0.
+    const std::string path = tests::TempDir() + "/two_vertex.ply";
+    WriteText(path,
+              "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\n"
+              "property float z\nelement vertex 0\nproperty float x\nproperty float y\n"
+              "property float z\nend_header\n1 2 3\n");
+    ExpectReadError(path, {path, "line 7", "element 'vertex' declared twice"});
+}
+
+TEST(PlyReader, HugeCountAfterTheVerticesDoesNotOverflow) {
+    // 2^62 rows of 4 bytes after the vertices: the declared size overflowed int64 (UBSan;
+    // the fuzz seed count_2pow62_after_vertex.ply is this file). The vertices read, and
+    // nothing is reported as trailing: the declared rows would cover any file.
+    const std::string path = tests::TempDir() + "/huge_after.ply";
+    std::string bytes =
+        "ply\nformat binary_little_endian 1.0\nelement vertex 1\nproperty float x\n"
+        "property float y\nproperty float z\nelement face 4611686018427387904\n"
+        "property float w\nend_header\n";
+    bytes += std::string(12 + 8, '\0');
+    WriteText(path, bytes);
+    PointCloud cloud;
+    const auto report = ReadPointCloud(path, cloud);
+    EXPECT_EQ(cloud.NumPoints(), 1);
+    EXPECT_EQ(report.trailing_bytes, 0);
+}
+
 }  // namespace
 }  // namespace io
 }  // namespace t

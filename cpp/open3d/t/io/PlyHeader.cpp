@@ -150,6 +150,11 @@ PlyHeader ParsePlyHeader(const std::string& filename, const uint8_t* bytes, size
                 fail("element needs a name and a non-negative count");
             }
             element.count = value;
+            // A second 'vertex' made the reader take the last one (0 splats, rc 0).
+            for (const PlyElement& earlier : header.elements) {
+                if (earlier.name == element.name)
+                    fail("element '" + element.name + "' declared twice");
+            }
             header.elements.push_back(element);
         } else if (keyword == "property") {
             if (header.elements.empty()) fail("property before any element");

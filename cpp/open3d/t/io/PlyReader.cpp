@@ -6,6 +6,7 @@
 #include <charconv>
 #include <cstdlib>
 #include <cstring>
+#include <limits>
 
 #include "open3d/core/Exception.h"
 #include "open3d/core/Logging.h"
@@ -295,15 +296,24 @@ geometry::PointCloud ReadPly(const std::string& filename, const ReadPointCloudOp
     int64_t declared_after = 0;
     for (size_t e = vertex_index + 1; e < header.elements.size(); ++e) {
         later_sizes_known = later_sizes_known && !header.elements[e].HasList();
-        declared_after += header.elements[e].count * header.elements[e].RowSize();
+        // Counts come from the file (2^62 overflowed here): past the file's size, the
+        // declared bytes only say that nothing trails.
+        int64_t element_bytes = 0;
+        if (__builtin_mul_overflow(header.elements[e].count, int64_t(header.elements[e].RowSize()),
+                                   &element_bytes) ||
+            __builtin_add_overflow(declared_after, element_bytes, &declared_after)) {
+            declared_after = std::numeric_limits<int64_t>::max();
+        }
     }
     if (ascii && vertex_index + 1 == static_cast<int>(header.elements.size())) {
         std::string_view token;
         const char* rest = cursor.pos;
         if (cursor.Next(token)) report.trailing_bytes = cursor.end - rest;
     } else if (later_sizes_known) {
-        report.trailing_bytes =
-            std::max<int64_t>(0, available - vertex.count * vertex.RowSize() - declared_after);
+        const int64_t vertex_bytes = vertex.count * int64_t(vertex.RowSize());  // <= available
+        report.trailing_bytes = declared_after >= available - vertex_bytes
+                                    ? 0
+                                    : available - vertex_bytes - declared_after;
     }
     if (report.trailing_bytes > 0) {
         core::LogWarning("'{}': ignoring {} bytes after the {} declared vertices", filename,
