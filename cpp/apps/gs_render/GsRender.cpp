@@ -186,7 +186,7 @@ std::optional<camera::PinholeCamera> ReadChosenView(const Options& opt) {
     if (opt.cameras.empty()) return std::nullopt;
     const auto views = camera::ReadCamerasJson(opt.cameras);
     if (opt.view < 0 || opt.view >= static_cast<int>(views.size())) {
-        core::ThrowError("bad view index {}: '{}' has {} views (0..{})", opt.view, opt.cameras,
+        core::ThrowError("--view {}: '{}' has {} views (0..{})", opt.view, opt.cameras,
                          views.size(), static_cast<int>(views.size()) - 1);
     }
     return views[opt.view].camera;
