@@ -687,6 +687,12 @@ int Run(const Options& opt) {
         t::geometry::SplatHierarchy hierarchy;
         double hierarchy_ms = 0.0;
         if (!budgets.empty() || !opt.stream.empty()) {
+            // The level-of-detail rows upload every node: refused before the build, which
+            // takes minutes at 1e8 splats, when even the leaves cannot fit.
+            if (vulkan != nullptr && !budgets.empty()) {
+                vulkan->CheckHierarchyFits(job.cloud.NumPoints(),
+                                           job.cloud.GetGaussianSplatArrays().sh_degree);
+            }
             const auto start = std::chrono::steady_clock::now();
             hierarchy = t::geometry::BuildSplatHierarchy(job.cloud);
             hierarchy_ms = core::MillisecondsSince(start);

@@ -24,8 +24,23 @@ void DeviceMemoryCharge::Release() {
     bytes_ = 0;
 }
 
+VkDeviceSize DeviceMemoryBudget::Room(uint32_t heap, const char** source) const {
+    if (const std::optional<uint64_t> limit = LimitFromEnvironment()) {
+        *source = "OPEN3D_DEVICE_MEMORY_LIMIT";
+        return *limit;
+    }
+    const VkDeviceSize size = properties_.memoryHeaps[heap].size;
+    if (have_reported_budgets_ && reported_budgets_[heap] > 0 && reported_budgets_[heap] < size) {
+        *source = "the device's memory budget";
+        return reported_budgets_[heap];
+    }
+    *source = "the device's report";
+    return size;
+}
+
 VkDeviceSize DeviceMemoryBudget::Available(uint32_t heap) const {
-    const VkDeviceSize size = LimitFromEnvironment().value_or(properties_.memoryHeaps[heap].size);
+    const char* source = nullptr;
+    const VkDeviceSize size = Room(heap, &source);
     const VkDeviceSize used = used_[heap].load();
     return size > used ? size - used : 0;
 }
@@ -35,14 +50,13 @@ DeviceMemoryCharge DeviceMemoryBudget::Charge(uint32_t memory_type, VkDeviceSize
     const uint32_t heap = HeapOf(memory_type);
     const VkDeviceSize available = Available(heap);
     if (bytes > available) {
-        const std::optional<uint64_t> limit = LimitFromEnvironment();
+        const char* source = nullptr;
+        const VkDeviceSize room = Room(heap, &source);
         core::ThrowError(
             "Vulkan: {} needs {} of device memory, {} is free (heap {}: {} by {}; this "
             "process holds {})",
             what, core::FormatBytes(bytes), core::FormatBytes(available), heap,
-            core::FormatBytes(limit.value_or(properties_.memoryHeaps[heap].size)),
-            limit ? "OPEN3D_DEVICE_MEMORY_LIMIT" : "the device's report",
-            core::FormatBytes(used_[heap].load()));
+            core::FormatBytes(room), source, core::FormatBytes(used_[heap].load()));
     }
     used_[heap] += bytes;
     return DeviceMemoryCharge(this, heap, bytes);

@@ -4,8 +4,9 @@
 // 2 GiB heap and does not enforce it). Each heap's room is its size, or
 // OPEN3D_DEVICE_MEMORY_LIMIT (bytes) where set: lower, for tests and to leave room to other
 // programs; higher, to use more of the system memory a CPU device such as lavapipe
-// allocates from. Less what this context's Buffers and Images hold. Other processes' use is
-// not seen: no budget extension is queried.
+// allocates from. Where the device reports VK_EXT_memory_budget, at most its heapBudget at
+// context creation (memory other processes and the driver hold is then out of the room).
+// Less what this context's Buffers and Images hold.
 #pragma once
 
 #include <vulkan/vulkan.h>
@@ -53,7 +54,14 @@ private:
 
 class DeviceMemoryBudget {
 public:
-    void Init(const VkPhysicalDeviceMemoryProperties& properties) { properties_ = properties; }
+    /// `budgets`: VK_EXT_memory_budget's heapBudget at context creation where the device
+    /// reports one (what this process may allocate of each heap), else null.
+    void Init(const VkPhysicalDeviceMemoryProperties& properties,
+              const std::array<VkDeviceSize, VK_MAX_MEMORY_HEAPS>* budgets = nullptr) {
+        properties_ = properties;
+        if (budgets != nullptr) reported_budgets_ = *budgets;
+        have_reported_budgets_ = budgets != nullptr;
+    }
     /// Bytes of `heap` still free to this context.
     VkDeviceSize Available(uint32_t heap) const;
     uint32_t HeapOf(uint32_t memory_type) const {
@@ -67,7 +75,13 @@ public:
 
 private:
     friend class DeviceMemoryCharge;
+    /// The room of `heap` before this context's charges: its size, the device's budget
+    /// where it reports one (the lower), or OPEN3D_DEVICE_MEMORY_LIMIT where set.
+    VkDeviceSize Room(uint32_t heap, const char** source) const;
+
     VkPhysicalDeviceMemoryProperties properties_{};
+    std::array<VkDeviceSize, VK_MAX_MEMORY_HEAPS> reported_budgets_{};
+    bool have_reported_budgets_ = false;
     mutable std::array<std::atomic<VkDeviceSize>, VK_MAX_MEMORY_HEAPS> used_{};
 };
 

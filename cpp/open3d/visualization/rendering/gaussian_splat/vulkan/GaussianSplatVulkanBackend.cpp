@@ -287,38 +287,6 @@ void GaussianSplatVulkanBackend::EnsureViewBuffers(uint32_t entry_capacity) {
                                 VK_BUFFER_USAGE_TRANSFER_DST_BIT, MemoryUsage::kHostReadback);
 }
 
-void GaussianSplatVulkanBackend::CheckViewFits(uint32_t width, uint32_t height) const {
-    if (color_ && depth_ && width == width_ && height == height_) return;
-    // Per pixel: the depth, alpha and median targets (4 bytes each), the RGBA32F colour
-    // image and its readback (16 each), the depth and median readbacks (4 each), and the
-    // composite's state. All are counted in the device-local heap: on a discrete GPU the
-    // readbacks live in host memory, so this errs on the side of refusing.
-    const uint64_t pixels = uint64_t(width) * height;
-    const uint64_t need =
-        pixels * (3 * 4 + 16 + 16 + 4 + 4) + GaussianCompositeStage::StateBytes(width, height);
-    const DeviceMemoryBudget& budget = context_->GetMemoryBudget();
-    const uint32_t heap =
-        budget.HeapOf(context_->FindMemoryType(~0u, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT));
-    // The images of the current size go when the new ones come.
-    uint64_t held = composite_state_ ? composite_state_.GetSize() : 0;
-    for (const Image* image : {&depth_, &alpha_, &median_, &color_}) {
-        held += *image ? image->GetAllocationSize() : 0;
-    }
-    for (const Buffer* buffer : {&color_readback_, &depth_readback_, &median_readback_}) {
-        held += *buffer ? buffer->GetSize() : 0;
-    }
-    const uint64_t available = budget.Available(heap) + held;
-    if (need <= available) return;
-    // The suggestion leaves a third of the room to the geometry stage's tile and entry
-    // buffers, which grow with the image too (sqrt(2/3) of each side).
-    const double scale = std::sqrt(double(available) / double(need) * 2.0 / 3.0);
-    core::ThrowError(
-        "Vulkan backend: a {}x{} view needs {} of device memory for its images, {} is free; "
-        "{}x{} would fit (or render with the cpu backend)",
-        width, height, core::FormatBytes(need), core::FormatBytes(available),
-        std::max(1, int(width * scale)), std::max(1, int(height * scale)));
-}
-
 void GaussianSplatVulkanBackend::EnsureTargets(uint32_t width, uint32_t height) {
     if (depth_ && width == width_ && height == height_) return;
     const CompositeStageStorageRequirements need = GaussianCompositeStage::GetStorageRequirements();

@@ -1,6 +1,7 @@
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/VulkanContext.h"
 
 #include <algorithm>
+#include <array>
 #include <cstdlib>
 #include <cstring>
 #include <iterator>
@@ -416,7 +417,26 @@ void VulkanContext::InitDevice(VkPhysicalDevice physical_device, uint32_t queue_
         }
     }
     vkGetPhysicalDeviceMemoryProperties(physical_device, &memory_properties_);
-    memory_budget_.Init(memory_properties_);
+    // Where the device reports a budget (VK_EXT_memory_budget: NVIDIA, AMD; a physical-device
+    // query, usable when the extension is supported), a heap's room is at most that budget:
+    // the heap size counts memory the driver and other processes hold, and allocations
+    // within it failed in the driver (VK_ERROR_OUT_OF_DEVICE_MEMORY) instead of being refused.
+    std::array<VkDeviceSize, VK_MAX_MEMORY_HEAPS> heap_budgets{};
+    bool have_budgets = false;
+    if (query.HasExtension(VK_EXT_MEMORY_BUDGET_EXTENSION_NAME)) {
+        VkPhysicalDeviceMemoryBudgetPropertiesEXT budget_properties =
+            MakeInfo<VkPhysicalDeviceMemoryBudgetPropertiesEXT>(
+                VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MEMORY_BUDGET_PROPERTIES_EXT);
+        VkPhysicalDeviceMemoryProperties2 properties2 = MakeInfo<VkPhysicalDeviceMemoryProperties2>(
+            VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MEMORY_PROPERTIES_2);
+        properties2.pNext = &budget_properties;
+        vkGetPhysicalDeviceMemoryProperties2(physical_device, &properties2);
+        for (uint32_t h = 0; h < memory_properties_.memoryHeapCount; ++h) {
+            heap_budgets[h] = budget_properties.heapBudget[h];
+        }
+        have_budgets = true;
+    }
+    memory_budget_.Init(memory_properties_, have_budgets ? &heap_budgets : nullptr);
 
     const VkPhysicalDeviceProperties& properties = query.properties.properties;
     info_.name = properties.deviceName;
