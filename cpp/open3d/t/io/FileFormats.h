@@ -2,6 +2,8 @@
 #pragma once
 
 #include <cmath>
+#include <cstddef>
+#include <cstdint>
 #include <string>
 
 #include "open3d/t/geometry/PointCloud.h"
@@ -28,6 +30,19 @@ void WriteSplat(const std::string& filename, const geometry::PointCloud& cloud);
 geometry::PointCloud ReadSpz(const std::string& filename, const ReadPointCloudOptions& options,
                              ReadPointCloudReport& report);
 void WriteSpz(const std::string& filename, const geometry::PointCloud& cloud);
+
+struct SplatColumns;
+/// The axes DecodeSpz hands out: converted from the stored convention (RUB, or what
+/// SPZ_ADOBE_coordinate_system names) to RDF, as a .spz file is read; or as stored, as
+/// glTF's KHR_spz_gaussian_splats_compression takes them (GltfSpz.cpp says why).
+enum class SpzAxes { kToRdf, kAsStored };
+/// Decodes a whole SPZ held in memory (v1-3 gzip or v4, every check ReadSpz makes) into
+/// `columns`, not yet finalised (FinalizeColumns). `label` opens every error and warning
+/// (the quoted file name, or the file and the glTF object holding the SPZ); `filename`
+/// names the file in the memory check.
+void DecodeSpz(const uint8_t* data, size_t size, const std::string& filename,
+               const std::string& label, SpzAxes axes, SplatColumns& columns,
+               ReadPointCloudReport& report);
 
 /// PlayCanvas compressed PLY (`element chunk` bounds + packed vertices, optional `sh`).
 /// CompressedPlyReader.cpp, CompressedPlyWriter.cpp.

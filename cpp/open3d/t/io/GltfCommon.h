@@ -15,6 +15,9 @@ namespace gltf {
 
 inline constexpr const char* kExtension = "KHR_gaussian_splatting";
 inline constexpr const char* kAttributePrefix = "KHR_gaussian_splatting:";
+/// The draft that stores a primitive's splats as one SPZ blob (CesiumGS/glTF branch
+/// draft-spz-splat-compression; read by GltfSpz.cpp).
+inline constexpr const char* kSpzExtension = "KHR_spz_gaussian_splats_compression";
 
 inline constexpr uint32_t kGlbMagic = 0x46546C67;   // "glTF"
 inline constexpr uint32_t kChunkJson = 0x4E4F534A;  // "JSON"

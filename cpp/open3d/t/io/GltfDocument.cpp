@@ -190,9 +190,9 @@ void GltfDocument::CheckAssetAndExtensions() {
     for (const Json& name : *required) {
         const std::string s = name.is_string() ? name.get<std::string>() : BriefJson(name);
         // Material and texture extensions do not touch splat data; quantised positions are
-        // decoded like every normalised accessor.
-        if (s == kExtension || s == "KHR_mesh_quantization" || s.rfind("KHR_materials_", 0) == 0 ||
-            s.rfind("KHR_texture_", 0) == 0) {
+        // decoded like every normalised accessor; SPZ-compressed splats are decoded.
+        if (s == kExtension || s == kSpzExtension || s == "KHR_mesh_quantization" ||
+            s.rfind("KHR_materials_", 0) == 0 || s.rfind("KHR_texture_", 0) == 0) {
             continue;
         }
         Fail("requires the extension {}, which this reader does not implement{}", s.substr(0, 80),

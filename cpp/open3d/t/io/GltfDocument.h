@@ -72,6 +72,11 @@ public:
     /// then means zeros). `attribute` names it in errors.
     std::vector<float> DecodeAccessor(uint64_t index, const std::string& attribute, int components,
                                       const std::vector<Allowed>& allowed, int64_t expected_count);
+    /// The bytes of bufferViews[index], checked against its buffer; `where` names the
+    /// object that refers to it.
+    Span BufferView(uint64_t index, const std::string& where) {
+        return View(index, where, nullptr);
+    }
 
 private:
     void ParseGlb(ReadPointCloudReport& report);

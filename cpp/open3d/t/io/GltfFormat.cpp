@@ -26,6 +26,8 @@
 //   node transform the change is sign flips only, exact. Under a non-uniform scale the
 //   covariance L Sigma L^T is diagonalised again (rotation, scale) and the SH follow the
 //   rotation component, as the spec says.
+// - Primitives compressed with the draft KHR_spz_gaussian_splats_compression (with or without
+//   KHR_gaussian_splatting beside it): GltfSpz.cpp, then placed as above.
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
@@ -42,6 +44,7 @@
 #include "open3d/t/io/FileFormats.h"
 #include "open3d/t/io/GltfCommon.h"
 #include "open3d/t/io/GltfDocument.h"
+#include "open3d/t/io/GltfPrimitive.h"
 #include "open3d/t/io/SplatColumns.h"
 
 namespace open3d {
@@ -54,18 +57,6 @@ using namespace gltf;
 // A node matrix is decomposable (rotation times positive scale) within this error, and its
 // scale uniform within this relative error.
 constexpr double kDecomposeTolerance = 1e-6;
-
-// One splat primitive: first in its node's glTF frame, then (Place) in the RDF world frame.
-struct PrimitiveData {
-    int64_t n = 0;
-    int degree = 0;
-    std::vector<float> positions;  // [n, 3]
-    std::vector<float> rot;        // [n, 4] (w, x, y, z)
-    std::vector<float> scale;      // [n, 3] linear
-    std::vector<float> opacity;    // [n] logit
-    std::vector<float> f_dc;       // [n, 3]
-    std::vector<float> f_rest;     // [n, Nc, 3]
-};
 
 struct Instance {
     int64_t node = -1;  // -1: a mesh read without a scene graph
@@ -93,7 +84,8 @@ private:
 
     std::vector<Instance> FindInstances();
     Eigen::Matrix4d LocalMatrix(const Json& node, uint64_t index) const;
-    bool ReadPrimitive(const Json& primitive, const std::string& where, PrimitiveData& out);
+    bool ReadPrimitive(const Json& primitive, const std::string& where, PrimitiveData& out,
+                       ReadPointCloudReport& report);
     void Place(PrimitiveData& d, const Eigen::Matrix4d& global, const std::string& where) const;
 
     GltfDocument doc_;
@@ -196,9 +188,15 @@ std::vector<Instance> SceneReader::FindInstances() {
     return out;
 }
 
-// Reads one primitive that carries the extension; false for any other primitive.
-bool SceneReader::ReadPrimitive(const Json& primitive, const std::string& where, PrimitiveData& d) {
+// Reads one primitive that carries either extension; false for any other primitive.
+bool SceneReader::ReadPrimitive(const Json& primitive, const std::string& where, PrimitiveData& d,
+                                ReadPointCloudReport& report) {
     const Json* extensions = Find(primitive, "extensions");
+    // The SPZ holds every value, whatever KHR_gaussian_splatting beside it says.
+    if (const Json* spz = extensions != nullptr ? Find(*extensions, kSpzExtension) : nullptr) {
+        ReadSpzPrimitive(doc_, primitive, *spz, where, d, report);
+        return true;
+    }
     const Json* ext = extensions != nullptr ? Find(*extensions, kExtension) : nullptr;
     if (ext == nullptr) return false;
     if (!ext->is_object()) Fail("{}: {} is not an object", where, kExtension);
@@ -454,7 +452,7 @@ geometry::PointCloud SceneReader::Read(const ReadPointCloudOptions& options,
         for (size_t k = 0; k < primitives->size(); ++k) {
             const std::string where = fmt::format("{} primitive {}", mesh_where, k);
             PrimitiveData d;
-            if (!ReadPrimitive((*primitives)[k], where, d)) {
+            if (!ReadPrimitive((*primitives)[k], where, d, report)) {
                 ++ignored;
                 continue;
             }
@@ -472,13 +470,13 @@ geometry::PointCloud SceneReader::Read(const ReadPointCloudOptions& options,
     }
     if (parts.empty()) {
         Fail(
-            "no mesh primitive of the scene has the {} extension (a plain glTF mesh or point "
-            "cloud is not a Gaussian splat file)",
-            kExtension);
+            "no mesh primitive of the scene has the {} or {} extension (a plain glTF mesh or "
+            "point cloud is not a Gaussian splat file)",
+            kExtension, kSpzExtension);
     }
     if (ignored > 0) {
-        core::LogWarning("'{}': {} mesh primitives without {} are ignored", doc_.Filename(),
-                         ignored, kExtension);
+        core::LogWarning("'{}': {} mesh primitives without {} or {} are ignored", doc_.Filename(),
+                         ignored, kExtension, kSpzExtension);
     }
     SplatColumns columns;
     columns.Allocate(doc_.Filename(), total, /*gaussian=*/true, degree);

@@ -22,50 +22,64 @@ namespace {
 
 using namespace spz;
 
+// What is decoded: `filename` for the memory check, `label` opens every message (the quoted
+// file name, or a glTF file and the JSON path of its SPZ), and whether the axes are handed out
+// as stored or converted to RDF.
+struct Source {
+    const std::string& filename;
+    std::string label;
+    SpzAxes axes;
+};
+
 /// Walks the extension records [u32 type][u32 length][payload] and returns the stored
 /// coordinate system (RUB unless SPZ_ADOBE_coordinate_system says otherwise).
-uint32_t ParseExtensions(const std::string& filename, const uint8_t* data, size_t size,
-                         const char* where) {
+uint32_t ParseExtensions(const Source& src, const uint8_t* data, size_t size, const char* where) {
     uint32_t stored = kCoordinateRUB;
     size_t offset = 0;
     while (offset < size) {
         if (size - offset < 8) {
             core::ThrowError(
-                "'{}': SPZ extension record at byte {} of the {} is truncated ({} of 8 "
+                "{}: SPZ extension record at byte {} of the {} is truncated ({} of 8 "
                 "header bytes)",
-                filename, offset, where, size - offset);
+                src.label, offset, where, size - offset);
         }
         const uint32_t type = LoadU32(data + offset);
         const uint32_t length = LoadU32(data + offset + 4);
         offset += 8;
         if (length > size - offset) {
             core::ThrowError(
-                "'{}': SPZ extension record 0x{:08x}: byteLength {} passes the end of "
+                "{}: SPZ extension record 0x{:08x}: byteLength {} passes the end of "
                 "the {} ({} bytes left)",
-                filename, type, length, where, size - offset);
+                src.label, type, length, where, size - offset);
         }
         if (type == kExtensionCoordinateSystem) {
             const uint32_t value = length >= 4 ? LoadU32(data + offset) : 0;
             if (length != 4 || value > 16) {
                 core::ThrowError(
-                    "'{}': SPZ_ADOBE_coordinate_system extension: payload of {} "
+                    "{}: SPZ_ADOBE_coordinate_system extension: payload of {} "
                     "bytes / value {} (expected 4 bytes holding 0..16)",
-                    filename, length, value);
+                    src.label, length, value);
             }
-            if (value == 0) {
-                core::LogWarning("'{}': SPZ_ADOBE_coordinate_system is UNSPECIFIED; assuming RUB",
-                                 filename);
+            if (src.axes == SpzAxes::kAsStored) {
+                // glTF takes the values as stored (FileFormats.h); the record changes nothing.
+                core::LogWarning(
+                    "{}: SPZ_ADOBE_coordinate_system value {} ignored: the values are read as "
+                    "stored",
+                    src.label, value);
+            } else if (value == 0) {
+                core::LogWarning("{}: SPZ_ADOBE_coordinate_system is UNSPECIFIED; assuming RUB",
+                                 src.label);
             } else if (value > 8) {
                 core::ThrowError(
-                    "'{}': SPZ_ADOBE_coordinate_system value {} is an axis order "
+                    "{}: SPZ_ADOBE_coordinate_system value {} is an axis order "
                     "rotated 90 degrees about x; only the axis-flip family (1..8) "
                     "is supported",
-                    filename, value);
+                    src.label, value);
             } else {
                 stored = value;
             }
         } else {
-            core::LogWarning("'{}': skipped unknown SPZ extension 0x{:08x} ({} bytes)", filename,
+            core::LogWarning("{}: skipped unknown SPZ extension 0x{:08x} ({} bytes)", src.label,
                              type, length);
         }
         offset += length;
@@ -88,29 +102,29 @@ float HalfToFloat(uint16_t h) {
 }
 
 /// Decodes the six attribute arrays (`streams[k]` holds StreamBytes(k) bytes) into the
-/// columns, applying the axis change, and hands them to FinalizeColumns.
-geometry::PointCloud DecodeSplats(const std::string& filename, const Header& h,
-                                  const std::array<const uint8_t*, kNumStreams>& streams,
-                                  const AxisFlips& flips, const ReadPointCloudOptions& options,
-                                  ReadPointCloudReport& report) {
+/// columns, applying the axis change from the `stored` convention unless kept as stored.
+void DecodeSplats(const Source& src, const Header& h,
+                  const std::array<const uint8_t*, kNumStreams>& streams, uint32_t stored,
+                  SplatColumns& c) {
+    const AxisFlips flips =
+        src.axes == SpzAxes::kAsStored ? AxisFlips({1, 1, 1}) : FlipsToRDF(stored);
     if (h.flags & kFlagAntialiased) {
         core::LogWarning(
-            "'{}': SPZ flag 'antialiased' is set (trained with mip-splatting antialiasing): "
+            "{}: SPZ flag 'antialiased' is set (trained with mip-splatting antialiasing): "
             "render it with antialiasing on",
-            filename);
+            src.label);
     }
     const int degree = std::min(h.sh_degree, kMaxCloudSHDegree);
     if (h.sh_degree > kMaxCloudSHDegree) {
         core::LogWarning(
-            "'{}': SH degree {} holds more than the 3 bands a cloud can; band 4 "
+            "{}: SH degree {} holds more than the 3 bands a cloud can; band 4 "
             "is dropped",
-            filename, h.sh_degree);
+            src.label, h.sh_degree);
     }
     const int64_t n = h.num_points;
     const int nc = geometry::NumSHRestCoeffs(degree),
               file_nc = geometry::NumSHRestCoeffs(h.sh_degree);
-    SplatColumns c;
-    c.Allocate(filename, n, /*gaussian=*/true, degree);
+    c.Allocate(src.filename, n, /*gaussian=*/true, degree);
     float* positions = c.positions.Data<float>();
     float* scale = c.scale.Data<float>();
     float* rot = c.rot.Data<float>();
@@ -163,53 +177,51 @@ geometry::PointCloud DecodeSplats(const std::string& filename, const Header& h,
             }
         },
         4096);
-    return FinalizeColumns(filename, c, options, report);
 }
 
 // The decoded cloud and the decompressed streams held while it is filled
 // must fit before anything is decompressed: a 61 KB file of RLE zstd frames claiming 1e8
 // splats was refused only after 11 s of decoding at 2 GB.
-void CheckDecodeMemory(const std::string& filename, const Header& h) {
+void CheckDecodeMemory(const Source& src, const Header& h) {
     uint64_t stream_bytes_per_splat = 0;
     for (int k = 0; k < kNumStreams; ++k) stream_bytes_per_splat += h.BytesPerSplat(k);
-    CheckSplatColumnsMemory(filename, int64_t(h.num_points), /*gaussian=*/true,
+    CheckSplatColumnsMemory(src.filename, int64_t(h.num_points), /*gaussian=*/true,
                             std::min(h.sh_degree, kMaxCloudSHDegree), stream_bytes_per_splat,
                             "bytes of decompressed streams");
 }
 
-void CheckHeader(const std::string& filename, const Header& h) {
+void CheckHeader(const Source& src, const Header& h) {
     if (h.sh_degree > kMaxFileSHDegree) {
-        core::ThrowError("'{}': SPZ header field 'shDegree' is {}; SPZ defines 0..4", filename,
+        core::ThrowError("{}: SPZ header field 'shDegree' is {}; SPZ defines 0..4", src.label,
                          h.sh_degree);
     }
     // Positions are 24-bit fixed point over 2^fractionalBits; the reference reader divides by
     // (1 << fractionalBits) in a 32-bit int, so 31 and more are no scale it can read (40
     // would put every splat at the origin).
     if (h.fractional_bits > 30) {
-        core::ThrowError("'{}': SPZ header field 'fractionalBits' is {}; SPZ positions take 0..30",
-                         filename, h.fractional_bits);
+        core::ThrowError("{}: SPZ header field 'fractionalBits' is {}; SPZ positions take 0..30",
+                         src.label, h.fractional_bits);
     }
 }
 
-geometry::PointCloud ReadLegacy(const std::string& filename, const uint8_t* file, size_t size,
-                                const ReadPointCloudOptions& options,
-                                ReadPointCloudReport& report) {
+void ReadLegacy(const Source& src, const uint8_t* file, size_t size, SplatColumns& columns,
+                ReadPointCloudReport& report) {
     // The header first, alone: numPoints bounds what the rest may inflate to, and the memory
     // check runs before that (a 2 MB gzip bomb named .spz once inflated 2 GiB first).
     bool more = false;
     const std::vector<uint8_t> head = GunzipPrefixBytes(
-        file, size, kLegacyHeaderBytes, &more, fmt::format("'{}': SPZ gzip stream", filename));
+        file, size, kLegacyHeaderBytes, &more, fmt::format("{}: SPZ gzip stream", src.label));
     if (head.size() < kLegacyHeaderBytes) {
         core::ThrowError(
-            "'{}': truncated SPZ header: the gzip stream holds {} bytes, the v1-3 "
+            "{}: truncated SPZ header: the gzip stream holds {} bytes, the v1-3 "
             "header needs {}",
-            filename, head.size(), kLegacyHeaderBytes);
+            src.label, head.size(), kLegacyHeaderBytes);
     }
     if (LoadU32(head.data()) != kMagic) {
         core::ThrowError(
-            "'{}': SPZ header field 'magic' is 0x{:08x} inside the gzip stream, "
+            "{}: SPZ header field 'magic' is 0x{:08x} inside the gzip stream, "
             "expected 0x{:08x} (\"NGSP\")",
-            filename, LoadU32(head.data()), kMagic);
+            src.label, LoadU32(head.data()), kMagic);
     }
     Header h;
     h.version = LoadU32(head.data() + 4);
@@ -219,26 +231,26 @@ geometry::PointCloud ReadLegacy(const std::string& filename, const uint8_t* file
     h.flags = head[14];
     if (h.version < 1 || h.version > 3) {
         core::ThrowError(
-            "'{}': SPZ header field 'version' is {} in a gzip stream; gzip holds "
+            "{}: SPZ header field 'version' is {} in a gzip stream; gzip holds "
             "versions 1-3 (version 4 is not gzip-compressed)",
-            filename, h.version);
+            src.label, h.version);
     }
-    CheckHeader(filename, h);
+    CheckHeader(src, h);
     uint64_t attribute_bytes = 0;
     for (int k = 0; k < kNumStreams; ++k) attribute_bytes += h.StreamBytes(k);
-    CheckDecodeMemory(filename, h);
+    CheckDecodeMemory(src, h);
     // Extensions follow the attributes inside the stream; more than kMaxLegacyTailBytes
     // after them is not read (a warning says so).
     const uint64_t wanted =
         std::min<uint64_t>(kLegacyHeaderBytes + attribute_bytes + kMaxLegacyTailBytes,
                            uint64_t(size) * kDeflateMaxExpansion + 1024);
     const std::vector<uint8_t> bytes = GunzipPrefixBytes(
-        file, size, size_t(wanted), &more, fmt::format("'{}': SPZ gzip stream", filename));
+        file, size, size_t(wanted), &more, fmt::format("{}: SPZ gzip stream", src.label));
     if (more) {
         core::LogWarning(
-            "'{}': the gzip stream goes on past {} bytes after the SPZ attributes; "
+            "{}: the gzip stream goes on past {} bytes after the SPZ attributes; "
             "the rest is not read",
-            filename, kMaxLegacyTailBytes);
+            src.label, kMaxLegacyTailBytes);
     }
     uint64_t offset = kLegacyHeaderBytes, per_splat = 0;
     for (int k = 0; k < kNumStreams; ++k) {
@@ -247,9 +259,9 @@ geometry::PointCloud ReadLegacy(const std::string& filename, const uint8_t* file
     }
     if (offset > bytes.size()) {
         core::ThrowError(
-            "'{}': SPZ header field 'numPoints' is {}: that needs {} bytes of "
+            "{}: SPZ header field 'numPoints' is {}: that needs {} bytes of "
             "attributes ({} per splat), the gzip stream holds {} after the header",
-            filename, h.num_points, offset - kLegacyHeaderBytes, per_splat,
+            src.label, h.num_points, offset - kLegacyHeaderBytes, per_splat,
             bytes.size() - kLegacyHeaderBytes);
     }
     std::array<const uint8_t*, kNumStreams> streams{};
@@ -258,19 +270,19 @@ geometry::PointCloud ReadLegacy(const std::string& filename, const uint8_t* file
     const size_t extra = bytes.size() - offset;
     uint32_t stored = kCoordinateRUB;
     if (h.flags & kFlagExtensions) {
-        stored = ParseExtensions(filename, bytes.data() + offset, extra, "gzip stream");
+        stored = ParseExtensions(src, bytes.data() + offset, extra, "gzip stream");
     } else if (extra > 0) {
-        core::LogWarning("'{}': {} bytes after the SPZ attributes ignored", filename, extra);
+        core::LogWarning("{}: {} bytes after the SPZ attributes ignored", src.label, extra);
         report.trailing_bytes = int64_t(extra);
     }
-    return DecodeSplats(filename, h, streams, FlipsToRDF(stored), options, report);
+    DecodeSplats(src, h, streams, stored, columns);
 }
 
-geometry::PointCloud ReadV4(const std::string& filename, const uint8_t* file, size_t size,
-                            const ReadPointCloudOptions& options, ReadPointCloudReport& report) {
+void ReadV4(const Source& src, const uint8_t* file, size_t size, SplatColumns& columns,
+            ReadPointCloudReport& report) {
     if (size < kHeaderBytes) {
-        core::ThrowError("'{}': truncated SPZ header: {} bytes, the header needs {}", filename,
-                         size, kHeaderBytes);
+        core::ThrowError("{}: truncated SPZ header: {} bytes, the header needs {}", src.label, size,
+                         kHeaderBytes);
     }
     Header h;
     h.version = LoadU32(file + 4);
@@ -282,34 +294,34 @@ geometry::PointCloud ReadV4(const std::string& filename, const uint8_t* file, si
     const uint32_t toc_offset = LoadU32(file + 16);
     if (h.version >= 1 && h.version <= 3) {
         core::ThrowError(
-            "'{}': SPZ header field 'version' is {} but the file is not "
+            "{}: SPZ header field 'version' is {} but the data is not "
             "gzip-compressed: the spec stores versions 1-3 as gzip streams only",
-            filename, h.version);
+            src.label, h.version);
     }
     if (h.version != 4) {
-        core::ThrowError("'{}': SPZ header field 'version' is {}; supported are 1-4", filename,
+        core::ThrowError("{}: SPZ header field 'version' is {}; supported are 1-4", src.label,
                          h.version);
     }
-    CheckHeader(filename, h);
+    CheckHeader(src, h);
     std::array<int, kNumStreams> present{};
     const int expected_streams = h.PresentStreams(present);
     if (num_streams != expected_streams) {
         core::ThrowError(
-            "'{}': SPZ header field 'numStreams' is {}; numPoints {} with shDegree "
+            "{}: SPZ header field 'numStreams' is {}; numPoints {} with shDegree "
             "{} needs {}",
-            filename, num_streams, h.num_points, h.sh_degree, expected_streams);
+            src.label, num_streams, h.num_points, h.sh_degree, expected_streams);
     }
     const uint64_t toc_end = uint64_t(toc_offset) + uint64_t(num_streams) * 16;
     if (toc_offset < kHeaderBytes || toc_end > size) {
         core::ThrowError(
-            "'{}': SPZ header field 'tocByteOffset' is {}: the TOC of {} streams "
-            "must lie between byte {} and the end of the file ({} bytes)",
-            filename, toc_offset, num_streams, kHeaderBytes, size);
+            "{}: SPZ header field 'tocByteOffset' is {}: the TOC of {} streams "
+            "must lie between byte {} and the end of the SPZ data ({} bytes)",
+            src.label, toc_offset, num_streams, kHeaderBytes, size);
     }
     uint32_t stored = kCoordinateRUB;
     if (h.flags & kFlagExtensions) {
-        stored = ParseExtensions(filename, file + kHeaderBytes, toc_offset - kHeaderBytes,
-                                 "header zone");
+        stored =
+            ParseExtensions(src, file + kHeaderBytes, toc_offset - kHeaderBytes, "header zone");
     }
     // The whole TOC is checked before anything is decompressed.
     std::array<uint64_t, kNumStreams> offsets{}, sizes{};
@@ -319,10 +331,10 @@ geometry::PointCloud ReadV4(const std::string& filename, const uint8_t* file, si
         const int k = present[s];
         const uint64_t compressed = LoadU64(file + toc_offset + s * 16);
         const uint64_t uncompressed = LoadU64(file + toc_offset + s * 16 + 8);
-        names[s] = fmt::format("'{}': SPZ stream {} ({}) at byte {}", filename, s, kStreamNames[k],
-                               offset);
+        names[s] =
+            fmt::format("{}: SPZ stream {} ({}) at byte {}", src.label, s, kStreamNames[k], offset);
         if (compressed > size - offset) {
-            core::ThrowError("{}: TOC compressedSize {} passes the end of the file ({} bytes)",
+            core::ThrowError("{}: TOC compressedSize {} passes the end of the SPZ data ({} bytes)",
                              names[s], compressed, size);
         }
         if (uncompressed != h.StreamBytes(k)) {
@@ -342,11 +354,11 @@ geometry::PointCloud ReadV4(const std::string& filename, const uint8_t* file, si
         offset += compressed;
     }
     if (offset < size) {
-        core::LogWarning("'{}': {} bytes after the last SPZ stream ignored", filename,
+        core::LogWarning("{}: {} bytes after the last SPZ stream ignored", src.label,
                          size - offset);
         report.trailing_bytes = int64_t(size - offset);
     }
-    CheckDecodeMemory(filename, h);
+    CheckDecodeMemory(src, h);
     std::array<std::vector<uint8_t>, kNumStreams> decoded;
     std::array<const uint8_t*, kNumStreams> streams{};
     for (int s = 0; s < num_streams; ++s) {
@@ -365,25 +377,37 @@ geometry::PointCloud ReadV4(const std::string& filename, const uint8_t* file, si
         decoded[k] = ZstdDecompressBytes(frame, sizes[s], h.StreamBytes(k), names[s]);
         streams[k] = decoded[k].data();
     }
-    return DecodeSplats(filename, h, streams, FlipsToRDF(stored), options, report);
+    DecodeSplats(src, h, streams, stored, columns);
 }
 
 }  // namespace
 
+void DecodeSpz(const uint8_t* data, size_t size, const std::string& filename,
+               const std::string& label, SpzAxes axes, SplatColumns& columns,
+               ReadPointCloudReport& report) {
+    const Source src{filename, label, axes};
+    if (size >= 2 && data[0] == 0x1f && data[1] == 0x8b) {
+        ReadLegacy(src, data, size, columns, report);
+        return;
+    }
+    if (size < 4 || LoadU32(data) != kMagic) {
+        core::ThrowError(
+            "{}: SPZ header field 'magic' is not \"NGSP\" and the data is not "
+            "gzip-compressed (SPZ v1-3)",
+            label);
+    }
+    ReadV4(src, data, size, columns, report);
+}
+
 geometry::PointCloud ReadSpz(const std::string& filename, const ReadPointCloudOptions& options,
                              ReadPointCloudReport& report) {
-    const MappedFile file(filename);
-    const uint8_t* data = file.data();
-    if (file.size() >= 2 && data[0] == 0x1f && data[1] == 0x8b) {
-        return ReadLegacy(filename, data, file.size(), options, report);
+    SplatColumns columns;
+    {
+        const MappedFile file(filename);
+        DecodeSpz(file.data(), file.size(), filename, fmt::format("'{}'", filename),
+                  SpzAxes::kToRdf, columns, report);
     }
-    if (file.size() < 4 || LoadU32(data) != kMagic) {
-        core::ThrowError(
-            "'{}': SPZ header field 'magic' is not \"NGSP\" and the file is not "
-            "gzip-compressed (SPZ v1-3)",
-            filename);
-    }
-    return ReadV4(filename, data, file.size(), options, report);
+    return FinalizeColumns(filename, columns, options, report);
 }
 
 }  // namespace io
