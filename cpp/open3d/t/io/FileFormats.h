@@ -51,9 +51,9 @@ geometry::PointCloud ReadCompressedPly(const std::string& filename,
                                        ReadPointCloudReport& report);
 void WriteCompressedPly(const std::string& filename, const geometry::PointCloud& cloud);
 
-/// PlayCanvas SOG v2 and v3: a bundled .sog (zip) or a folder holding meta.json and its
+/// PlayCanvas SOG v1, v2 and v3: a bundled .sog (zip) or a folder holding meta.json and its
 /// WebP images (`filename` is the folder or its meta.json). Written as a bundled .sog of
-/// version 2 (SogLayout.h says why). SogReader.cpp, SogWriter.cpp.
+/// version 2 (SogLayout.h says why). SogReader.cpp (v2, v3), SogV1Reader.cpp, SogWriter.cpp.
 geometry::PointCloud ReadSog(const std::string& filename, const ReadPointCloudOptions& options,
                              ReadPointCloudReport& report);
 void WriteSog(const std::string& filename, const geometry::PointCloud& cloud);

@@ -30,11 +30,28 @@
 // serialised a NaN) gets codebook[1] + (codebook[1] - codebook[255]) / 255 there, as the
 // PlayCanvas engine does. Alpha 0 and 255 map to logits of +-13.8 (1e-6 margin), like .splat.
 //
-// Choices of this reader: versions 2 and 3 are decoded with the layout above (version 1,
-// without a "version" field, is refused); a quats alpha outside 252..255 or a palette label
-// at or above shN.count is an error naming the splat; files named in meta.json must be plain
-// relative names (no "..", no absolute paths); all per-Gaussian images must have the same
-// size; at most 2^24 texels per image.
+// Version 1 ("SOGS": meta.json without "version", or version 1), as PlayCanvas's engine
+// (gsplat-sog-data.js and its shaders) and splat-transform (read-sog-v1.ts; the writers
+// write-sogs.ts of mid-2025 and playcanvas/sogs) read and wrote it. The same images, texel
+// addressing, positions (means.mins / maxs, log transform) and quats as above; instead of
+// codebooks every 8-bit value is lerp(lo, hi, byte / 255):
+//   count = means.shape[0] (no "count"); scales RGB with scales.mins / maxs[0..2] (natural-log
+//   scales); sh0 RGB f_dc with sh0.mins / maxs[0..2] and A the opacity logit (not a sigmoid)
+//   with sh0.mins / maxs[3]; shN.mins / shN.maxs are single numbers for every palette
+//   coefficient; there is no shN.count or shN.bands: the bands follow the centroid image's
+//   width (192, 512, 960 = 64 * Nc for 1, 2, 3 bands) and the palette is its rows * 64.
+// The other shape entries, dtype and shN.shape (the two writers disagree on it) are not used.
+//
+// Choices of this reader: versions 2 and 3 are decoded with the layout above and version 1 as
+// just said; a quats alpha outside 252..255 or a palette label at or above shN.count (version
+// 1: outside the centroid image) is an error naming the splat; files named in meta.json must
+// be plain relative names (no "..", no absolute paths); all per-Gaussian images must have the
+// same size; at most 2^24 texels per image. Version 1 refuses quats.encoding other than
+// "quaternion_packed", shN.quantization other than 8, and the first SOGS layout of spring
+// 2025 (an "opacities" image; no PlayCanvas tool reads it now).
+// meta.json "model" (splat-transform 3.2) and "antialias": "antialiased" or antialias true
+// are read with a warning to render with antialiasing on; "2dgs" (2D Gaussian surfels) is
+// refused, as this library draws 3D Gaussians only; an unknown model is read with a warning.
 //
 // The writer writes a bundled .sog of version 2 (kWriteVersion; the version-3 changes could
 // not be consulted, and version 2 is the one every PlayCanvas tool reads): texture sides

@@ -1,12 +1,7 @@
-// The SOG reader (layout and choices: SogLayout.h).
-#include <algorithm>
+// The SOG reader: versions 2 and 3 here, version 1 in SogV1Reader.cpp (layouts and choices:
+// SogLayout.h).
 #include <array>
 #include <cmath>
-#include <cstring>
-#include <filesystem>
-#include <fstream>
-#include <limits>
-#include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
@@ -16,200 +11,68 @@
 #include "open3d/core/ParallelFor.h"
 #include "open3d/t/geometry/SphericalHarmonics.h"
 #include "open3d/t/io/FileFormats.h"
-#include "open3d/t/io/InputPaths.h"
 #include "open3d/t/io/SogLayout.h"
+#include "open3d/t/io/SogMeta.h"
 #include "open3d/t/io/SplatColumns.h"
 #include "open3d/t/io/WebpImage.h"
-#include "open3d/t/io/ZipArchive.h"
 
 namespace open3d {
 namespace t {
 namespace io {
 namespace {
 
-namespace fs = std::filesystem;
 using Json = nlohmann::json;
 using namespace sog;
 
-// The files of one SOG: zip entries or files in a folder, by the names meta.json gives.
-class SogFiles {
-public:
-    explicit SogFiles(const std::string& filename) : filename_(filename) {
-        std::error_code ec;
-        if (fs::is_directory(filename, ec)) {
-            folder_ = fs::path(filename);
-            meta_name_ = "meta.json";
-            return;
+// meta.json's "model" (splat-transform 3.2 and later: absent or "default" for ordinary 3D
+// Gaussians, "antialiased", "2dgs") and "antialias" (a boolean; this library's writer writes
+// false). They say how the scene was trained and so how it must be rendered; the cloud has no
+// place for either, so the reader says it here (SogLayout.h, docs/formats.md).
+void CheckModel(const Meta& meta) {
+    bool antialiased = false;
+    if (const Json* model = meta.Optional(meta.root, "model"); model != nullptr) {
+        if (!model->is_string()) {
+            meta.Fail("model", fmt::format("is {}, expected a string", model->dump()));
         }
-        file_ = std::make_unique<MappedFile>(filename);
-        if (LooksLikeZip(file_->data(), file_->size())) {
-            zip_ = std::make_unique<ZipReader>(file_->data(), file_->size(), "'" + filename + "'");
-            meta_name_ = "meta.json";
-            if (!zip_->Has(meta_name_)) {
-                std::string names;
-                for (const std::string& name : zip_->Names())
-                    names += (names.empty() ? "" : ", ") + name;
-                core::ThrowError("'{}': the archive has no meta.json at its root (entries: {})",
-                                 filename, names);
-            }
-        } else {
-            // A meta.json (any name): the images are beside it.
-            folder_ = fs::path(filename).parent_path();
-            meta_name_ = fs::path(filename).filename().string();
+        const std::string value = model->get<std::string>();
+        if (value == "2dgs") {
+            // Surfels with no third axis, evaluated by ray-surfel intersection: drawn as 3D
+            // Gaussians they are flat ellipsoids seen through the wrong footprint.
+            meta.Fail("model",
+                      "is '2dgs' (2D Gaussian splats, surfels): this renderer draws 3D Gaussians "
+                      "and cannot draw them faithfully, so the file is not read");
+        }
+        if (value == "antialiased") {
+            antialiased = true;
+            core::LogWarning(
+                "'{}': SOG model 'antialiased' (meta.json 'model'; trained with mip-splatting "
+                "antialiasing): render it with antialiasing on",
+                meta.filename);
+        } else if (value != "default") {
+            core::LogWarning(
+                "'{}': SOG model '{}' (meta.json 'model') is not one this reader knows "
+                "('default', 'antialiased', '2dgs'); read as ordinary 3D Gaussians",
+                meta.filename, value);
         }
     }
+    if (const Json* aa = meta.Optional(meta.root, "antialias"); aa != nullptr) {
+        if (!aa->is_boolean()) {
+            meta.Fail("antialias", fmt::format("is {}, expected true or false", aa->dump()));
+        }
+        if (aa->get<bool>() && !antialiased) {
+            core::LogWarning(
+                "'{}': SOG meta.json 'antialias' is true (trained with antialiasing): render "
+                "it with antialiasing on",
+                meta.filename);
+        }
+    }
+}
 
-    const std::string& MetaName() const { return meta_name_; }
-
-    std::vector<uint8_t> Read(const std::string& name, size_t max_size) const {
-        if (zip_) return zip_->Read(name, max_size);
-        if (name == meta_name_ && file_) {
-            if (file_->size() > max_size) {
-                core::ThrowError("'{}': {} bytes, more than the {} allowed for meta.json",
-                                 filename_, file_->size(), max_size);
-            }
-            return std::vector<uint8_t>(file_->data(), file_->data() + file_->size());
-        }
-        const fs::path path = folder_ / name;
-        std::error_code ec;
-        if (const std::string problem = InputPathProblem(path.string(), false); !problem.empty()) {
-            core::ThrowError("'{}': its '{}' cannot be read: {}", filename_, name, problem);
-        }
-        const uintmax_t size = fs::file_size(path, ec);
-        if (ec || size > max_size) {
-            core::ThrowError("'{}': '{}' is larger than the {} bytes allowed", filename_, name,
-                             max_size);
-        }
-        std::ifstream in(path, std::ios::binary);
-        std::vector<uint8_t> bytes(static_cast<size_t>(size));
-        if (!in.read(reinterpret_cast<char*>(bytes.data()), static_cast<std::streamsize>(size))) {
-            core::ThrowError("'{}': cannot read '{}'", filename_, path.string());
-        }
-        return bytes;
-    }
-
-private:
-    std::string filename_;
-    std::unique_ptr<MappedFile> file_;
-    std::unique_ptr<ZipReader> zip_;
-    fs::path folder_;
-    std::string meta_name_;
-};
-
-// Validating accessors for meta.json; every error names the file and the field path.
-struct Meta {
-    const std::string& filename;
-    const Json& root;
-
-    [[noreturn]] void Fail(const std::string& path, const std::string& what) const {
-        core::ThrowError("'{}': meta.json: '{}' {}", filename, path, what);
-    }
-    const Json& Field(const Json& obj, const std::string& parent, const char* key) const {
-        const std::string path = parent.empty() ? key : parent + "." + key;
-        if (!obj.is_object()) Fail(parent, "is not an object");
-        const auto it = obj.find(key);
-        if (it == obj.end()) Fail(path, "is missing");
-        return *it;
-    }
-    const Json* Optional(const Json& obj, const char* key) const {
-        const auto it = obj.find(key);
-        return it == obj.end() ? nullptr : &*it;
-    }
-    int64_t Integer(const Json& v, const std::string& path, int64_t lo, int64_t hi) const {
-        if (v.is_number_unsigned()) {
-            const uint64_t u = v.get<uint64_t>();
-            if (u <= uint64_t(hi) && int64_t(u) >= lo) return int64_t(u);
-        } else if (v.is_number_integer()) {
-            const int64_t i = v.get<int64_t>();
-            if (i >= lo && i <= hi) return i;
-        } else {
-            Fail(path, fmt::format("is {}, expected an integer", v.dump()));
-        }
-        Fail(path, fmt::format("is {}, outside {}..{}", v.dump(), lo, hi));
-    }
-    double Number(const Json& v, const std::string& path) const {
-        if (!v.is_number()) Fail(path, fmt::format("is {}, expected a number", v.dump()));
-        const double d = v.get<double>();
-        if (!std::isfinite(d)) Fail(path, "is not finite");
-        return d;
-    }
-    std::vector<double> Numbers(const Json& parent, const std::string& parent_path, const char* key,
-                                size_t n) const {
-        const std::string path = parent_path + "." + key;
-        const Json& v = Field(parent, parent_path, key);
-        if (!v.is_array() || v.size() != n) {
-            Fail(path, fmt::format("must be an array of {} numbers", n));
-        }
-        std::vector<double> out(n);
-        for (size_t i = 0; i < n; ++i) out[i] = Number(v[i], fmt::format("{}[{}]", path, i));
-        return out;
-    }
-    std::vector<float> Codebook(const Json& parent, const std::string& parent_path) const {
-        const std::string path = parent_path + ".codebook";
-        const Json& v = Field(parent, parent_path, "codebook");
-        if (!v.is_array() || v.size() != size_t(kCodebookSize)) {
-            Fail(path, fmt::format("must be an array of {} numbers (has {})", kCodebookSize,
-                                   v.is_array() ? v.size() : 0));
-        }
-        std::vector<double> d(kCodebookSize);
-        for (int i = (v[0].is_null() ? 1 : 0); i < kCodebookSize; ++i) {
-            d[i] = Number(v[i], fmt::format("{}[{}]", path, i));
-        }
-        // As the PlayCanvas engine does for writers that serialised a NaN as null.
-        if (v[0].is_null()) d[0] = d[1] + (d[1] - d[255]) / 255.0;
-        std::vector<float> out(kCodebookSize);
-        for (int i = 0; i < kCodebookSize; ++i) {
-            out[i] = static_cast<float>(d[i]);
-            if (!std::isfinite(out[i])) Fail(fmt::format("{}[{}]", path, i), "overflows float");
-        }
-        return out;
-    }
-    std::vector<std::string> Files(const Json& parent, const std::string& parent_path,
-                                   size_t n) const {
-        const std::string path = parent_path + ".files";
-        const Json& v = Field(parent, parent_path, "files");
-        if (!v.is_array() || v.size() != n) Fail(path, fmt::format("must list {} file name(s)", n));
-        std::vector<std::string> out;
-        for (size_t i = 0; i < n; ++i) {
-            const std::string item = fmt::format("{}[{}]", path, i);
-            if (!v[i].is_string()) Fail(item, "is not a string");
-            const std::string name = v[i].get<std::string>();
-            const fs::path p(name);
-            bool bad = name.empty() || p.is_absolute() || p.has_root_path();
-            for (const auto& part : p) bad = bad || part == "..";
-            if (bad) Fail(item, fmt::format("'{}' is not a relative file name", name));
-            out.push_back(name);
-        }
-        return out;
-    }
-};
-
-// One decoded per-Gaussian image, checked against the others' size and the count.
-struct Plane {
-    Rgba8Image image;
-    const uint8_t* Texel(int64_t i) const { return image.rgba.data() + i * 4; }
-};
-
-}  // namespace
-
-geometry::PointCloud ReadSog(const std::string& filename, const ReadPointCloudOptions& options,
-                             ReadPointCloudReport& report) {
-    const SogFiles files(filename);
-    const std::vector<uint8_t> meta_bytes = files.Read(files.MetaName(), kMaxMetaBytes);
-    const Json root = Json::parse(meta_bytes.begin(), meta_bytes.end(), nullptr, false);
-    if (root.is_discarded()) core::ThrowError("'{}': meta.json is not valid JSON", filename);
-    if (!root.is_object()) core::ThrowError("'{}': meta.json is not a JSON object", filename);
-    const Meta meta{filename, root};
-
-    if (meta.Optional(root, "version") == nullptr) {
-        meta.Fail("version",
-                  "is missing (a SOG version 1 / SOGS meta.json, which this reader does not "
-                  "read; versions 2 and 3 are supported)");
-    }
-    const int64_t version = meta.Integer(root["version"], "version", 0, 1 << 30);
-    if (version != 2 && version != 3) {
-        meta.Fail("version", fmt::format("is {}; versions 2 and 3 are supported", version));
-    }
+// Versions 2 and 3 (the layout of SogLayout.h).
+geometry::PointCloud ReadSogV2(const SogFiles& files, const Meta& meta,
+                               const ReadPointCloudOptions& options, ReadPointCloudReport& report) {
+    const std::string& filename = meta.filename;
+    const Json& root = meta.root;
     const int64_t count = meta.Integer(meta.Field(root, "", "count"), "count", 0, kMaxTexels);
 
     const Json& means = meta.Field(root, "", "means");
@@ -235,71 +98,21 @@ geometry::PointCloud ReadSog(const std::string& filename, const ReadPointCloudOp
         shn_codebook = meta.Codebook(*shn, "shN");
         shn_files = meta.Files(*shn, "shN", 2);
     }
-    if (const Json* aa = meta.Optional(root, "antialias");
-        aa != nullptr && aa->is_boolean() && aa->get<bool>()) {
-        core::LogWarning(
-            "'{}': the scene was trained with anti-aliasing (meta.json 'antialias'); the cloud "
-            "does not carry that flag",
-            filename);
-    }
-
-    // Every per-Gaussian image: same size, at least count texels.
-    int width = -1, height = -1;
-    auto load = [&](const std::string& name, const std::string& field) {
-        const std::vector<uint8_t> bytes = files.Read(name, kMaxImageBytes);
-        const std::string what = fmt::format("'{}': '{}' ({})", filename, name, field);
-        Plane plane{DecodeWebp(bytes.data(), bytes.size(), what, kMaxTexels)};
-        const int w = plane.image.width, h = plane.image.height;
-        if (width < 0) {
-            width = w;
-            height = h;
-        } else if (w != width || h != height) {
-            core::ThrowError(
-                "{} is {}x{}, but '{}' ({}) is {}x{}: per-Gaussian images must share one size",
-                what, w, h, means_files[0], "means.files[0]", width, height);
-        }
-        if (int64_t(w) * h < count) {
-            core::ThrowError("{} is {}x{} = {} texels, fewer than count {}", what, w, h,
-                             int64_t(w) * h, count);
-        }
-        return plane;
-    };
+    PlaneLoader planes(files, filename, count);
 
     SplatColumns columns;
     {
-        const Plane lo = load(means_files[0], "means.files[0]");
-        const Plane hi = load(means_files[1], "means.files[1]");
+        const Plane lo = planes.Load(means_files[0], "means.files[0]");
+        const Plane hi = planes.Load(means_files[1], "means.files[1]");
         columns.Allocate(filename, count, /*gaussian=*/true, degree);
-        float* positions = columns.positions.Data<float>();
-        core::ParallelFor(count, [&](int64_t i) {
-            const uint8_t* l = lo.Texel(i);
-            const uint8_t* u = hi.Texel(i);
-            for (int a = 0; a < 3; ++a) {
-                const double t = (l[a] | (u[a] << 8)) / 65535.0;
-                positions[i * 3 + a] = static_cast<float>(UnLog(mins[a] * (1.0 - t) + maxs[a] * t));
-            }
-        });
+        DecodePositions(lo, hi, mins, maxs, count, columns.positions.Data<float>());
     }
     {
-        const Plane quats = load(quats_file, "quats.files[0]");
-        for (int64_t i = 0; i < count; ++i) {
-            const uint8_t tag = quats.Texel(i)[3];
-            if (tag < 252) {
-                core::ThrowError(
-                    "'{}': '{}' (quats.files[0]): splat {} has alpha {}, expected 252..255 (the "
-                    "index of the omitted component)",
-                    filename, quats_file, i, tag);
-            }
-        }
-        float* rot = columns.rot.Data<float>();
-        core::ParallelFor(count, [&](int64_t i) {
-            double q[4];
-            DecodeQuat(quats.Texel(i), quats.Texel(i)[3] - 252, q);
-            for (int c = 0; c < 4; ++c) rot[i * 4 + c] = static_cast<float>(q[c]);
-        });
+        const Plane quats = planes.Load(quats_file, "quats.files[0]");
+        DecodeRotations(quats, filename, quats_file, count, columns.rot.Data<float>());
     }
     {
-        const Plane plane = load(scales_file, "scales.files[0]");
+        const Plane plane = planes.Load(scales_file, "scales.files[0]");
         std::array<float, kCodebookSize> linear;
         for (int k = 0; k < kCodebookSize; ++k) linear[k] = DecodeLogScale(scale_codebook[k]);
         float* scale = columns.scale.Data<float>();
@@ -308,7 +121,7 @@ geometry::PointCloud ReadSog(const std::string& filename, const ReadPointCloudOp
         });
     }
     {
-        const Plane plane = load(sh0_file, "sh0.files[0]");
+        const Plane plane = planes.Load(sh0_file, "sh0.files[0]");
         float* f_dc = columns.f_dc.Data<float>();
         float* opacity = columns.opacity.Data<float>();
         core::ParallelFor(count, [&](int64_t i) {
@@ -319,40 +132,45 @@ geometry::PointCloud ReadSog(const std::string& filename, const ReadPointCloudOp
     }
     if (degree > 0) {
         const int nc = geometry::NumSHRestCoeffs(degree);
-        const Plane labels = load(shn_files[1], "shN.files[1]");
-        const std::vector<uint8_t> bytes = files.Read(shn_files[0], kMaxImageBytes);
-        const Rgba8Image centroids = DecodeWebp(
-            bytes.data(), bytes.size(),
-            fmt::format("'{}': '{}' (shN.files[0])", filename, shn_files[0]), kMaxTexels);
+        const Plane labels = planes.Load(shn_files[1], "shN.files[1]");
+        const Rgba8Image centroids = planes.LoadOther(shn_files[0], "shN.files[0]");
         if (centroids.width != 64 * nc) {
             core::ThrowError(
                 "'{}': '{}' (shN.files[0]) is {} texels wide; {} band(s) need 64 * {} = {}",
                 filename, shn_files[0], centroids.width, degree, nc, 64 * nc);
         }
-        for (int64_t i = 0; i < count; ++i) {
-            const uint8_t* t = labels.Texel(i);
-            const int64_t label = t[0] | (t[1] << 8);
-            if (label >= palette || label / 64 >= centroids.height) {
-                core::ThrowError(
-                    "'{}': '{}' (shN.files[1]): splat {} has palette label {}, but shN.count is "
-                    "{} and '{}' holds {} rows of 64 entries",
-                    filename, shn_files[1], i, label, palette, shn_files[0], centroids.height);
-            }
-        }
-        float* rest = columns.f_rest.Data<float>();
-        core::ParallelFor(count, [&](int64_t i) {
-            const uint8_t* t = labels.Texel(i);
-            const int64_t label = t[0] | (t[1] << 8);
-            const uint8_t* row =
-                centroids.rgba.data() + ((label / 64) * centroids.width + (label % 64) * nc) * 4;
-            for (int j = 0; j < nc; ++j) {
-                for (int c = 0; c < 3; ++c) {
-                    rest[(i * nc + j) * 3 + c] = shn_codebook[row[j * 4 + c]];
-                }
-            }
-        });
+        DecodeShPalette(labels, centroids, nc, palette, shn_codebook.data(), filename,
+                        {shn_files[0], shn_files[1]}, count, columns.f_rest.Data<float>());
     }
     return FinalizeColumns(filename, columns, options, report);
+}
+
+}  // namespace
+
+geometry::PointCloud ReadSog(const std::string& filename, const ReadPointCloudOptions& options,
+                             ReadPointCloudReport& report) {
+    const SogFiles files(filename);
+    const std::vector<uint8_t> meta_bytes = files.Read(files.MetaName(), kMaxMetaBytes);
+    const Json root = Json::parse(meta_bytes.begin(), meta_bytes.end(), nullptr, false);
+    if (root.is_discarded()) core::ThrowError("'{}': meta.json is not valid JSON", filename);
+    if (!root.is_object()) core::ThrowError("'{}': meta.json is not a JSON object", filename);
+    Meta meta{filename, root};
+    CheckModel(meta);
+
+    // No "version" is the version-1 ("SOGS") layout, as PlayCanvas's engine and
+    // splat-transform read it; its errors say so, for a newer file that lost its version.
+    const Json* version_field = meta.Optional(root, "version");
+    const int64_t version =
+        version_field == nullptr ? 1 : meta.Integer(*version_field, "version", 0, 1 << 30);
+    if (version == 1) {
+        meta.where = version_field == nullptr ? "meta.json (no 'version': SOG version 1)"
+                                              : "meta.json (SOG version 1)";
+        return ReadSogV1(files, meta, options, report);
+    }
+    if (version != 2 && version != 3) {
+        meta.Fail("version", fmt::format("is {}; versions 1, 2 and 3 are supported", version));
+    }
+    return ReadSogV2(files, meta, options, report);
 }
 
 }  // namespace io
