@@ -261,9 +261,21 @@ int Run(const Options& opt) {
         };
     }
     viewer.Run(run);
-    if (opt.screenshot_on_exit && viewer.GetWidth() > 0) {
-        viewer.RequestScreenshot();
-        viewer.RenderFrame();
+    // --screenshot-on-exit promises a file: a run that saved none fails (it exited 0).
+    int status = 0;
+    if (opt.screenshot_on_exit) {
+        const std::string path = viewer.RequestScreenshot();
+        // A frame the panel's input holds back or a cancelled one leaves the shot pending.
+        for (int tries = 0; tries < 4 && viewer.HasPendingScreenshot(); ++tries) {
+            if (!viewer.RenderFrame()) break;  // minimised: nothing to draw
+        }
+        if (viewer.GetLastScreenshotPath() != path) {
+            std::fprintf(stderr, "GaussianSplat: error: --screenshot-on-exit saved nothing: %s\n",
+                         !viewer.GetLastScreenshotError().empty()
+                             ? viewer.GetLastScreenshotError().c_str()
+                             : "the window drew no frame (minimised?)");
+            status = 1;
+        }
     }
     if (const auto progress = viewer.GetStreamProgress()) {
         std::printf("GaussianSplat: %s\n", rendering::FormatStreamProgress(*progress).c_str());
@@ -278,7 +290,7 @@ int Run(const Options& opt) {
         static_cast<long long>(s.num_tile_entries), s.gpu_project_ms, s.gpu_sort_ms,
         s.gpu_composite_ms,
         s.geometry_reused ? " (geometry stage reused: the camera did not move)" : "");
-    return 0;
+    return status;
 }
 
 }  // namespace

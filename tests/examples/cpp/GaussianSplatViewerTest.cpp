@@ -284,6 +284,45 @@ TEST(GaussianSplatViewer, DrivenByXdotool) {
     EXPECT_NE(text.find("frame time mean"), std::string::npos) << text;
 }
 
+// --screenshot-on-exit promises a file: the run fails when none could be saved (it exited 0),
+// and passes with the file when one is.
+TEST(GaussianSplatViewer, ScreenshotOnExitFailsWhenNothingIsSaved) {
+    const char* display = std::getenv("DISPLAY");
+    if (display == nullptr || display[0] == '\0') {
+        OPEN3D_SKIP_OR_FAIL_WHEN_UNAVAILABLE(
+            "DISPLAY is not set: run under xvfb-run (scripts/test.sh does)");
+    }
+    const std::string dir = TempDir();
+    std::ofstream(dir + "/a_file") << "not a folder";
+    for (const bool good : {false, true}) {
+        const std::string shots = good ? dir + "/shots" : dir + "/a_file/shots";
+        const std::string log = dir + (good ? "/good.log" : "/bad.log");
+        ViewerProcess viewer({GAUSSIAN_SPLAT_VIEWER, "--width", "160", "--height", "120",
+                              "--frames", "1", "--screenshot-on-exit", "--screenshot-dir", shots},
+                             log);
+        ASSERT_TRUE(viewer.Started());
+        int status = 0;
+        const Clock::time_point start = Clock::now();
+        // The built-in scene's frame takes well under a second on lavapipe; only a hang
+        // reaches the deadline.
+        while (!viewer.Exited(&status) &&
+               std::chrono::duration<double>(Clock::now() - start).count() < 300) {
+            std::this_thread::sleep_for(std::chrono::milliseconds(50));
+        }
+        ASSERT_TRUE(viewer.Exited(&status)) << "still running after 300 s:\n" << ReadFile(log);
+        if (good) {
+            EXPECT_EQ(status, 0) << ReadFile(log);
+            EXPECT_TRUE(std::filesystem::exists(shots + "/screenshot_0000.png")) << ReadFile(log);
+        } else {
+            EXPECT_EQ(status, 1) << ReadFile(log);
+            EXPECT_NE(
+                ReadFile(log).find("--screenshot-on-exit saved nothing: Screenshot not saved"),
+                std::string::npos)
+                << ReadFile(log);
+        }
+    }
+}
+
 }  // namespace
 }  // namespace tests
 }  // namespace open3d

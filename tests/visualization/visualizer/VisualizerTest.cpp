@@ -289,6 +289,25 @@ TEST_F(VisualizerTest, ScreenshotKeyWritesThePicture) {
     EXPECT_FALSE(std::filesystem::exists(path + ".part"));
 }
 
+// Requests before a frame is drawn (P pressed twice during a load) make one shot and use one
+// number: the number is taken when the file is written.
+TEST_F(VisualizerTest, ScreenshotRequestsBeforeAFrameMakeOneShot) {
+    Visualizer& vis = MakeVisualizer();
+    AddWallAndSphere(vis);
+    const std::string dir = TempDir();
+    vis.SetScreenshotDir(dir);
+    const std::string first = vis.RequestScreenshot();
+    EXPECT_EQ(vis.RequestScreenshot(), first);
+    EXPECT_TRUE(vis.HasPendingScreenshot());
+    ASSERT_TRUE(vis.RenderFrame());
+    EXPECT_FALSE(vis.HasPendingScreenshot());
+    EXPECT_EQ(first, dir + "/screenshot_0000.png");
+    EXPECT_EQ(vis.GetLastScreenshotPath(), first);
+    // The shot's frame drew the new splats (the panel shows their numbers, not 0).
+    EXPECT_GT(vis.GetLastFrame().splat_stats.num_visible, 0);
+    EXPECT_EQ(vis.RequestScreenshot(), dir + "/screenshot_0001.png");
+}
+
 TEST_F(VisualizerTest, RunStopsAfterTheFrameLimit) {
     Visualizer& vis = MakeVisualizer();
     AddWallAndSphere(vis);

@@ -314,7 +314,18 @@ bool Visualizer::RenderFrame() {
     // A screenshot waits until ImGui has seen all input (a click takes two frames), so it
     // shows the state after everything that came before the request.
     const bool settled = BuildOverlay();
-    const bool screenshot = settled && !pending_screenshot_.empty();
+    const bool screenshot = settled && screenshot_pending_;
+    if (screenshot && new_splats_ > 0) {
+        // New splats not yet drawn: the panel would show the last frame's numbers (no
+        // splats for a new scene). A plain frame first, then the shot with its numbers.
+        last_frame_ = DrawToWindow(false, 1);
+        if (last_frame_.cancelled) {
+            last_present_s_ = -1.0;
+            return true;  // the shot stays pending
+        }
+        if (last_frame_.splats_drawn) new_splats_ = 0;
+        BuildOverlay();
+    }
     const int divisor = screenshot ? 1 : InteractiveDivisor();  // screenshots: full size
     last_frame_ = DrawToWindow(screenshot, divisor);
     if (last_frame_.cancelled) {
@@ -330,9 +341,15 @@ bool Visualizer::RenderFrame() {
     return true;
 }
 
+std::string Visualizer::NextScreenshotPath() const {
+    return (std::filesystem::path(screenshot_dir_) /
+            fmt::format("screenshot_{:04d}.png", screenshot_index_))
+        .string();
+}
+
 void Visualizer::WriteScreenshot(const t::geometry::Image& rgb) {
-    const std::string path = std::move(pending_screenshot_);
-    pending_screenshot_.clear();
+    const std::string path = NextScreenshotPath();
+    screenshot_pending_ = false;
     // Written under another name, then renamed: a watcher never sees half a file. A failure
     // (a folder that cannot be made, a full disk) is a message; the viewer goes on.
     const std::string partial = path + ".part";
@@ -350,6 +367,7 @@ void Visualizer::WriteScreenshot(const t::geometry::Image& rgb) {
     }
     screenshot_error_.clear();
     last_screenshot_ = path;
+    ++screenshot_index_;
     core::LogInfo("Saved screenshot {}", path);
 }
 
@@ -406,11 +424,9 @@ t::geometry::Image Visualizer::CaptureScreenImage() {
 }
 
 std::string Visualizer::RequestScreenshot() {
-    pending_screenshot_ = (std::filesystem::path(screenshot_dir_) /
-                           fmt::format("screenshot_{:04d}.png", screenshot_index_++))
-                              .string();
+    screenshot_pending_ = true;
     PostRedraw();
-    return pending_screenshot_;
+    return NextScreenshotPath();
 }
 
 t::geometry::Image Visualizer::RenderToImage(bool with_alpha) {

@@ -196,10 +196,14 @@ public:
     t::geometry::Image CaptureScreenImage();
     /// Writes the next drawn frame to screenshot_dir/screenshot_NNNN.png (P key, panel
     /// button) and returns that path; the file appears complete (written, then renamed).
-    /// The frame waits until the panel has taken all earlier input (a click needs two).
+    /// The frame waits until the panel has taken all earlier input (a click needs two) and
+    /// shows new splats with their numbers in the panel; requests before it make one shot.
     std::string RequestScreenshot();
     /// Folder of later screenshots (made when missing).
     void SetScreenshotDir(const std::string& dir) { screenshot_dir_ = dir.empty() ? "." : dir; }
+    /// Whether a requested screenshot waits for a frame (none drawn yet: minimised, loading,
+    /// a cancelled frame).
+    bool HasPendingScreenshot() const { return screenshot_pending_; }
     /// Path of the last screenshot written, empty before the first.
     const std::string& GetLastScreenshotPath() const { return last_screenshot_; }
     /// Why the last screenshot could not be written (shown in the panel; the viewer goes
@@ -294,6 +298,8 @@ private:
     bool DeferDuringFrame(std::function<void()> handler);
     void OpenFiles(const std::vector<std::string>& paths);
     void WriteScreenshot(const t::geometry::Image& rgb);
+    /// screenshot_dir/screenshot_NNNN.png with the number the next written shot takes.
+    std::string NextScreenshotPath() const;
     /// Owes frames for what changed without input: a reduced frame to refine, pages that
     /// arrived, a new stream progress line.
     void NoteBackgroundChanges();
@@ -324,7 +330,9 @@ private:
 
     std::string screenshot_dir_;
     int screenshot_index_ = 0;
-    std::string pending_screenshot_;  // path to write at the next drawn frame
+    // A screenshot is asked for: the next drawn frame is written, and only then does it take
+    // its number (presses before that frame, during a load say, make one shot, not gaps).
+    bool screenshot_pending_ = false;
     std::string last_screenshot_;
     std::string screenshot_error_;
 
