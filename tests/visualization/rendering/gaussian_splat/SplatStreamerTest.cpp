@@ -287,7 +287,10 @@ TEST(SplatStreamWorker, ConvergesOffTheCallersThreadAsTheViewMoves) {
         }
         worker.SetView(SplatCutViewOf(b));  // destroyed while it works: joins, no hang
     }
-    EXPECT_GT(takes, 3);
+    // At least one take per view; how many steps each view's convergence is split into
+    // depends on how fast the worker runs against this thread (an idle machine converges
+    // each view before the first take), so no more is asked.
+    EXPECT_GE(takes, 3);
     EXPECT_GT(streamer.Evictions(), 0);
     EXPECT_THROW(SplatStreamWorker(streamer, 0), core::Open3DError);
 }
