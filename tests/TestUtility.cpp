@@ -1,5 +1,7 @@
 #include "TestUtility.h"
 
+#include "open3d/core/Logging.h"
+
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -59,6 +61,31 @@ std::vector<uint8_t> ReadFileBytes(const std::string& path) {
 void WriteFileBytes(const std::string& path, const std::vector<uint8_t>& bytes) {
     std::ofstream out(path, std::ios::binary);
     out.write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
+}
+
+void AppendU32(std::vector<uint8_t>& bytes, uint32_t value) {
+    for (int i = 0; i < 4; ++i) bytes.push_back(uint8_t(value >> (8 * i)));
+}
+
+void AppendU64(std::vector<uint8_t>& bytes, uint64_t value) {
+    AppendU32(bytes, uint32_t(value));
+    AppendU32(bytes, uint32_t(value >> 32));
+}
+
+std::vector<std::string> CaptureWarnings(const std::function<void()>& call) {
+    std::vector<std::string> warnings;
+    core::LogSink previous =
+        core::SetLogSink([&warnings](core::LogLevel level, std::string_view message) {
+            if (level == core::LogLevel::Warning) warnings.emplace_back(message);
+        });
+    try {
+        call();
+    } catch (...) {
+        core::SetLogSink(previous);
+        throw;
+    }
+    core::SetLogSink(previous);
+    return warnings;
 }
 
 }  // namespace tests

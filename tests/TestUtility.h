@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -26,6 +27,12 @@ std::string TempDir();
 std::vector<uint8_t> ReadFileBytes(const std::string& path);
 /// Writes `bytes` as the whole file at `path`.
 void WriteFileBytes(const std::string& path, const std::vector<uint8_t>& bytes);
+/// Appends `value` little-endian (files assembled byte by byte as their specs lay them out).
+void AppendU32(std::vector<uint8_t>& bytes, uint32_t value);
+void AppendU64(std::vector<uint8_t>& bytes, uint64_t value);
+/// The warnings (core::LogWarning) logged while `call` runs, in order; the previous log sink
+/// is back afterwards, also when `call` throws.
+std::vector<std::string> CaptureWarnings(const std::function<void()>& call);
 /// True in CI (environment CI=true): there a test that lacks an X display, a Vulkan device,
 /// a tool or a shared scene fails instead of skipping, so the suite cannot pass by skipping.
 bool SkipsAreFailures();

@@ -19,14 +19,7 @@ namespace {
 
 std::vector<std::string> WarningsOfWriting(const std::string& path,
                                            const geometry::PointCloud& cloud) {
-    std::vector<std::string> warnings;
-    core::LogSink previous =
-        core::SetLogSink([&warnings](core::LogLevel level, std::string_view m) {
-            if (level == core::LogLevel::Warning) warnings.emplace_back(m);
-        });
-    WritePointCloud(path, cloud);
-    core::SetLogSink(previous);
-    return warnings;
+    return tests::CaptureWarnings([&] { WritePointCloud(path, cloud); });
 }
 
 TEST(CompressedPlySh, WritingShWarnsWithTheCloudsErrorAndClampedCount) {

@@ -74,22 +74,6 @@ void ExpectSameCloud(const PointCloud& read, const PointCloud& expected) {
     }
 }
 
-template <typename F>
-std::vector<std::string> Warnings(F&& f) {
-    std::vector<std::string> out;
-    auto previous = core::SetLogSink([&](core::LogLevel level, std::string_view msg) {
-        if (level == core::LogLevel::Warning) out.emplace_back(msg);
-    });
-    try {
-        f();
-    } catch (...) {
-        core::SetLogSink(previous);
-        throw;
-    }
-    core::SetLogSink(previous);
-    return out;
-}
-
 // Without a node transform the glTF cloud is the .spz cloud exactly: the SPZ values are the
 // primitive's glTF coordinates, as stored (CesiumJS's reading, GltfSpz.cpp), and glTF -> RDF
 // is the same sign flip (x, -y, -z) as SPZ's RUB -> RDF, so no value is rounded differently.
@@ -214,7 +198,7 @@ TEST(GltfSpz, FewerShDegreesNamedThanStored) {
     PointCloud from_spz, from_glb;
     ReadPointCloud(dir + "/fewer.spz", from_spz);
     const auto warnings =
-        Warnings([&] { ReadPointCloud(a.WriteGlb(dir + "/fewer.glb"), from_glb); });
+        tests::CaptureWarnings([&] { ReadPointCloud(a.WriteGlb(dir + "/fewer.glb"), from_glb); });
     ASSERT_EQ(from_glb.GaussianSplatGetSHOrder(), 1);
     bool warned = false;
     for (const auto& w : warnings) warned = warned || w.find("SH degree 3") != std::string::npos;
@@ -301,7 +285,7 @@ TEST(GltfSpz, AccessorStorageIsIgnored) {
     PointCloud from_spz, from_glb;
     ReadPointCloud(dir + "/stored.spz", from_spz);
     const auto warnings =
-        Warnings([&] { ReadPointCloud(a.WriteGlb(dir + "/stored.glb"), from_glb); });
+        tests::CaptureWarnings([&] { ReadPointCloud(a.WriteGlb(dir + "/stored.glb"), from_glb); });
     ExpectSameCloud(from_glb, from_spz);
     bool warned = false;
     for (const auto& w : warnings) {

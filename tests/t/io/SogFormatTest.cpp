@@ -15,6 +15,7 @@
 #include <optional>
 #include <random>
 
+#include "SogV1TestFiles.h"
 #include "TestUtility.h"
 #include "open3d/core/Exception.h"
 #include "open3d/core/Logging.h"
@@ -445,19 +446,8 @@ TEST(SogFormat, WrittenMetaFollowsTheSchema) {
     }
 }
 
-void ExpectError(const std::string& path, const std::vector<std::string>& parts) {
-    PointCloud cloud;
-    try {
-        ReadPointCloud(path, cloud);
-        ADD_FAILURE() << path << " was read";
-    } catch (const core::Open3DError& e) {
-        const std::string message = e.what();
-        EXPECT_NE(message.find(path), std::string::npos) << message;
-        for (const std::string& part : parts) {
-            EXPECT_NE(message.find(part), std::string::npos) << "'" << part << "' in: " << message;
-        }
-    }
-}
+// ExpectError: SogV1TestFiles.h (the same check for every SOG version).
+using sogv1::ExpectError;
 
 TEST(SogFormat, MalformedFilesFailCleanly) {
     const std::string dir = tests::TempDir();

@@ -21,22 +21,6 @@ namespace {
 using geometry::PointCloud;
 using namespace sogv1;
 
-/// Warnings logged while `f` runs.
-std::vector<std::string> Warnings(const std::function<void()>& f) {
-    std::vector<std::string> out;
-    auto previous = core::SetLogSink([&](core::LogLevel level, std::string_view msg) {
-        if (level == core::LogLevel::Warning) out.emplace_back(msg);
-    });
-    try {
-        f();
-    } catch (...) {
-        core::SetLogSink(previous);
-        throw;
-    }
-    core::SetLogSink(previous);
-    return out;
-}
-
 // meta.json's "model" and "antialias" act the same in version 1 and in version 2 (a file of
 // this library's writer with its meta.json edited).
 TEST(SogModel, AntialiasedWarnsTwoDgsIsRefusedUnknownWarns) {
@@ -76,7 +60,7 @@ TEST(SogModel, AntialiasedWarnsTwoDgsIsRefusedUnknownWarns) {
     };
     const auto read_warnings = [&](const std::string& path) {
         PointCloud c;
-        const std::vector<std::string> w = Warnings([&] { ReadPointCloud(path, c); });
+        const std::vector<std::string> w = tests::CaptureWarnings([&] { ReadPointCloud(path, c); });
         // The flags change nothing in what is read.
         EXPECT_TRUE(c == (path.find("/v2_") != std::string::npos ? cloud_v2 : cloud)) << path;
         return w;

@@ -20,14 +20,6 @@ namespace {
 
 using Bytes = std::vector<uint8_t>;
 
-void PutU32(Bytes& b, uint32_t v) {
-    for (int i = 0; i < 4; ++i) b.push_back(uint8_t(v >> (8 * i)));
-}
-void PutU64(Bytes& b, uint64_t v) {
-    PutU32(b, uint32_t(v));
-    PutU32(b, uint32_t(v >> 32));
-}
-
 constexpr uint32_t kMagic = 0x5053474e;  // "NGSP"
 constexpr uint32_t kClaimed = 100000000;
 
@@ -46,18 +38,18 @@ TEST(SpzBomb, V4StreamsAreNotDecompressedBeforeTheMemoryCheck) {
     // splat. Each stream's compressed size is the least the zstd bound (32768x) allows.
     const uint64_t per_splat[] = {9, 1, 3, 3, 4};
     Bytes b;
-    PutU32(b, kMagic);
-    PutU32(b, 4);
-    PutU32(b, kClaimed);
+    AppendU32(b, kMagic);
+    AppendU32(b, 4);
+    AppendU32(b, kClaimed);
     b.insert(b.end(), {0, 12, 0, 5});
-    PutU32(b, 32);  // the TOC right after the 32-byte header
+    AppendU32(b, 32);  // the TOC right after the 32-byte header
     b.resize(32, 0);
     uint64_t payload = 0;
     for (uint64_t bytes : per_splat) {
         const uint64_t uncompressed = bytes * kClaimed;
         const uint64_t compressed = (uncompressed + 32767) / 32768;
-        PutU64(b, compressed);
-        PutU64(b, uncompressed);
+        AppendU64(b, compressed);
+        AppendU64(b, uncompressed);
         payload += compressed;
     }
     b.resize(b.size() + payload, 0x5a);  // no zstd frame at all
@@ -76,9 +68,9 @@ TEST(SpzBomb, V4StreamsAreNotDecompressedBeforeTheMemoryCheck) {
 
 TEST(SpzBomb, GzipStreamInflatesItsHeaderFirst) {
     Bytes header;
-    PutU32(header, kMagic);
-    PutU32(header, 2);
-    PutU32(header, kClaimed);
+    AppendU32(header, kMagic);
+    AppendU32(header, 2);
+    AppendU32(header, kClaimed);
     header.insert(header.end(), {0, 12, 0, 0});
     // A gzip member of the header and 1 MB of zeros: the attributes it claims are nowhere.
     Bytes raw = header;

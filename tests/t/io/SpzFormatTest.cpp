@@ -69,13 +69,6 @@ using Bytes = std::vector<uint8_t>;
 
 // ---- assembling SPZ files by hand, as the spec lays them out ----
 
-void PutU32(Bytes& b, uint32_t v) {
-    for (int i = 0; i < 4; ++i) b.push_back(uint8_t(v >> (8 * i)));
-}
-void PutU64(Bytes& b, uint64_t v) {
-    PutU32(b, uint32_t(v));
-    PutU32(b, uint32_t(v >> 32));
-}
 uint32_t GetU32(const uint8_t* p) { return p[0] | p[1] << 8 | p[2] << 16 | uint32_t(p[3]) << 24; }
 uint64_t GetU64(const uint8_t* p) { return GetU32(p) | uint64_t(GetU32(p + 4)) << 32; }
 
@@ -89,9 +82,9 @@ struct RawSpz {
 
 Bytes LegacyBytes(const RawSpz& r, bool gzip = true) {
     Bytes b;
-    PutU32(b, 0x5053474e);
-    PutU32(b, r.version);
-    PutU32(b, r.n);
+    tests::AppendU32(b, 0x5053474e);
+    tests::AppendU32(b, r.version);
+    tests::AppendU32(b, r.n);
     b.insert(b.end(), {r.degree, r.fractional_bits, r.flags, 0});
     for (const Bytes& s : r.streams) b.insert(b.end(), s.begin(), s.end());
     b.insert(b.end(), r.extensions.begin(), r.extensions.end());
@@ -107,16 +100,16 @@ Bytes V4Bytes(const RawSpz& r) {
         sizes.push_back(s.size());
     }
     Bytes b;
-    PutU32(b, 0x5053474e);
-    PutU32(b, r.version);
-    PutU32(b, r.n);
+    tests::AppendU32(b, 0x5053474e);
+    tests::AppendU32(b, r.version);
+    tests::AppendU32(b, r.n);
     b.insert(b.end(), {r.degree, r.fractional_bits, r.flags, uint8_t(chunks.size())});
-    PutU32(b, uint32_t(32 + r.extensions.size()));
+    tests::AppendU32(b, uint32_t(32 + r.extensions.size()));
     b.resize(32, 0);
     b.insert(b.end(), r.extensions.begin(), r.extensions.end());
     for (size_t i = 0; i < chunks.size(); ++i) {
-        PutU64(b, chunks[i].size());
-        PutU64(b, sizes[i]);
+        tests::AppendU64(b, chunks[i].size());
+        tests::AppendU64(b, sizes[i]);
     }
     for (const Bytes& c : chunks) b.insert(b.end(), c.begin(), c.end());
     return b;
@@ -150,23 +143,6 @@ void PutFixed(Bytes& b, std::array<int32_t, 3> v) {
     for (int32_t x : v) {
         for (int i = 0; i < 3; ++i) b.push_back(uint8_t(uint32_t(x) >> (8 * i)));
     }
-}
-
-/// Warnings logged while `f` runs.
-template <typename F>
-std::vector<std::string> Warnings(F&& f) {
-    std::vector<std::string> out;
-    auto previous = core::SetLogSink([&](core::LogLevel level, std::string_view msg) {
-        if (level == core::LogLevel::Warning) out.emplace_back(msg);
-    });
-    try {
-        f();
-    } catch (...) {
-        core::SetLogSink(previous);
-        throw;
-    }
-    core::SetLogSink(previous);
-    return out;
 }
 
 void ExpectReadError(const std::string& path, std::initializer_list<const char*> needles) {
@@ -414,7 +390,7 @@ TEST(SpzFormat, AxisChangeAndRotationEncodings) {
     r.streams[2] = {0, 255, 128};
     r.streams[3] = {0, 160, 255};
     const uint32_t packed = 1u << 30 | (1u << 9 | 217) << 20 | 72u << 10 | 145;
-    PutU32(r.streams[4], packed);
+    tests::AppendU32(r.streams[4], packed);
     WriteBytes(dir + "/v3.spz", LegacyBytes(r));
     PointCloud c;
     ReadPointCloud(dir + "/v3.spz", c);
@@ -470,7 +446,7 @@ TEST(SpzFormat, SHSignsKeepTheColourUnderTheAxisChange) {
     r.streams[1] = {128};
     r.streams[2] = {128, 128, 128};
     r.streams[3] = {100, 100, 100};
-    PutU32(r.streams[4], 3u << 30);
+    tests::AppendU32(r.streams[4], 3u << 30);
     float stored[45];
     for (int k = 0; k < 45; ++k) {
         r.streams[5].push_back(uint8_t(20 + 5 * k));
@@ -524,36 +500,36 @@ TEST(SpzFormat, FlagsExtensionsAndDegreeFour) {
     r.streams[1] = {200};
     r.streams[2] = {1, 2, 3};
     r.streams[3] = {4, 5, 6};
-    PutU32(r.streams[4], 3u << 30);
+    tests::AppendU32(r.streams[4], 3u << 30);
     // Antialiased: read, and said in a warning.
     r.flags = 0x1;
     WriteBytes(dir + "/aa.spz", V4Bytes(r));
     PointCloud c;
-    auto w = Warnings([&] { ReadPointCloud(dir + "/aa.spz", c); });
+    auto w = tests::CaptureWarnings([&] { ReadPointCloud(dir + "/aa.spz", c); });
     ASSERT_EQ(w.size(), 1u);
     EXPECT_NE(w[0].find("antialiased"), std::string::npos);
     // Extensions: an unknown record is skipped with a warning; SPZ_ADOBE_coordinate_system
     // RDF (6) means no axis change.
     r.flags = 0x2;
-    PutU32(r.extensions, 0x12340001);
-    PutU32(r.extensions, 3);
+    tests::AppendU32(r.extensions, 0x12340001);
+    tests::AppendU32(r.extensions, 3);
     r.extensions.insert(r.extensions.end(), {9, 9, 9});
-    PutU32(r.extensions, 0xADBE0003);
-    PutU32(r.extensions, 4);
-    PutU32(r.extensions, 6);
+    tests::AppendU32(r.extensions, 0xADBE0003);
+    tests::AppendU32(r.extensions, 4);
+    tests::AppendU32(r.extensions, 6);
     WriteBytes(dir + "/ext.spz", V4Bytes(r));
-    w = Warnings([&] { ReadPointCloud(dir + "/ext.spz", c); });
+    w = tests::CaptureWarnings([&] { ReadPointCloud(dir + "/ext.spz", c); });
     ASSERT_EQ(w.size(), 1u);
     EXPECT_NE(w[0].find("0x12340001"), std::string::npos);
     EXPECT_EQ(F(c, "positions")[1], 2.0f);
     EXPECT_EQ(F(c, "positions")[2], 3.0f);
     r.extensions.resize(r.extensions.size() - 4);
-    PutU32(r.extensions, 10);  // RFD: the rotated family
+    tests::AppendU32(r.extensions, 10);  // RFD: the rotated family
     WriteBytes(dir + "/rfd.spz", V4Bytes(r));
     ExpectReadError(dir + "/rfd.spz", {"SPZ_ADOBE_coordinate_system", "10"});
     // Same in a gzip stream, records after the arrays.
     r.extensions.resize(r.extensions.size() - 4);
-    PutU32(r.extensions, 4);  // RUB, the default
+    tests::AppendU32(r.extensions, 4);  // RUB, the default
     r.version = 3;
     WriteBytes(dir + "/ext3.spz", LegacyBytes(r));
     ReadPointCloud(dir + "/ext3.spz", c);
@@ -564,7 +540,7 @@ TEST(SpzFormat, FlagsExtensionsAndDegreeFour) {
     r.degree = 4;
     for (int k = 0; k < 72; ++k) r.streams[5].push_back(uint8_t(k));
     WriteBytes(dir + "/deg4.spz", LegacyBytes(r));
-    w = Warnings([&] { ReadPointCloud(dir + "/deg4.spz", c); });
+    w = tests::CaptureWarnings([&] { ReadPointCloud(dir + "/deg4.spz", c); });
     ASSERT_EQ(w.size(), 1u);
     EXPECT_NE(w[0].find("band 4"), std::string::npos);
     EXPECT_EQ(c.GaussianSplatGetSHOrder(), 3);
@@ -578,7 +554,7 @@ TEST(SpzFormat, FuzzSeedsAreValid) {
          std::filesystem::directory_iterator(std::string(OPEN3D_TEST_SOURCE_DIR) + "/fuzz/seeds")) {
         if (entry.path().extension() != ".spz") continue;
         PointCloud cloud;
-        Warnings([&] { ReadPointCloud(entry.path().string(), cloud); });
+        tests::CaptureWarnings([&] { ReadPointCloud(entry.path().string(), cloud); });
         EXPECT_GT(cloud.NumPoints(), 0) << entry.path();
         ++count;
     }
@@ -643,7 +619,8 @@ TEST(SpzFormat, MalformedFiles) {
     trailing.insert(trailing.end(), {1, 2, 3});
     PointCloud cloud;
     ReadPointCloudReport report;
-    Warnings([&] { report = ReadPointCloud(write("trailing.spz", trailing), cloud); });
+    tests::CaptureWarnings(
+        [&] { report = ReadPointCloud(write("trailing.spz", trailing), cloud); });
     EXPECT_EQ(report.trailing_bytes, 3);
 
     // Legacy (gzip) layout.
