@@ -501,10 +501,25 @@ void AddLodRows(const Options& opt, const std::vector<int64_t>& budgets, const S
                 exact_filtered_psnr, t::geometry::ComputePSNR(exact.back(), filtered.back(), 1.0));
         }
     }
+    // The hierarchy's backend is another device context: the exact scene's buffers go first
+    // (the 98M-splat grid held both and failed on an 80 GB card), and come back after it is
+    // gone (declared first, so destroyed last).
+    struct RestoreScene {
+        rendering::GaussianSplatBackend& backend;
+        const t::geometry::PointCloud& cloud;
+        bool released = false;
+        ~RestoreScene() {
+            if (released) backend.SetScene(cloud);
+        }
+    } restore{backend, job.cloud};
     auto lod_backend = rendering::CreateGaussianSplatBackend(opt.backend);
     auto* vulkan = dynamic_cast<rendering::vulkan::GaussianSplatVulkanBackend*>(lod_backend.get());
     if (vulkan != nullptr) {
+        backend.ReleaseResources();
+        restore.released = true;
         vulkan->SetFramesInFlight(opt.frames_in_flight);
+        vulkan->CheckHierarchyFits(job.cloud.NumPoints(),
+                                   job.cloud.GetGaussianSplatArrays().sh_degree);
         vulkan->SetSceneHierarchy(job.cloud, hierarchy);
     }
     const double n = static_cast<double>(cams.size());

@@ -418,9 +418,11 @@ void VulkanContext::InitDevice(VkPhysicalDevice physical_device, uint32_t queue_
     }
     vkGetPhysicalDeviceMemoryProperties(physical_device, &memory_properties_);
     // Where the device reports a budget (VK_EXT_memory_budget: NVIDIA, AMD; a physical-device
-    // query, usable when the extension is supported), a heap's room is at most that budget:
-    // the heap size counts memory the driver and other processes hold, and allocations
-    // within it failed in the driver (VK_ERROR_OUT_OF_DEVICE_MEMORY) instead of being refused.
+    // query, usable when the extension is supported), a heap's room is at most that budget
+    // less what the process already uses: the heap size counts memory the driver, other
+    // processes and this process's other contexts hold, and each context kept its own
+    // count, so two contexts of one process (gs-bench's exact and level-of-detail backends)
+    // each saw the whole heap and the driver failed with VK_ERROR_OUT_OF_DEVICE_MEMORY.
     std::array<VkDeviceSize, VK_MAX_MEMORY_HEAPS> heap_budgets{};
     bool have_budgets = false;
     if (query.HasExtension(VK_EXT_MEMORY_BUDGET_EXTENSION_NAME)) {
@@ -431,8 +433,12 @@ void VulkanContext::InitDevice(VkPhysicalDevice physical_device, uint32_t queue_
             VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MEMORY_PROPERTIES_2);
         properties2.pNext = &budget_properties;
         vkGetPhysicalDeviceMemoryProperties2(physical_device, &properties2);
+        // heapBudget is what the whole process may use; what it already uses (another
+        // context, GL) is not this context's to take.
         for (uint32_t h = 0; h < memory_properties_.memoryHeapCount; ++h) {
-            heap_budgets[h] = budget_properties.heapBudget[h];
+            const VkDeviceSize budget = budget_properties.heapBudget[h];
+            const VkDeviceSize usage = budget_properties.heapUsage[h];
+            heap_budgets[h] = budget > usage ? budget - usage : 0;
         }
         have_budgets = true;
     }
