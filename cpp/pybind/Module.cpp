@@ -48,6 +48,7 @@ PYBIND11_MODULE(_core, m) {
     open3d::pybind::BindMaterial(rendering);
     open3d::pybind::BindIo(t_io);
     open3d::pybind::BindCamera(camera);
+    open3d::pybind::BindScene(rendering);
     open3d::pybind::BindRendering(rendering);
     open3d::pybind::BindVisualization(visualization);
 }

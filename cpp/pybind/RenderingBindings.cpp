@@ -1,5 +1,6 @@
-// visualization.rendering: OffscreenRenderer for splat scenes without a display (the splat
-// backends alone, no Filament), RenderConfig knobs as properties, batches of cameras.
+// visualization.rendering.OffscreenRenderer: splat scenes rendered to numpy arrays without a
+// display (the splat backends alone, no Filament), RenderConfig knobs as properties, batches
+// of cameras (the scene's bindings: SceneBindings.cpp; the state: SplatOffscreen).
 #include <pybind11/eigen.h>
 #include <pybind11/numpy.h>
 #include <pybind11/stl.h>
@@ -13,12 +14,8 @@
 
 #include "Bindings.h"
 #include "NumpyTensor.h"
-#include "PyPointCloud.h"
+#include "SplatOffscreen.h"
 #include "open3d/core/Exception.h"
-#include "open3d/t/geometry/TriangleMesh.h"
-#include "open3d/visualization/rendering/filament/MaterialRecord.h"
-#include "open3d/visualization/rendering/filament/OffscreenRenderer.h"
-#include "open3d/visualization/rendering/gaussian_splat/GaussianSplatRenderer.h"
 
 namespace py = pybind11;
 
@@ -27,211 +24,8 @@ namespace pybind {
 
 namespace {
 
-using visualization::rendering::GaussianSplatRenderer;
-using visualization::rendering::MaterialRecord;
 using visualization::rendering::RenderConfig;
 using visualization::rendering::RenderOutput;
-
-constexpr uint64_t kView = 0;  // the renderer's one view
-
-// The scene, its camera and its settings. Without meshes: the splat backend alone
-// (GaussianSplatRenderer, no display needed). With `meshes`: the Filament OffscreenRenderer
-// (meshes and splats composited by depth; needs an X server). Python's OffscreenRenderer and
-// its `scene` share one of these.
-class SplatOffscreen {
-public:
-    SplatOffscreen(int width, int height, const std::string& backend, bool meshes)
-        : width_(width), height_(height) {
-        if (width <= 0 || height <= 0) {
-            core::ThrowError("OffscreenRenderer: size must be positive, got {}x{}", width, height);
-        }
-        if (backend != "vulkan" && backend != "cpu") {
-            core::ThrowError("OffscreenRenderer: backend '{}' (vulkan or cpu)", backend);
-        }
-        if (!meshes) {
-            renderer_ = std::make_unique<GaussianSplatRenderer>(backend);
-            return;
-        }
-        visualization::rendering::Open3DSceneOptions options;
-        options.backend = backend;
-        try {
-            filament_ = std::make_unique<visualization::rendering::OffscreenRenderer>(width, height,
-                                                                                      options);
-        } catch (const core::Open3DError& e) {
-            core::ThrowError(
-                "OffscreenRenderer(meshes=True) draws with Filament, which needs an X server "
-                "(splats alone need none: leave meshes off): {}",
-                e.what());
-        }
-    }
-
-    bool HasMeshes() const { return filament_ != nullptr; }
-    RenderConfig& Config() { return config_; }
-    int Width() const { return width_; }
-    int Height() const { return height_; }
-    std::string BackendName() const {
-        return filament_ ? filament_->GetScene()->GetScene().GetBackend().GetName()
-                         : renderer_->GetBackendName();
-    }
-    const std::vector<std::string>& Names() const { return names_; }
-
-    void AddCloud(const std::string& name, const t::geometry::PointCloud& cloud,
-                  const std::optional<MaterialRecord>& material) {
-        if (filament_) {
-            if (material) {
-                filament_->GetScene()->AddGeometry(name, cloud, *material);
-            } else {
-                filament_->GetScene()->AddGeometry(name, cloud);
-            }
-        } else {
-            if (material && material->shader != visualization::rendering::kShaderGaussianSplat) {
-                core::ThrowError(
-                    "OffscreenRenderer: '{}' with shader '{}': without meshes=True only Gaussian "
-                    "splat clouds are drawn",
-                    name, material->shader);
-            }
-            renderer_->AddCloud(name, cloud);
-        }
-        names_.push_back(name);
-    }
-    void AddMesh(const std::string& name, const t::geometry::TriangleMesh& mesh,
-                 const MaterialRecord& material) {
-        if (!filament_) {
-            core::ThrowError(
-                "OffscreenRenderer: mesh '{}': meshes are drawn by Filament; create the renderer "
-                "with meshes=True (needs an X server)",
-                name);
-        }
-        filament_->GetScene()->AddGeometry(name, mesh, material);
-        names_.push_back(name);
-    }
-    void UpdateCloud(const std::string& name, const t::geometry::PointCloud& cloud) {
-        if (filament_) {
-            filament_->GetScene()->UpdateGeometry(name, cloud);
-        } else {
-            renderer_->UpdateCloud(name, cloud);
-        }
-    }
-    bool Remove(const std::string& name) {
-        const bool removed =
-            filament_ ? filament_->GetScene()->RemoveGeometry(name) : renderer_->RemoveCloud(name);
-        std::erase(names_, name);
-        return removed;
-    }
-    void Show(const std::string& name, bool show) {
-        if (filament_) {
-            filament_->GetScene()->ShowGeometry(name, show);
-        } else {
-            renderer_->ShowCloud(name, show);
-        }
-    }
-    bool Has(const std::string& name) const {
-        return filament_ ? filament_->GetScene()->HasGeometry(name) : renderer_->HasCloud(name);
-    }
-    void Clear() {
-        if (filament_) {
-            filament_->GetScene()->ClearGeometry();
-        } else {
-            renderer_->Clear();
-        }
-        names_.clear();
-    }
-    GaussianSplatRenderer& SplatRenderer() const {
-        return filament_ ? filament_->GetScene()->GetScene().GetSplatRenderer() : *renderer_;
-    }
-    void SetBackground(const Eigen::Vector3d& rgb) {
-        config_.background = rgb;
-        if (filament_) {
-            filament_->GetScene()->SetBackground(rgb.cast<float>().homogeneous());
-        }
-    }
-
-    /// Uses the camera at the renderer's size.
-    void SetCamera(const camera::PinholeCamera& camera) {
-        camera_ = Sized(camera);
-        has_camera_ = true;
-    }
-    const camera::PinholeCamera& Camera() const {
-        if (!has_camera_) core::ThrowError("OffscreenRenderer: call setup_camera first");
-        return camera_;
-    }
-
-    RenderOutput Render(bool expected_depth, bool median_depth) {
-        const camera::PinholeCamera camera = Camera();
-        RequireVisibleSplats();
-        RenderOutput out;
-        visualization::rendering::CompositeInputs inputs;
-        inputs.expected_depth = expected_depth;
-        inputs.median_depth = median_depth;
-        py::gil_scoped_release release;
-        renderer_->Prepare();
-        renderer_->RenderGeometryStage(kView, camera, config_);
-        renderer_->RenderCompositeStage(kView, out, inputs);
-        return out;
-    }
-
-    /// Filament's frame: UInt8 [H, W, 3], or the view z Float32 [H, W, 1] with `depth`.
-    t::geometry::Image RenderWithMeshes(bool depth) {
-        const camera::PinholeCamera camera = Camera();
-        // The knobs go to the scene's splat settings (background stays the view's).
-        RenderConfig& splat = filament_->GetScene()->GetSplatConfig();
-        splat.sh_degree = config_.sh_degree;
-        splat.antialias = config_.antialias;
-        splat.near_plane = config_.near_plane;
-        splat.compact_storage = config_.compact_storage;
-        filament_->SetupCamera(camera);
-        py::gil_scoped_release release;
-        return depth ? filament_->RenderToDepthImage(true) : filament_->RenderToImage();
-    }
-
-    /// Renders into `destination` (N x H x W x 4 elements of float32, or uint8 with `uint8`),
-    /// which lies in `memory` when that is set (the device then copies into it directly).
-    void RenderBatch(const std::vector<camera::PinholeCamera>& cameras, bool uint8,
-                     uint8_t* destination,
-                     const visualization::rendering::BatchHostMemory& memory = {}) {
-        if (filament_) {
-            core::ThrowError("render_batch: batches are for splat-only renderers (meshes=False)");
-        }
-        if (renderer_->IsStreaming()) {
-            // A batch draws the pool as it stands and gives the stream no view.
-            core::ThrowError(
-                "render_batch: not while a stream runs (render_to_image streams for its view)");
-        }
-        std::vector<camera::PinholeCamera> sized;
-        for (const camera::PinholeCamera& c : cameras) sized.push_back(Sized(c));
-        RequireVisibleSplats();
-        visualization::rendering::BatchOptions options;
-        options.color_uint8 = uint8;
-        options.color_destination = destination;
-        options.color_memory = memory;
-        py::gil_scoped_release release;
-        renderer_->Prepare();
-        // The batch replaces the view's sorted entries in the backend.
-        renderer_->ReleaseView(kView);
-        renderer_->GetBackend().RenderBatch(sized, config_, options);
-    }
-
-private:
-    /// Validated, with its intrinsics scaled to the renderer's size when its size differs.
-    camera::PinholeCamera Sized(const camera::PinholeCamera& camera) const {
-        camera.Validate();
-        return camera.width == width_ && camera.height == height_ ? camera
-                                                                  : camera.Resized(width_, height_);
-    }
-    void RequireVisibleSplats() const {
-        if (!renderer_->HasVisibleSplats()) {
-            core::ThrowError("OffscreenRenderer: the scene has no visible splat cloud");
-        }
-    }
-
-    int width_, height_;
-    std::unique_ptr<GaussianSplatRenderer> renderer_;
-    std::unique_ptr<visualization::rendering::OffscreenRenderer> filament_;
-    std::vector<std::string> names_;
-    RenderConfig config_;
-    camera::PinholeCamera camera_;
-    bool has_camera_ = false;
-};
 
 using Offscreen = std::shared_ptr<SplatOffscreen>;
 
@@ -270,10 +64,6 @@ visualization::rendering::BatchHostMemory BatchMemoryOf(const py::array& array) 
     return {};
 }
 
-struct SplatScene {
-    Offscreen renderer;
-};
-
 py::array ColorArray(RenderOutput& out, const std::string& dtype) {
     if (dtype == "float32") return ArrayFromImage(std::move(out.color));
     return ArrayFromImage(out.color.SelectChannels(0, 3).ToUInt8());
@@ -293,121 +83,6 @@ void CheckDtype(const std::string& dtype) {
 }  // namespace
 
 void BindRendering(py::module_& m) {
-    py::class_<SplatScene>(m, "Scene",
-                           "The geometry of an OffscreenRenderer, by name: Gaussian splat "
-                           "clouds, and with meshes=True meshes and point clouds too")
-        .def(
-            "add_geometry",
-            [](SplatScene& s, const std::string& name, const PyPointCloud& cloud,
-               const std::optional<MaterialRecord>& material) {
-                s.renderer->AddCloud(name, cloud.cloud, material);
-            },
-            py::arg("name"), py::arg("geometry"), py::arg("material") = py::none(),
-            "Adds a copy of a cloud (a Gaussian splat cloud unless the material says otherwise); "
-            "raises for a taken name or a cloud without the Gaussian attributes")
-        .def(
-            "add_geometry",
-            [](SplatScene& s, const std::string& name, const t::geometry::TriangleMesh& mesh,
-               const std::optional<MaterialRecord>& material) {
-                s.renderer->AddMesh(name, mesh, material.value_or(MaterialRecord{}));
-            },
-            py::arg("name"), py::arg("geometry"), py::arg("material") = py::none(),
-            "Adds a copy of a mesh (renderers made with meshes=True)")
-        .def(
-            "update_geometry",
-            [](SplatScene& s, const std::string& name, const PyPointCloud& cloud) {
-                s.renderer->UpdateCloud(name, cloud.cloud);
-            },
-            py::arg("name"), py::arg("geometry"))
-        .def(
-            "remove_geometry",
-            [](SplatScene& s, const std::string& name) { return s.renderer->Remove(name); },
-            py::arg("name"))
-        .def(
-            "show_geometry",
-            [](SplatScene& s, const std::string& name, bool show) { s.renderer->Show(name, show); },
-            py::arg("name"), py::arg("show"))
-        .def(
-            "has_geometry",
-            [](const SplatScene& s, const std::string& name) { return s.renderer->Has(name); },
-            py::arg("name"))
-        .def(
-            "clear_geometry", [](SplatScene& s) { s.renderer->Clear(); },
-            "Removes every geometry and ends a stream")
-        .def(
-            "stream_splats",
-            [](SplatScene& s, const std::string& path, const py::object& gpu_budget,
-               int64_t splat_budget, int64_t reads_per_step, std::optional<bool> compact_storage) {
-                visualization::rendering::SplatStreamOptions options;
-                if (py::isinstance<py::str>(gpu_budget)) {
-                    options.gpu_budget =
-                        visualization::rendering::ParseGpuBudget(gpu_budget.cast<std::string>());
-                } else if (py::isinstance<py::int_>(gpu_budget) &&
-                           !py::isinstance<py::bool_>(gpu_budget) &&
-                           gpu_budget.cast<py::int_>() >= py::int_(0)) {
-                    options.gpu_budget = gpu_budget.cast<uint64_t>();
-                } else {
-                    core::ThrowError(
-                        "stream_splats: gpu_budget {} is neither bytes (an int >= 0, 0: the "
-                        "default) nor a size such as '2G' or 'auto'",
-                        py::repr(gpu_budget).cast<std::string>());
-                }
-                options.splat_budget = splat_budget;
-                options.reads_per_step = reads_per_step;
-                options.compact_storage =
-                    compact_storage.value_or(s.renderer->Config().compact_storage);
-                s.renderer->SplatRenderer().StreamSplats(path, options);
-            },
-            py::arg("path"), py::arg("gpu_budget") = 0, py::arg("splat_budget") = 0,
-            py::arg("reads_per_step") = 16, py::arg("compact_storage") = py::none(),
-            "Streams a paged file (write_splat_pages, gs-convert --pages) as the splat scene "
-            "(docs/streaming.md): its pages are read on a worker thread into a GPU pool of "
-            "gpu_budget bytes (an int, or a str such as '512M' or '2G'; 0 or 'auto': 1 GiB, or "
-            "what the device holds in one scene where that is less) for the view of each "
-            "render; each render shows the pages read since the one before. splat_budget: nodes "
-            "a cut may draw (0: what the pool holds). compact_storage: the pool at half precision "
-            "(about 1.8 times the splats in gpu_budget; None: the renderer's compact_storage); "
-            "the stream draws at its pool's precision. Raises Open3DError while splat clouds are "
-            "held, for a refused file, or with the cpu backend (only vulkan streams).")
-        .def(
-            "stop_streaming",
-            [](SplatScene& s) { return s.renderer->SplatRenderer().StopStreaming(); },
-            "Ends the stream and frees its pool; False when there was none")
-        .def_property_readonly(
-            "stream_progress",
-            [](const SplatScene& s) -> py::object {
-                const auto p = s.renderer->SplatRenderer().GetStreamProgress();
-                if (!p) return py::none();
-                py::dict d;
-                d["path"] = p->path;
-                d["file_pages"] = p->file_pages;
-                d["pool_pages"] = p->pool_pages;
-                d["resident_pages"] = p->resident_pages;
-                d["pages_read"] = p->pages_read;
-                d["bytes_read"] = p->bytes_read;
-                d["evictions"] = p->evictions;
-                d["nodes_drawn"] = p->nodes_drawn;
-                d["pages_wanted"] = p->pages_wanted;
-                d["starved"] = p->starved;
-                d["settled"] = p->settled;
-                d["error"] = p->error;
-                d["text"] = visualization::rendering::FormatStreamProgress(*p);
-                return d;
-            },
-            "None when not streaming; else a dict as of the last render: file_pages, pool_pages, "
-            "resident_pages, pages_read, bytes_read, evictions, nodes_drawn (by the newest cut), "
-            "pages_wanted (pages that cut lacks), starved (the pool is full for this view), "
-            "settled (nothing more will change for this view: the last render showed it all), "
-            "error, and text (the viewer panel's line)")
-        .def_property_readonly("geometry_names",
-                               [](const SplatScene& s) { return s.renderer->Names(); })
-        .def(
-            "set_background",
-            [](SplatScene& s, const Eigen::Vector3d& rgb) { s.renderer->SetBackground(rgb); },
-            py::arg("rgb"),
-            "Linear RGB where nothing is drawn (default black: splat colours are then "
-            "premultiplied)");
-
     py::class_<SplatOffscreen, Offscreen>(
         m, "OffscreenRenderer",
         "Renders scenes to numpy arrays. Default: splat clouds only, drawn by the splat backend "
