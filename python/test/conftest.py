@@ -28,6 +28,15 @@ def data():
     return path
 
 
+@pytest.fixture(scope="module")
+def playbot():
+    """playbot_31k (SH degree 2) and its cameras, read once per test module."""
+    path = DATA / "playbot/playbot_31k.ply"
+    if not path.exists():
+        unavailable(f"shared scene {path} is absent")
+    return o3d.t.io.read_point_cloud(str(path)), o3d.camera.read_cameras_json(str(DATA / "playbot/cameras.json"))
+
+
 @pytest.fixture
 def gs_render():
     exe = os.environ.get("GS_RENDER", "")
