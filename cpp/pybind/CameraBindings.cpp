@@ -2,13 +2,16 @@
 // look-at; the 3DGS convention (x right, y down, z forward) throughout.
 #include <pybind11/eigen.h>
 #include <pybind11/stl.h>
+#include <pybind11/stl/filesystem.h>
 
 #include <fmt/format.h>
 
+#include <filesystem>
 #include <string>
 #include <vector>
 
 #include "Bindings.h"
+#include "PathArgs.h"
 #include "open3d/camera/CamerasJson.h"
 #include "open3d/camera/PinholeCamera.h"
 #include "open3d/core/Exception.h"
@@ -95,9 +98,15 @@ void BindCamera(py::module_& m) {
         .def_readonly("id", &camera::CameraView::id)
         .def_readonly("img_name", &camera::CameraView::img_name)
         .def_readonly("camera", &camera::CameraView::camera);
-    m.def("read_cameras_json", &camera::ReadCamerasJson, py::arg("filename"),
-          "Every view of a 3DGS cameras.json, in file order; raises naming the file, the entry "
-          "and the field for malformed input.");
+    m.def(
+        "read_cameras_json",
+        [](const std::filesystem::path& filename) {
+            return camera::ReadCamerasJson(InputPath(filename));
+        },
+        py::arg("filename"),
+        "Every view of a 3DGS cameras.json (a str or os.PathLike), in file order; raises "
+        "naming the file, the entry and the field for malformed input, and "
+        "Open3DFileNotFoundError (also a FileNotFoundError) for a missing file.");
 }
 
 }  // namespace pybind

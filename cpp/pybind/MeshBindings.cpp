@@ -10,6 +10,7 @@
 
 #include "Bindings.h"
 #include "NumpyTensor.h"
+#include "PyMaterial.h"
 #include "open3d/core/Exception.h"
 #include "open3d/t/geometry/TriangleMesh.h"
 #include "open3d/visualization/rendering/filament/MaterialRecord.h"
@@ -79,15 +80,35 @@ void BindMesh(py::module_& m) {
 
 void BindMaterial(py::module_& m) {
     using visualization::rendering::MaterialRecord;
-    py::class_<MaterialRecord>(m, "MaterialRecord",
-                               "How a geometry is drawn: shader 'defaultUnlit', 'defaultLit' "
-                               "(meshes, points) or 'gaussianSplat'")
-        .def(py::init<>())
-        .def_readwrite("shader", &MaterialRecord::shader)
-        .def_readwrite("base_color", &MaterialRecord::base_color)
-        .def_readwrite("point_size", &MaterialRecord::point_size)
-        .def_readwrite("gaussian_splat_sh_degree", &MaterialRecord::gaussian_splat_sh_degree)
-        .def_readwrite("gaussian_splat_antialias", &MaterialRecord::gaussian_splat_antialias);
+    py::class_<PyMaterialRecord>(
+        m, "MaterialRecord",
+        "How a geometry is drawn, as Open3D's: shader 'defaultUnlit', 'defaultLit' (meshes, "
+        "points) or 'gaussianSplat'. While shader is left unset the geometry is drawn its own "
+        "way: a Gaussian splat cloud as splats (what a renderer without meshes draws), a plain "
+        "cloud as points, a mesh unlit; reading it gives Open3D's default, 'defaultUnlit'.")
+        .def(py::init<>(), "Open3D's defaults; the shader left to the geometry (see the class)")
+        .def_property(
+            "shader", [](const PyMaterialRecord& r) { return r.shader; },
+            [](PyMaterialRecord& r, const std::string& shader) {
+                r.shader = shader;
+                r.shader_set = true;
+            },
+            "'defaultUnlit', 'defaultLit' or 'gaussianSplat'")
+        .def_readwrite("base_color", &PyMaterialRecord::base_color,
+                       "Linear RGBA multiplied with the vertex colours")
+        .def_readwrite("point_size", &PyMaterialRecord::point_size,
+                       "Point clouds drawn as points: the side of each point in pixels")
+        .def_readwrite("gaussian_splat_sh_degree", &PyMaterialRecord::gaussian_splat_sh_degree,
+                       "'gaussianSplat': the highest SH band used (0..3)")
+        .def_readwrite("gaussian_splat_antialias", &PyMaterialRecord::gaussian_splat_antialias,
+                       "'gaussianSplat': Mip-Splatting's antialias, for clouds trained with it")
+        .def(
+            "__repr__",
+            [](const PyMaterialRecord& r) {
+                return fmt::format("MaterialRecord(shader='{}'{})", r.shader,
+                                   r.shader_set ? "" : ", unset: the geometry's own way");
+            },
+            "The shader, and whether it was set");
 }
 
 }  // namespace pybind

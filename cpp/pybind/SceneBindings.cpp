@@ -2,11 +2,15 @@
 // paged files it streams.
 #include <pybind11/eigen.h>
 #include <pybind11/stl.h>
+#include <pybind11/stl/filesystem.h>
 
+#include <filesystem>
 #include <optional>
 #include <string>
 
 #include "Bindings.h"
+#include "PathArgs.h"
+#include "PyMaterial.h"
 #include "PyPointCloud.h"
 #include "SplatOffscreen.h"
 #include "open3d/core/Exception.h"
@@ -27,8 +31,8 @@ void BindScene(py::module_& m) {
         .def(
             "add_geometry",
             [](SplatScene& s, const std::string& name, const PyPointCloud& cloud,
-               const std::optional<MaterialRecord>& material) {
-                s.renderer->AddCloud(name, cloud.cloud, material);
+               const std::optional<PyMaterialRecord>& material) {
+                s.renderer->AddCloud(name, cloud.cloud, CloudMaterial(material));
             },
             py::arg("name"), py::arg("geometry"), py::arg("material") = py::none(),
             "Adds a copy of a cloud (a Gaussian splat cloud unless the material says otherwise); "
@@ -36,8 +40,9 @@ void BindScene(py::module_& m) {
         .def(
             "add_geometry",
             [](SplatScene& s, const std::string& name, const t::geometry::TriangleMesh& mesh,
-               const std::optional<MaterialRecord>& material) {
-                s.renderer->AddMesh(name, mesh, material.value_or(MaterialRecord{}));
+               const std::optional<PyMaterialRecord>& material) {
+                s.renderer->AddMesh(name, mesh,
+                                    material ? MaterialRecord(*material) : MaterialRecord{});
             },
             py::arg("name"), py::arg("geometry"), py::arg("material") = py::none(),
             "Adds a copy of a mesh (renderers made with meshes=True)")
@@ -64,7 +69,7 @@ void BindScene(py::module_& m) {
             "Removes every geometry and ends a stream")
         .def(
             "stream_splats",
-            [](SplatScene& s, const std::string& path, const py::object& gpu_budget,
+            [](SplatScene& s, const std::filesystem::path& path, const py::object& gpu_budget,
                int64_t splat_budget, int64_t reads_per_step, std::optional<bool> compact_storage) {
                 visualization::rendering::SplatStreamOptions options;
                 if (py::isinstance<py::str>(gpu_budget)) {
@@ -84,7 +89,7 @@ void BindScene(py::module_& m) {
                 options.reads_per_step = reads_per_step;
                 options.compact_storage =
                     compact_storage.value_or(s.renderer->Config().compact_storage);
-                s.renderer->SplatRenderer().StreamSplats(path, options);
+                s.renderer->SplatRenderer().StreamSplats(InputPath(path), options);
             },
             py::arg("path"), py::arg("gpu_budget") = 0, py::arg("splat_budget") = 0,
             py::arg("reads_per_step") = 16, py::arg("compact_storage") = py::none(),

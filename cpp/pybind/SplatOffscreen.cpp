@@ -62,8 +62,10 @@ void SplatOffscreen::AddCloud(const std::string& name, const t::geometry::PointC
     } else {
         if (material && material->shader != visualization::rendering::kShaderGaussianSplat) {
             core::ThrowError(
-                "OffscreenRenderer: '{}' with shader '{}': without meshes=True only Gaussian "
-                "splat clouds are drawn",
+                "OffscreenRenderer: '{}' with shader '{}': a renderer without meshes=True draws "
+                "Gaussian splat clouds only; set material.shader = 'gaussianSplat' (or leave "
+                "it unset) to draw the cloud as splats, or create the renderer with "
+                "meshes=True to draw points",
                 name, material->shader);
         }
         renderer_->AddCloud(name, cloud);
