@@ -130,8 +130,8 @@ void SplatOffscreen::SetBackground(const Eigen::Vector3d& rgb) {
     if (filament_) filament_->GetScene()->SetBackground(rgb.cast<float>().homogeneous());
 }
 
-void SplatOffscreen::SetCamera(const camera::PinholeCamera& camera) {
-    camera_ = Sized(camera);
+void SplatOffscreen::SetCamera(const camera::PinholeCamera& camera, bool rescale) {
+    camera_ = Sized(camera, rescale, "setup_camera: the camera");
     has_camera_ = true;
 }
 
@@ -167,8 +167,8 @@ t::geometry::Image SplatOffscreen::RenderWithMeshes(bool depth) {
     return depth ? filament_->RenderToDepthImage(true) : filament_->RenderToImage();
 }
 
-void SplatOffscreen::RenderBatch(const std::vector<camera::PinholeCamera>& cameras, bool uint8,
-                                 uint8_t* destination,
+void SplatOffscreen::RenderBatch(const std::vector<camera::PinholeCamera>& cameras, bool rescale,
+                                 bool uint8, uint8_t* destination,
                                  const visualization::rendering::BatchHostMemory& memory) {
     if (filament_) {
         core::ThrowError("render_batch: batches are for splat-only renderers (meshes=False)");
@@ -179,7 +179,9 @@ void SplatOffscreen::RenderBatch(const std::vector<camera::PinholeCamera>& camer
             "render_batch: not while a stream runs (render_to_image streams for its view)");
     }
     std::vector<camera::PinholeCamera> sized;
-    for (const camera::PinholeCamera& c : cameras) sized.push_back(Sized(c));
+    for (size_t i = 0; i < cameras.size(); ++i) {
+        sized.push_back(Sized(cameras[i], rescale, fmt::format("render_batch: camera {}", i)));
+    }
     RequireVisibleSplats();
     visualization::rendering::BatchOptions options;
     options.color_uint8 = uint8;
@@ -192,10 +194,19 @@ void SplatOffscreen::RenderBatch(const std::vector<camera::PinholeCamera>& camer
     renderer_->GetBackend().RenderBatch(sized, config_, options);
 }
 
-camera::PinholeCamera SplatOffscreen::Sized(const camera::PinholeCamera& camera) const {
+camera::PinholeCamera SplatOffscreen::Sized(const camera::PinholeCamera& camera, bool rescale,
+                                            const std::string& what) const {
     camera.Validate();
-    return camera.width == width_ && camera.height == height_ ? camera
-                                                              : camera.Resized(width_, height_);
+    if (camera.width == width_ && camera.height == height_) return camera;
+    if (!rescale) {
+        core::ThrowError(
+            "{} is {}x{}, the renderer's picture {}x{}: pass rescale=True to scale its "
+            "intrinsics to {}x{} (another aspect ratio stretches the picture), or make the "
+            "renderer {}x{}",
+            what, camera.width, camera.height, width_, height_, width_, height_, camera.width,
+            camera.height);
+    }
+    return camera.Resized(width_, height_);
 }
 
 void SplatOffscreen::RequireVisibleSplats() const {

@@ -27,6 +27,7 @@ public:
 
     bool HasMeshes() const { return filament_ != nullptr; }
     visualization::rendering::RenderConfig& Config() { return config_; }
+    const visualization::rendering::RenderConfig& Config() const { return config_; }
     int Width() const { return width_; }
     int Height() const { return height_; }
     std::string BackendName() const;
@@ -45,8 +46,10 @@ public:
     visualization::rendering::GaussianSplatRenderer& SplatRenderer() const;
     void SetBackground(const Eigen::Vector3d& rgb);
 
-    /// Uses the camera at the renderer's size.
-    void SetCamera(const camera::PinholeCamera& camera);
+    /// Uses the camera. A camera of another size than the renderer's is refused unless
+    /// `rescale`, which scales its intrinsics to the renderer's size (another aspect ratio
+    /// stretches the picture: what used to happen unasked).
+    void SetCamera(const camera::PinholeCamera& camera, bool rescale);
     const camera::PinholeCamera& Camera() const;
 
     /// The splat backend's frame of the current camera (renderers without meshes).
@@ -55,13 +58,15 @@ public:
     t::geometry::Image RenderWithMeshes(bool depth);
     /// Renders into `destination` (N x H x W x 4 elements of float32, or uint8 with `uint8`),
     /// which lies in `memory` when that is set (the device then copies into it directly).
-    void RenderBatch(const std::vector<camera::PinholeCamera>& cameras, bool uint8,
+    /// Cameras of another size are refused unless `rescale` (as SetCamera).
+    void RenderBatch(const std::vector<camera::PinholeCamera>& cameras, bool rescale, bool uint8,
                      uint8_t* destination,
                      const visualization::rendering::BatchHostMemory& memory = {});
 
 private:
-    /// Validated, with its intrinsics scaled to the renderer's size when its size differs.
-    camera::PinholeCamera Sized(const camera::PinholeCamera& camera) const;
+    /// Validated and at the renderer's size (see SetCamera); `what` names it in errors.
+    camera::PinholeCamera Sized(const camera::PinholeCamera& camera, bool rescale,
+                                const std::string& what) const;
     void RequireVisibleSplats() const;
 
     int width_, height_;

@@ -69,7 +69,7 @@ def test_meshes_need_meshes_true():
         r.scene.add_geometry("box", o3d.t.geometry.TriangleMesh.create_box())
     points = o3d.visualization.rendering.MaterialRecord()
     points.shader = "defaultUnlit"
-    with pytest.raises(o3d.Open3DError, match="only Gaussian splat clouds"):
+    with pytest.raises(o3d.Open3DError, match="draws Gaussian splat clouds only; set material.shader = 'gaussianSplat'"):
         r.scene.add_geometry("points", wall(), points)
 
 
