@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -105,7 +106,7 @@ void BindCamera(py::module_& m) {
         "down, z forward). A world point p projects to c = R p + t, then to the pixel "
         "(fx c.x / c.z + cx, fy c.y / c.z + cy).")
         .def(py::init([](int width, int height, double fx, double fy, double cx, double cy,
-                         const Eigen::Matrix4d& world_to_camera) {
+                         const std::optional<Eigen::Matrix4d>& world_to_camera) {
                  PinholeCamera c;
                  c.width = width;
                  c.height = height;
@@ -113,14 +114,14 @@ void BindCamera(py::module_& m) {
                  c.fy = fy;
                  c.cx = cx;
                  c.cy = cy;
-                 c.world_to_camera = world_to_camera;
+                 c.world_to_camera = world_to_camera.value_or(Eigen::Matrix4d::Identity());
                  c.Validate();
                  return c;
              }),
              py::arg("width"), py::arg("height"), py::arg("fx"), py::arg("fy"), py::arg("cx"),
-             py::arg("cy"), py::arg("world_to_camera") = Eigen::Matrix4d::Identity(),
+             py::arg("cy"), py::arg("world_to_camera") = py::none(),
              "A camera of an image size, focal lengths and principal point in pixels, and a "
-             "world-to-camera extrinsic")
+             "world-to-camera extrinsic (default: the identity)")
         .def_static(
             "from_intrinsics_extrinsics",
             [](const Eigen::Matrix3d& K, const Eigen::Matrix4d& extrinsic, int width, int height) {

@@ -48,13 +48,17 @@ void BindMesh(py::module_& m) {
                  mesh.Validate();
                  return mesh;
              }),
-             py::arg("vertices"), py::arg("triangles"))
+             py::arg("vertices"), py::arg("triangles"),
+             "A mesh of vertices [N, 3] (any real dtype, copied as float32) and triangles [M, "
+             "3] of vertex indices")
         .def_static("create_sphere", &TriangleMesh::CreateSphere, py::arg("radius") = 1.0,
-                    py::arg("resolution") = 20)
+                    py::arg("resolution") = 20, "A UV sphere about the origin")
         .def_static("create_box", &TriangleMesh::CreateBox, py::arg("width") = 1.0,
-                    py::arg("height") = 1.0, py::arg("depth") = 1.0)
-        .def("num_vertices", &TriangleMesh::NumVertices)
-        .def("num_triangles", &TriangleMesh::NumTriangles)
+                    py::arg("height") = 1.0, py::arg("depth") = 1.0,
+                    "A box with one corner at the origin and the opposite one at (width, "
+                    "height, depth)")
+        .def("num_vertices", &TriangleMesh::NumVertices, "The number of vertices")
+        .def("num_triangles", &TriangleMesh::NumTriangles, "The number of triangles")
         .def_property_readonly(
             "vertices",
             [](const TriangleMesh& mesh) { return CopyOfTensor(mesh.GetVertexPositions()); },
@@ -71,11 +75,15 @@ void BindMesh(py::module_& m) {
             [](TriangleMesh& mesh, const Eigen::Vector3d& t) -> TriangleMesh& {
                 return mesh.Translate(t);
             },
-            py::arg("translation"), py::return_value_policy::reference_internal)
-        .def("__repr__", [](const TriangleMesh& mesh) {
-            return fmt::format("TriangleMesh with {} vertices and {} triangles", mesh.NumVertices(),
-                               mesh.NumTriangles());
-        });
+            py::arg("translation"), py::return_value_policy::reference_internal,
+            "Moves the vertices by translation; returns the mesh")
+        .def(
+            "__repr__",
+            [](const TriangleMesh& mesh) {
+                return fmt::format("TriangleMesh with {} vertices and {} triangles",
+                                   mesh.NumVertices(), mesh.NumTriangles());
+            },
+            "The vertex and triangle counts");
 }
 
 void BindMaterial(py::module_& m) {

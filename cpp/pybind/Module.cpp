@@ -33,11 +33,14 @@ py::object Decoded(const std::string& text) {
 
 PYBIND11_MODULE(_core, m) {
     m.doc() = "open3d_gs: Gaussian splat scenes from Python (docs/python.md)";
+    m.attr("__version__") = OPEN3D_GS_VERSION;  // the project's version (CMakeLists.txt)
     // The C++ library's errors arrive as open3d_gs.Open3DError (a RuntimeError) with the
     // C++ message; a missing input file as Open3DFileNotFoundError, which is Open3DError and
     // FileNotFoundError both, so that code written for either catches it.
     static py::exception<open3d::core::Open3DError> open3d_error(m, "Open3DError",
                                                                  PyExc_RuntimeError);
+    open3d_error.attr("__doc__") =
+        "An error of the C++ library (a bad file, argument or device), with its message";
     py::dict scope;
     scope["__name__"] = "open3d_gs";
     scope["Open3DError"] = open3d_error;

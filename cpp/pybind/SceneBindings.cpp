@@ -51,19 +51,20 @@ void BindScene(py::module_& m) {
             [](SplatScene& s, const std::string& name, const PyPointCloud& cloud) {
                 s.renderer->UpdateCloud(name, cloud.cloud);
             },
-            py::arg("name"), py::arg("geometry"))
+            py::arg("name"), py::arg("geometry"),
+            "Replaces the cloud of that name by a copy of this one")
         .def(
             "remove_geometry",
             [](SplatScene& s, const std::string& name) { return s.renderer->Remove(name); },
-            py::arg("name"))
+            py::arg("name"), "Removes the geometry; False when there was none of that name")
         .def(
             "show_geometry",
             [](SplatScene& s, const std::string& name, bool show) { s.renderer->Show(name, show); },
-            py::arg("name"), py::arg("show"))
+            py::arg("name"), py::arg("show"), "Shows or hides the geometry (kept in the scene)")
         .def(
             "has_geometry",
             [](const SplatScene& s, const std::string& name) { return s.renderer->Has(name); },
-            py::arg("name"))
+            py::arg("name"), "Whether a geometry of that name is in the scene")
         .def(
             "clear_geometry", [](SplatScene& s) { s.renderer->Clear(); },
             "Removes every geometry and ends a stream")
@@ -132,8 +133,9 @@ void BindScene(py::module_& m) {
             "pages_wanted (pages that cut lacks), starved (the pool is full for this view), "
             "settled (nothing more will change for this view: the last render showed it all), "
             "error, and text (the viewer panel's line)")
-        .def_property_readonly("geometry_names",
-                               [](const SplatScene& s) { return s.renderer->Names(); })
+        .def_property_readonly(
+            "geometry_names", [](const SplatScene& s) { return s.renderer->Names(); },
+            "The names, in the order they were added")
         .def(
             "set_background",
             [](SplatScene& s, const Eigen::Vector3d& rgb) { s.renderer->SetBackground(rgb); },
