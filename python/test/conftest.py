@@ -45,6 +45,13 @@ def gs_render():
     return exe
 
 
+@pytest.fixture
+def display():
+    """An X server: Filament (meshes, the viewer) needs one."""
+    if not os.environ.get("DISPLAY"):
+        unavailable("DISPLAY is not set: meshes and the viewer need an X server (run under xvfb-run; ctest does)")
+
+
 @pytest.fixture(params=["vulkan", "cpu"])
 def backend(request):
     """Both backends; the Vulkan one needs a device (lavapipe without a GPU)."""

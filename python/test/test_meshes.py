@@ -8,15 +8,8 @@ import numpy as np
 import pytest
 
 import open3d_gs as o3d
-from conftest import unavailable
 
 Renderer = o3d.visualization.rendering.OffscreenRenderer
-
-
-@pytest.fixture
-def display():
-    if not os.environ.get("DISPLAY"):
-        unavailable("DISPLAY is not set: meshes need an X server (run under xvfb-run; ctest does)")
 
 
 def wall(n=20):

@@ -90,6 +90,15 @@ def test_draw_takes_open3d_dict_items(tmp_path):
         o3d.visualization.draw([o3d.t.geometry.PointCloud(), {"name": "a"}])
 
 
+def test_draw_opens_the_viewer_with_dict_items(playbot, display):
+    pcd, _ = playbot
+    sphere = o3d.t.geometry.TriangleMesh.create_sphere(0.2)
+    material = o3d.visualization.rendering.MaterialRecord()  # unset: the cloud as splats
+    # Runs the viewer for half a second and returns: the items were taken.
+    o3d.visualization.draw([{"name": "playbot", "geometry": pcd, "material": material, "is_visible": True},
+                            ("sphere", sphere)], title="habits", width=160, height=120, max_seconds=0.5)
+
+
 def test_material_record_default_draws_splats(playbot):
     pcd, views = playbot
     r = Renderer(32, 32, "cpu")
