@@ -29,15 +29,17 @@ def main():
         # A new array per call, one numpy array reused, one batch_array reused (the GPU
         # writes it directly on Vulkan).
         for mode in ("new array", "out= reused", "out=batch_array"):
-            out = r.render_batch(cameras, dtype)  # warm-up: pipelines, buffers, clocks
+            # RGBA in both dtypes (alpha=True): what the device writes, the numbers in
+            # docs/python.md; the cameras.json views are scaled to --size (rescale=True).
+            out = r.render_batch(cameras, dtype, alpha=True, rescale=True)  # warm-up: pipelines, buffers, clocks
             if mode == "out=batch_array":
                 out = r.batch_array(args.batch, dtype)
             reused = out if mode != "new array" else None
             for _ in range(2):
-                r.render_batch(cameras, dtype, out=reused)
+                r.render_batch(cameras, dtype, out=reused, alpha=True, rescale=True)
             batches, start = 0, time.monotonic()
             while time.monotonic() - start < args.seconds:
-                r.render_batch(cameras, dtype, out=reused)
+                r.render_batch(cameras, dtype, out=reused, alpha=True, rescale=True)
                 batches += 1
             seconds = time.monotonic() - start
             print(f"python render_batch {dtype}, {mode}: "

@@ -12,7 +12,9 @@ void BindGeometry(pybind11::module_& t_geometry);
 void BindMesh(pybind11::module_& t_geometry);
 void BindMaterial(pybind11::module_& rendering);
 void BindIo(pybind11::module_& t_io);
+void BindImageIo(pybind11::module_& io);
 void BindCamera(pybind11::module_& camera);
+void BindScene(pybind11::module_& rendering);
 void BindRendering(pybind11::module_& rendering);
 void BindVisualization(pybind11::module_& visualization);
 

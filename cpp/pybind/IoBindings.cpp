@@ -1,11 +1,14 @@
 // t.io: read_point_cloud / write_point_cloud in every format the library knows, and the paged
 // file a renderer streams (write_splat_pages).
 #include <pybind11/stl.h>
+#include <pybind11/stl/filesystem.h>
 
+#include <filesystem>
 #include <memory>
 #include <string>
 
 #include "Bindings.h"
+#include "PathArgs.h"
 #include "PyPointCloud.h"
 #include "open3d/core/Exception.h"
 #include "open3d/t/geometry/SplatHierarchy.h"
@@ -20,21 +23,25 @@ namespace pybind {
 void BindIo(py::module_& m) {
     m.def(
         "read_point_cloud",
-        [](const std::string& filename, bool drop_non_finite) {
+        [](const std::filesystem::path& filename, bool drop_non_finite) {
             auto cloud = std::make_shared<PyPointCloud>();
             t::io::ReadPointCloudOptions options;
             options.drop_non_finite = drop_non_finite;
+            const std::string path = InputPath(filename);
             py::gil_scoped_release release;
-            t::io::ReadPointCloud(filename, cloud->cloud, options);
+            t::io::ReadPointCloud(path, cloud->cloud, options);
             return cloud;
         },
         py::arg("filename"), py::arg("drop_non_finite") = false,
         "Reads a splat file of any supported format (detected by content: .ply, "
-        ".compressed.ply, .splat, .spz, .sog or a SOG folder, .gltf, .glb, .ksplat). Raises "
-        "Open3DError naming the file and the problem.");
+        ".compressed.ply, .splat, .spz, .sog or a SOG folder, .gltf, .glb, .ksplat); filename "
+        "is a str or an os.PathLike. Raises Open3DError naming the file and the problem "
+        "(Open3DFileNotFoundError, also a FileNotFoundError, when nothing is there); "
+        "non-finite values are refused unless drop_non_finite drops their splats.");
     m.def(
         "write_point_cloud",
-        [](const std::string& filename, const PyPointCloud& cloud, const std::string& ply_format) {
+        [](const std::filesystem::path& filename, const PyPointCloud& cloud,
+           const std::string& ply_format) {
             t::io::WritePointCloudOptions options;
             if (ply_format == "binary_little_endian") {
                 options.ply_format = t::io::PlyFormat::BinaryLittleEndian;
@@ -48,20 +55,23 @@ void BindIo(py::module_& m) {
                     "binary_big_endian or ascii)",
                     ply_format);
             }
+            const std::string path = PathString(filename);
             py::gil_scoped_release release;
-            t::io::WritePointCloud(filename, cloud.cloud, options);
+            t::io::WritePointCloud(path, cloud.cloud, options);
         },
         py::arg("filename"), py::arg("pointcloud"), py::arg("ply_format") = "binary_little_endian",
         "Writes the format the extension names (.ply, .compressed.ply, .splat, .spz, .sog, .glb, "
         ".gltf); the file appears complete or not at all.");
     m.def(
         "write_splat_pages",
-        [](const std::string& filename, const PyPointCloud& cloud, int64_t page_capacity) {
+        [](const std::filesystem::path& filename, const PyPointCloud& cloud,
+           int64_t page_capacity) {
             cloud.cloud.ValidateGaussianSplat();
+            const std::string path = PathString(filename);
             py::gil_scoped_release release;
             const t::geometry::SplatHierarchy hierarchy =
                 t::geometry::BuildSplatHierarchy(cloud.cloud);
-            t::io::WriteSplatPages(filename, cloud.cloud, hierarchy, page_capacity);
+            t::io::WriteSplatPages(path, cloud.cloud, hierarchy, page_capacity);
         },
         py::arg("filename"), py::arg("pointcloud"), py::arg("page_capacity") = 65536,
         "Builds the level-of-detail hierarchy of a Gaussian splat cloud and writes it as a paged "

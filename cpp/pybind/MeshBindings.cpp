@@ -10,6 +10,7 @@
 
 #include "Bindings.h"
 #include "NumpyTensor.h"
+#include "PyMaterial.h"
 #include "open3d/core/Exception.h"
 #include "open3d/t/geometry/TriangleMesh.h"
 #include "open3d/visualization/rendering/filament/MaterialRecord.h"
@@ -47,13 +48,17 @@ void BindMesh(py::module_& m) {
                  mesh.Validate();
                  return mesh;
              }),
-             py::arg("vertices"), py::arg("triangles"))
+             py::arg("vertices"), py::arg("triangles"),
+             "A mesh of vertices [N, 3] (any real dtype, copied as float32) and triangles [M, "
+             "3] of vertex indices")
         .def_static("create_sphere", &TriangleMesh::CreateSphere, py::arg("radius") = 1.0,
-                    py::arg("resolution") = 20)
+                    py::arg("resolution") = 20, "A UV sphere about the origin")
         .def_static("create_box", &TriangleMesh::CreateBox, py::arg("width") = 1.0,
-                    py::arg("height") = 1.0, py::arg("depth") = 1.0)
-        .def("num_vertices", &TriangleMesh::NumVertices)
-        .def("num_triangles", &TriangleMesh::NumTriangles)
+                    py::arg("height") = 1.0, py::arg("depth") = 1.0,
+                    "A box with one corner at the origin and the opposite one at (width, "
+                    "height, depth)")
+        .def("num_vertices", &TriangleMesh::NumVertices, "The number of vertices")
+        .def("num_triangles", &TriangleMesh::NumTriangles, "The number of triangles")
         .def_property_readonly(
             "vertices",
             [](const TriangleMesh& mesh) { return CopyOfTensor(mesh.GetVertexPositions()); },
@@ -70,24 +75,48 @@ void BindMesh(py::module_& m) {
             [](TriangleMesh& mesh, const Eigen::Vector3d& t) -> TriangleMesh& {
                 return mesh.Translate(t);
             },
-            py::arg("translation"), py::return_value_policy::reference_internal)
-        .def("__repr__", [](const TriangleMesh& mesh) {
-            return fmt::format("TriangleMesh with {} vertices and {} triangles", mesh.NumVertices(),
-                               mesh.NumTriangles());
-        });
+            py::arg("translation"), py::return_value_policy::reference_internal,
+            "Moves the vertices by translation; returns the mesh")
+        .def(
+            "__repr__",
+            [](const TriangleMesh& mesh) {
+                return fmt::format("TriangleMesh with {} vertices and {} triangles",
+                                   mesh.NumVertices(), mesh.NumTriangles());
+            },
+            "The vertex and triangle counts");
 }
 
 void BindMaterial(py::module_& m) {
     using visualization::rendering::MaterialRecord;
-    py::class_<MaterialRecord>(m, "MaterialRecord",
-                               "How a geometry is drawn: shader 'defaultUnlit', 'defaultLit' "
-                               "(meshes, points) or 'gaussianSplat'")
-        .def(py::init<>())
-        .def_readwrite("shader", &MaterialRecord::shader)
-        .def_readwrite("base_color", &MaterialRecord::base_color)
-        .def_readwrite("point_size", &MaterialRecord::point_size)
-        .def_readwrite("gaussian_splat_sh_degree", &MaterialRecord::gaussian_splat_sh_degree)
-        .def_readwrite("gaussian_splat_antialias", &MaterialRecord::gaussian_splat_antialias);
+    py::class_<PyMaterialRecord>(
+        m, "MaterialRecord",
+        "How a geometry is drawn, as Open3D's: shader 'defaultUnlit', 'defaultLit' (meshes, "
+        "points) or 'gaussianSplat'. While shader is left unset the geometry is drawn its own "
+        "way: a Gaussian splat cloud as splats (what a renderer without meshes draws), a plain "
+        "cloud as points, a mesh unlit; reading it gives Open3D's default, 'defaultUnlit'.")
+        .def(py::init<>(), "Open3D's defaults; the shader left to the geometry (see the class)")
+        .def_property(
+            "shader", [](const PyMaterialRecord& r) { return r.shader; },
+            [](PyMaterialRecord& r, const std::string& shader) {
+                r.shader = shader;
+                r.shader_set = true;
+            },
+            "'defaultUnlit', 'defaultLit' or 'gaussianSplat'")
+        .def_readwrite("base_color", &PyMaterialRecord::base_color,
+                       "Linear RGBA multiplied with the vertex colours")
+        .def_readwrite("point_size", &PyMaterialRecord::point_size,
+                       "Point clouds drawn as points: the side of each point in pixels")
+        .def_readwrite("gaussian_splat_sh_degree", &PyMaterialRecord::gaussian_splat_sh_degree,
+                       "'gaussianSplat': the highest SH band used (0..3)")
+        .def_readwrite("gaussian_splat_antialias", &PyMaterialRecord::gaussian_splat_antialias,
+                       "'gaussianSplat': Mip-Splatting's antialias, for clouds trained with it")
+        .def(
+            "__repr__",
+            [](const PyMaterialRecord& r) {
+                return fmt::format("MaterialRecord(shader='{}'{})", r.shader,
+                                   r.shader_set ? "" : ", unset: the geometry's own way");
+            },
+            "The shader, and whether it was set");
 }
 
 }  // namespace pybind

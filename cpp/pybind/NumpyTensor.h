@@ -18,10 +18,17 @@ pybind11::array ViewOfTensor(core::Tensor& tensor, pybind11::object owner);
 /// The image moved into the array's own keeper: a numpy array of shape (H, W, C), or
 /// (H, W) when `squeeze_channel` and C == 1, without a copy.
 pybind11::array ArrayFromImage(t::geometry::Image&& image, bool squeeze_channel = false);
-/// A copy of `array` as a tensor of the array's dtype (float32, uint8 or uint16, any
-/// C-contiguous layout after numpy's conversion); throws core::Open3DError naming `what`
-/// for other dtypes.
-core::Tensor TensorFromArray(const pybind11::array& array, const std::string& what);
+/// `value` (an array, a list, anything numpy.asarray takes) as an array of a dtype the
+/// library's tensors hold: float32, uint8 and uint16 as they are; float16, float64 (and
+/// other floating dtypes) and integers that float32 holds exactly converted to float32.
+/// Throws core::Open3DError naming `what` for other dtypes, for float64 values beyond
+/// float32's range, and for values numpy cannot make an array of.
+pybind11::array ArrayForTensor(const pybind11::handle& value, const std::string& what);
+/// A C-order copy of ArrayForTensor(value) as a tensor. Unless `allow_non_finite`, a NaN or
+/// infinity is refused with core::Open3DError naming `what` and the first row holding one
+/// (the file readers refuse them too: they break sorting and blending).
+core::Tensor TensorFromArray(const pybind11::handle& value, const std::string& what,
+                             bool allow_non_finite = false);
 
 }  // namespace pybind
 }  // namespace open3d

@@ -1,24 +1,24 @@
-// visualization.rendering: OffscreenRenderer for splat scenes without a display (the splat
-// backends alone, no Filament), RenderConfig knobs as properties, batches of cameras.
+// visualization.rendering.OffscreenRenderer: splat scenes rendered to numpy arrays without a
+// display (the splat backends alone, no Filament), RenderConfig knobs as properties, batches
+// of cameras (the scene's bindings: SceneBindings.cpp; the state: SplatOffscreen).
 #include <pybind11/eigen.h>
 #include <pybind11/numpy.h>
 #include <pybind11/stl.h>
 
 #include <algorithm>
 #include <cstring>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "Bindings.h"
 #include "NumpyTensor.h"
-#include "PyPointCloud.h"
+#include "PyCamera.h"
+#include "SplatOffscreen.h"
 #include "open3d/core/Exception.h"
-#include "open3d/t/geometry/TriangleMesh.h"
-#include "open3d/visualization/rendering/filament/MaterialRecord.h"
-#include "open3d/visualization/rendering/filament/OffscreenRenderer.h"
-#include "open3d/visualization/rendering/gaussian_splat/GaussianSplatRenderer.h"
 
 namespace py = pybind11;
 
@@ -27,211 +27,8 @@ namespace pybind {
 
 namespace {
 
-using visualization::rendering::GaussianSplatRenderer;
-using visualization::rendering::MaterialRecord;
 using visualization::rendering::RenderConfig;
 using visualization::rendering::RenderOutput;
-
-constexpr uint64_t kView = 0;  // the renderer's one view
-
-// The scene, its camera and its settings. Without meshes: the splat backend alone
-// (GaussianSplatRenderer, no display needed). With `meshes`: the Filament OffscreenRenderer
-// (meshes and splats composited by depth; needs an X server). Python's OffscreenRenderer and
-// its `scene` share one of these.
-class SplatOffscreen {
-public:
-    SplatOffscreen(int width, int height, const std::string& backend, bool meshes)
-        : width_(width), height_(height) {
-        if (width <= 0 || height <= 0) {
-            core::ThrowError("OffscreenRenderer: size must be positive, got {}x{}", width, height);
-        }
-        if (backend != "vulkan" && backend != "cpu") {
-            core::ThrowError("OffscreenRenderer: backend '{}' (vulkan or cpu)", backend);
-        }
-        if (!meshes) {
-            renderer_ = std::make_unique<GaussianSplatRenderer>(backend);
-            return;
-        }
-        visualization::rendering::Open3DSceneOptions options;
-        options.backend = backend;
-        try {
-            filament_ = std::make_unique<visualization::rendering::OffscreenRenderer>(width, height,
-                                                                                      options);
-        } catch (const core::Open3DError& e) {
-            core::ThrowError(
-                "OffscreenRenderer(meshes=True) draws with Filament, which needs an X server "
-                "(splats alone need none: leave meshes off): {}",
-                e.what());
-        }
-    }
-
-    bool HasMeshes() const { return filament_ != nullptr; }
-    RenderConfig& Config() { return config_; }
-    int Width() const { return width_; }
-    int Height() const { return height_; }
-    std::string BackendName() const {
-        return filament_ ? filament_->GetScene()->GetScene().GetBackend().GetName()
-                         : renderer_->GetBackendName();
-    }
-    const std::vector<std::string>& Names() const { return names_; }
-
-    void AddCloud(const std::string& name, const t::geometry::PointCloud& cloud,
-                  const std::optional<MaterialRecord>& material) {
-        if (filament_) {
-            if (material) {
-                filament_->GetScene()->AddGeometry(name, cloud, *material);
-            } else {
-                filament_->GetScene()->AddGeometry(name, cloud);
-            }
-        } else {
-            if (material && material->shader != visualization::rendering::kShaderGaussianSplat) {
-                core::ThrowError(
-                    "OffscreenRenderer: '{}' with shader '{}': without meshes=True only Gaussian "
-                    "splat clouds are drawn",
-                    name, material->shader);
-            }
-            renderer_->AddCloud(name, cloud);
-        }
-        names_.push_back(name);
-    }
-    void AddMesh(const std::string& name, const t::geometry::TriangleMesh& mesh,
-                 const MaterialRecord& material) {
-        if (!filament_) {
-            core::ThrowError(
-                "OffscreenRenderer: mesh '{}': meshes are drawn by Filament; create the renderer "
-                "with meshes=True (needs an X server)",
-                name);
-        }
-        filament_->GetScene()->AddGeometry(name, mesh, material);
-        names_.push_back(name);
-    }
-    void UpdateCloud(const std::string& name, const t::geometry::PointCloud& cloud) {
-        if (filament_) {
-            filament_->GetScene()->UpdateGeometry(name, cloud);
-        } else {
-            renderer_->UpdateCloud(name, cloud);
-        }
-    }
-    bool Remove(const std::string& name) {
-        const bool removed =
-            filament_ ? filament_->GetScene()->RemoveGeometry(name) : renderer_->RemoveCloud(name);
-        std::erase(names_, name);
-        return removed;
-    }
-    void Show(const std::string& name, bool show) {
-        if (filament_) {
-            filament_->GetScene()->ShowGeometry(name, show);
-        } else {
-            renderer_->ShowCloud(name, show);
-        }
-    }
-    bool Has(const std::string& name) const {
-        return filament_ ? filament_->GetScene()->HasGeometry(name) : renderer_->HasCloud(name);
-    }
-    void Clear() {
-        if (filament_) {
-            filament_->GetScene()->ClearGeometry();
-        } else {
-            renderer_->Clear();
-        }
-        names_.clear();
-    }
-    GaussianSplatRenderer& SplatRenderer() const {
-        return filament_ ? filament_->GetScene()->GetScene().GetSplatRenderer() : *renderer_;
-    }
-    void SetBackground(const Eigen::Vector3d& rgb) {
-        config_.background = rgb;
-        if (filament_) {
-            filament_->GetScene()->SetBackground(rgb.cast<float>().homogeneous());
-        }
-    }
-
-    /// Uses the camera at the renderer's size.
-    void SetCamera(const camera::PinholeCamera& camera) {
-        camera_ = Sized(camera);
-        has_camera_ = true;
-    }
-    const camera::PinholeCamera& Camera() const {
-        if (!has_camera_) core::ThrowError("OffscreenRenderer: call setup_camera first");
-        return camera_;
-    }
-
-    RenderOutput Render(bool expected_depth, bool median_depth) {
-        const camera::PinholeCamera camera = Camera();
-        RequireVisibleSplats();
-        RenderOutput out;
-        visualization::rendering::CompositeInputs inputs;
-        inputs.expected_depth = expected_depth;
-        inputs.median_depth = median_depth;
-        py::gil_scoped_release release;
-        renderer_->Prepare();
-        renderer_->RenderGeometryStage(kView, camera, config_);
-        renderer_->RenderCompositeStage(kView, out, inputs);
-        return out;
-    }
-
-    /// Filament's frame: UInt8 [H, W, 3], or the view z Float32 [H, W, 1] with `depth`.
-    t::geometry::Image RenderWithMeshes(bool depth) {
-        const camera::PinholeCamera camera = Camera();
-        // The knobs go to the scene's splat settings (background stays the view's).
-        RenderConfig& splat = filament_->GetScene()->GetSplatConfig();
-        splat.sh_degree = config_.sh_degree;
-        splat.antialias = config_.antialias;
-        splat.near_plane = config_.near_plane;
-        splat.compact_storage = config_.compact_storage;
-        filament_->SetupCamera(camera);
-        py::gil_scoped_release release;
-        return depth ? filament_->RenderToDepthImage(true) : filament_->RenderToImage();
-    }
-
-    /// Renders into `destination` (N x H x W x 4 elements of float32, or uint8 with `uint8`),
-    /// which lies in `memory` when that is set (the device then copies into it directly).
-    void RenderBatch(const std::vector<camera::PinholeCamera>& cameras, bool uint8,
-                     uint8_t* destination,
-                     const visualization::rendering::BatchHostMemory& memory = {}) {
-        if (filament_) {
-            core::ThrowError("render_batch: batches are for splat-only renderers (meshes=False)");
-        }
-        if (renderer_->IsStreaming()) {
-            // A batch draws the pool as it stands and gives the stream no view.
-            core::ThrowError(
-                "render_batch: not while a stream runs (render_to_image streams for its view)");
-        }
-        std::vector<camera::PinholeCamera> sized;
-        for (const camera::PinholeCamera& c : cameras) sized.push_back(Sized(c));
-        RequireVisibleSplats();
-        visualization::rendering::BatchOptions options;
-        options.color_uint8 = uint8;
-        options.color_destination = destination;
-        options.color_memory = memory;
-        py::gil_scoped_release release;
-        renderer_->Prepare();
-        // The batch replaces the view's sorted entries in the backend.
-        renderer_->ReleaseView(kView);
-        renderer_->GetBackend().RenderBatch(sized, config_, options);
-    }
-
-private:
-    /// Validated, with its intrinsics scaled to the renderer's size when its size differs.
-    camera::PinholeCamera Sized(const camera::PinholeCamera& camera) const {
-        camera.Validate();
-        return camera.width == width_ && camera.height == height_ ? camera
-                                                                  : camera.Resized(width_, height_);
-    }
-    void RequireVisibleSplats() const {
-        if (!renderer_->HasVisibleSplats()) {
-            core::ThrowError("OffscreenRenderer: the scene has no visible splat cloud");
-        }
-    }
-
-    int width_, height_;
-    std::unique_ptr<GaussianSplatRenderer> renderer_;
-    std::unique_ptr<visualization::rendering::OffscreenRenderer> filament_;
-    std::vector<std::string> names_;
-    RenderConfig config_;
-    camera::PinholeCamera camera_;
-    bool has_camera_ = false;
-};
 
 using Offscreen = std::shared_ptr<SplatOffscreen>;
 
@@ -270,13 +67,76 @@ visualization::rendering::BatchHostMemory BatchMemoryOf(const py::array& array) 
     return {};
 }
 
-struct SplatScene {
-    Offscreen renderer;
-};
+void CheckDtype(const std::string& dtype) {
+    if (dtype != "float32" && dtype != "uint8") {
+        core::ThrowError("dtype '{}': float32 or uint8", dtype);
+    }
+}
 
-py::array ColorArray(RenderOutput& out, const std::string& dtype) {
-    if (dtype == "float32") return ArrayFromImage(std::move(out.color));
-    return ArrayFromImage(out.color.SelectChannels(0, 3).ToUInt8());
+// One rule for every colour array: float32 is RGBA (premultiplied over a black background),
+// uint8 is RGB (Open3D's render_to_image); `alpha` asks for the other.
+int Channels(const std::string& dtype, std::optional<bool> alpha) {
+    CheckDtype(dtype);
+    return alpha.value_or(dtype == "float32") ? 4 : 3;
+}
+
+py::array ColorArray(RenderOutput& out, const std::string& dtype, int channels) {
+    t::geometry::Image color =
+        channels == 4 ? std::move(out.color) : out.color.SelectChannels(0, channels);
+    if (dtype == "uint8") color = color.ToUInt8();
+    return ArrayFromImage(std::move(color));
+}
+
+// A view-z image (0 where nothing is) in the convention asked for: None, as it is (this
+// package's default since it began); True, Open3D's z_in_view_space (infinity where nothing
+// is); False, Open3D's normalised depth, 0 at the near plane to 1 at the far plane, which is
+// here infinitely far: 1 - near / z (the depth buffer of such a projection), 1 where nothing
+// is.
+py::array DepthArray(t::geometry::Image&& z, std::optional<bool> z_in_view_space, double near) {
+    if (z_in_view_space) {
+        float* d = z.Data<float>();
+        const float n = static_cast<float>(near);
+        for (int64_t i = 0; i < z.NumPixels(); ++i) {
+            if (!(d[i] > 0.0f)) {
+                d[i] = *z_in_view_space ? std::numeric_limits<float>::infinity() : 1.0f;
+            } else if (!*z_in_view_space) {
+                d[i] = std::clamp(1.0f - n / d[i], 0.0f, 1.0f);
+            }
+        }
+    }
+    return ArrayFromImage(std::move(z), true);
+}
+
+py::array RenderDepth(SplatOffscreen& r, const std::string& kind,
+                      std::optional<bool> z_in_view_space) {
+    if (kind != "expected" && kind != "median") {
+        core::ThrowError("render_to_depth_image: kind '{}' (expected or median)", kind);
+    }
+    const double near = r.Config().near_plane;
+    if (r.HasMeshes()) {
+        // The nearer of the meshes' z and the splats' expected z (Filament's merge).
+        return DepthArray(r.RenderWithMeshes(true), z_in_view_space, near);
+    }
+    RenderOutput out = r.Render(kind == "expected", kind == "median");
+    return DepthArray(std::move(kind == "expected" ? out.depth_expected : out.depth_median),
+                      z_in_view_space, near);
+}
+
+// The RGB of `rgba` ([count, 4] elements of T) into `rgb` ([count, 3]).
+template <typename T>
+void DropAlpha(const T* rgba, T* rgb, int64_t count) {
+    for (int64_t i = 0; i < count; ++i) {
+        for (int c = 0; c < 3; ++c) rgb[3 * i + c] = rgba[4 * i + c];
+    }
+}
+
+// The size of (intrinsic, extrinsic) cameras: the renderer's unless given (both or neither).
+std::pair<int, int> CameraSize(const SplatOffscreen& r, std::optional<int> width,
+                               std::optional<int> height) {
+    if (width.has_value() != height.has_value()) {
+        core::ThrowError("setup_camera: give width and height both, or neither");
+    }
+    return {width.value_or(r.Width()), height.value_or(r.Height())};
 }
 
 int CheckShDegree(int degree) {
@@ -284,130 +144,9 @@ int CheckShDegree(int degree) {
     return degree;
 }
 
-void CheckDtype(const std::string& dtype) {
-    if (dtype != "float32" && dtype != "uint8") {
-        core::ThrowError("dtype '{}': float32 (premultiplied RGBA) or uint8 (RGB)", dtype);
-    }
-}
-
 }  // namespace
 
 void BindRendering(py::module_& m) {
-    py::class_<SplatScene>(m, "Scene",
-                           "The geometry of an OffscreenRenderer, by name: Gaussian splat "
-                           "clouds, and with meshes=True meshes and point clouds too")
-        .def(
-            "add_geometry",
-            [](SplatScene& s, const std::string& name, const PyPointCloud& cloud,
-               const std::optional<MaterialRecord>& material) {
-                s.renderer->AddCloud(name, cloud.cloud, material);
-            },
-            py::arg("name"), py::arg("geometry"), py::arg("material") = py::none(),
-            "Adds a copy of a cloud (a Gaussian splat cloud unless the material says otherwise); "
-            "raises for a taken name or a cloud without the Gaussian attributes")
-        .def(
-            "add_geometry",
-            [](SplatScene& s, const std::string& name, const t::geometry::TriangleMesh& mesh,
-               const std::optional<MaterialRecord>& material) {
-                s.renderer->AddMesh(name, mesh, material.value_or(MaterialRecord{}));
-            },
-            py::arg("name"), py::arg("geometry"), py::arg("material") = py::none(),
-            "Adds a copy of a mesh (renderers made with meshes=True)")
-        .def(
-            "update_geometry",
-            [](SplatScene& s, const std::string& name, const PyPointCloud& cloud) {
-                s.renderer->UpdateCloud(name, cloud.cloud);
-            },
-            py::arg("name"), py::arg("geometry"))
-        .def(
-            "remove_geometry",
-            [](SplatScene& s, const std::string& name) { return s.renderer->Remove(name); },
-            py::arg("name"))
-        .def(
-            "show_geometry",
-            [](SplatScene& s, const std::string& name, bool show) { s.renderer->Show(name, show); },
-            py::arg("name"), py::arg("show"))
-        .def(
-            "has_geometry",
-            [](const SplatScene& s, const std::string& name) { return s.renderer->Has(name); },
-            py::arg("name"))
-        .def(
-            "clear_geometry", [](SplatScene& s) { s.renderer->Clear(); },
-            "Removes every geometry and ends a stream")
-        .def(
-            "stream_splats",
-            [](SplatScene& s, const std::string& path, const py::object& gpu_budget,
-               int64_t splat_budget, int64_t reads_per_step, std::optional<bool> compact_storage) {
-                visualization::rendering::SplatStreamOptions options;
-                if (py::isinstance<py::str>(gpu_budget)) {
-                    options.gpu_budget =
-                        visualization::rendering::ParseGpuBudget(gpu_budget.cast<std::string>());
-                } else if (py::isinstance<py::int_>(gpu_budget) &&
-                           !py::isinstance<py::bool_>(gpu_budget) &&
-                           gpu_budget.cast<py::int_>() >= py::int_(0)) {
-                    options.gpu_budget = gpu_budget.cast<uint64_t>();
-                } else {
-                    core::ThrowError(
-                        "stream_splats: gpu_budget {} is neither bytes (an int >= 0, 0: the "
-                        "default) nor a size such as '2G' or 'auto'",
-                        py::repr(gpu_budget).cast<std::string>());
-                }
-                options.splat_budget = splat_budget;
-                options.reads_per_step = reads_per_step;
-                options.compact_storage =
-                    compact_storage.value_or(s.renderer->Config().compact_storage);
-                s.renderer->SplatRenderer().StreamSplats(path, options);
-            },
-            py::arg("path"), py::arg("gpu_budget") = 0, py::arg("splat_budget") = 0,
-            py::arg("reads_per_step") = 16, py::arg("compact_storage") = py::none(),
-            "Streams a paged file (write_splat_pages, gs-convert --pages) as the splat scene "
-            "(docs/streaming.md): its pages are read on a worker thread into a GPU pool of "
-            "gpu_budget bytes (an int, or a str such as '512M' or '2G'; 0 or 'auto': 1 GiB, or "
-            "what the device holds in one scene where that is less) for the view of each "
-            "render; each render shows the pages read since the one before. splat_budget: nodes "
-            "a cut may draw (0: what the pool holds). compact_storage: the pool at half precision "
-            "(about 1.8 times the splats in gpu_budget; None: the renderer's compact_storage); "
-            "the stream draws at its pool's precision. Raises Open3DError while splat clouds are "
-            "held, for a refused file, or with the cpu backend (only vulkan streams).")
-        .def(
-            "stop_streaming",
-            [](SplatScene& s) { return s.renderer->SplatRenderer().StopStreaming(); },
-            "Ends the stream and frees its pool; False when there was none")
-        .def_property_readonly(
-            "stream_progress",
-            [](const SplatScene& s) -> py::object {
-                const auto p = s.renderer->SplatRenderer().GetStreamProgress();
-                if (!p) return py::none();
-                py::dict d;
-                d["path"] = p->path;
-                d["file_pages"] = p->file_pages;
-                d["pool_pages"] = p->pool_pages;
-                d["resident_pages"] = p->resident_pages;
-                d["pages_read"] = p->pages_read;
-                d["bytes_read"] = p->bytes_read;
-                d["evictions"] = p->evictions;
-                d["nodes_drawn"] = p->nodes_drawn;
-                d["pages_wanted"] = p->pages_wanted;
-                d["starved"] = p->starved;
-                d["settled"] = p->settled;
-                d["error"] = p->error;
-                d["text"] = visualization::rendering::FormatStreamProgress(*p);
-                return d;
-            },
-            "None when not streaming; else a dict as of the last render: file_pages, pool_pages, "
-            "resident_pages, pages_read, bytes_read, evictions, nodes_drawn (by the newest cut), "
-            "pages_wanted (pages that cut lacks), starved (the pool is full for this view), "
-            "settled (nothing more will change for this view: the last render showed it all), "
-            "error, and text (the viewer panel's line)")
-        .def_property_readonly("geometry_names",
-                               [](const SplatScene& s) { return s.renderer->Names(); })
-        .def(
-            "set_background",
-            [](SplatScene& s, const Eigen::Vector3d& rgb) { s.renderer->SetBackground(rgb); },
-            py::arg("rgb"),
-            "Linear RGB where nothing is drawn (default black: splat colours are then "
-            "premultiplied)");
-
     py::class_<SplatOffscreen, Offscreen>(
         m, "OffscreenRenderer",
         "Renders scenes to numpy arrays. Default: splat clouds only, drawn by the splat backend "
@@ -431,21 +170,54 @@ void BindRendering(py::module_& m) {
              "The knobs are keyword arguments and properties: sh_degree (cap, 0..3), "
              "antialias (Mip-Splatting's), compact_storage (Vulkan, half precision), "
              "near_plane")
-        .def_property_readonly("scene", [](const Offscreen& r) { return SplatScene{r}; })
-        .def_property_readonly("backend", &SplatOffscreen::BackendName)
-        .def_property_readonly("meshes", &SplatOffscreen::HasMeshes)
-        .def_property_readonly("width", &SplatOffscreen::Width)
-        .def_property_readonly("height", &SplatOffscreen::Height)
-        .def("setup_camera", &SplatOffscreen::SetCamera, py::arg("camera"),
-             "Uses the camera; its intrinsics are scaled to the renderer's size when they differ")
+        .def_property_readonly(
+            "scene", [](const Offscreen& r) { return SplatScene{r}; },
+            "The geometry by name (add_geometry, set_background, stream_splats, ...)")
+        .def_property_readonly("backend", &SplatOffscreen::BackendName,
+                               "The splat backend's name: 'vulkan' or 'cpu'")
+        .def_property_readonly("meshes", &SplatOffscreen::HasMeshes,
+                               "Whether Filament draws (meshes=True)")
+        .def_property_readonly("width", &SplatOffscreen::Width, "Picture width in pixels")
+        .def_property_readonly("height", &SplatOffscreen::Height, "Picture height in pixels")
+        .def("setup_camera", &SplatOffscreen::SetCamera, py::arg("camera"), py::kw_only(),
+             py::arg("rescale") = false,
+             "Uses the camera. One of another size is refused unless rescale=True, which "
+             "scales its intrinsics to the renderer's size (another aspect ratio stretches the "
+             "picture)")
         .def(
             "setup_camera",
-            [](SplatOffscreen& r, const Eigen::Matrix3d& K, const Eigen::Matrix4d& extrinsic) {
-                r.SetCamera(
-                    camera::PinholeCamera::FromIntrinsic(K, extrinsic, r.Width(), r.Height()));
+            [](SplatOffscreen& r, const Eigen::Matrix3d& K, const Eigen::Matrix4d& extrinsic,
+               std::optional<int> width, std::optional<int> height, bool rescale) {
+                CheckIntrinsicMatrix(K, "setup_camera");
+                const auto [w, h] = CameraSize(r, width, height);
+                r.SetCamera(camera::PinholeCamera::FromIntrinsic(K, extrinsic, w, h), rescale);
             },
-            py::arg("intrinsic"), py::arg("extrinsic"),
-            "OpenCV intrinsics (for this renderer's size) and a world-to-camera extrinsic")
+            py::arg("intrinsic_matrix"), py::arg("extrinsic_matrix"),
+            py::arg("intrinsic_width_px") = py::none(), py::arg("intrinsic_height_px") = py::none(),
+            py::kw_only(), py::arg("rescale") = false,
+            "Open3D's setup_camera(intrinsic_matrix, extrinsic_matrix, width, height): OpenCV "
+            "intrinsics K (no skew) for an image of that size (default: the renderer's) and a "
+            "world-to-camera extrinsic. Another size than the renderer's is refused unless "
+            "rescale=True")
+        .def(
+            "setup_camera",
+            [](SplatOffscreen& r, const PinholeCameraIntrinsic& intrinsic,
+               const Eigen::Matrix4d& extrinsic, std::optional<int> width,
+               std::optional<int> height, bool rescale) {
+                if ((width && *width != intrinsic.width) ||
+                    (height && *height != intrinsic.height)) {
+                    core::ThrowError(
+                        "setup_camera: width and height {}x{} differ from the intrinsic's {}x{}",
+                        width.value_or(intrinsic.width), height.value_or(intrinsic.height),
+                        intrinsic.width, intrinsic.height);
+                }
+                r.SetCamera(CameraFromIntrinsic(intrinsic, extrinsic), rescale);
+            },
+            py::arg("intrinsics"), py::arg("extrinsic_matrix"),
+            py::arg("intrinsic_width_px") = py::none(), py::arg("intrinsic_height_px") = py::none(),
+            py::kw_only(), py::arg("rescale") = false,
+            "Open3D's setup_camera(PinholeCameraIntrinsic, extrinsic_matrix): the intrinsic's "
+            "size must be the renderer's unless rescale=True")
         .def(
             "setup_camera",
             [](SplatOffscreen& r, double vertical_fov_deg, const Eigen::Vector3d& center,
@@ -455,71 +227,88 @@ void BindRendering(py::module_& m) {
                 look.center = center;
                 look.up = up;
                 look.vertical_fov_deg = vertical_fov_deg;
-                r.SetCamera(camera::PinholeCamera::FromLookAt(look, r.Width(), r.Height()));
+                r.SetCamera(camera::PinholeCamera::FromLookAt(look, r.Width(), r.Height()), false);
             },
-            py::arg("vertical_field_of_view"), py::arg("center"), py::arg("eye"), py::arg("up"))
-        .def_property_readonly("camera", &SplatOffscreen::Camera)
+            py::arg("vertical_field_of_view"), py::arg("center"), py::arg("eye"), py::arg("up"),
+            "Open3D's look-at form: a vertical field of view in degrees, the point looked at, "
+            "the eye and the up direction, at the renderer's size")
+        .def_property_readonly("camera", &SplatOffscreen::Camera,
+                               "The camera in use, at the renderer's size (a PinholeCamera)")
         .def_property(
             "sh_degree", [](SplatOffscreen& r) { return r.Config().sh_degree; },
             [](SplatOffscreen& r, int v) { r.Config().sh_degree = CheckShDegree(v); },
             "SH degree cap, 0..3")
         .def_property(
             "antialias", [](SplatOffscreen& r) { return r.Config().antialias; },
-            [](SplatOffscreen& r, bool v) { r.Config().antialias = v; })
+            [](SplatOffscreen& r, bool v) { r.Config().antialias = v; },
+            "Mip-Splatting's antialias, for clouds trained with it")
         .def_property(
             "near_plane", [](SplatOffscreen& r) { return r.Config().near_plane; },
-            [](SplatOffscreen& r, double v) { r.Config().near_plane = v; })
+            [](SplatOffscreen& r, double v) { r.Config().near_plane = v; },
+            "Splats nearer than this view z are culled (3DGS: 0.2); the 0 of normalised depth")
         .def_property(
             "compact_storage", [](SplatOffscreen& r) { return r.Config().compact_storage; },
             [](SplatOffscreen& r, bool v) { r.Config().compact_storage = v; },
             "Vulkan: half-precision splat storage (about half the memory, not exact)")
         .def(
             "render_to_image",
-            [](SplatOffscreen& r, const std::optional<std::string>& requested) {
+            [](SplatOffscreen& r, const std::optional<std::string>& requested,
+               std::optional<bool> alpha) {
                 const std::string dtype = requested.value_or(r.HasMeshes() ? "uint8" : "float32");
-                CheckDtype(dtype);
+                const int channels = Channels(dtype, alpha);
                 if (r.HasMeshes()) {
-                    if (dtype != "uint8") {
+                    if (dtype != "uint8" || channels != 3) {
                         core::ThrowError(
-                            "render_to_image: with meshes=True the picture is 8-bit (Filament's "
-                            "colour target): dtype 'uint8'");
+                            "render_to_image: with meshes=True the picture is 8-bit RGB "
+                            "(Filament's colour target): dtype 'uint8' without alpha");
                     }
                     return ArrayFromImage(r.RenderWithMeshes(false));
                 }
                 RenderOutput out = r.Render(false, false);
-                return ColorArray(out, dtype);
+                return ColorArray(out, dtype, channels);
             },
-            py::arg("dtype") = py::none(),
-            "float32 (the default without meshes): (H, W, 4) RGBA, premultiplied over a black "
-            "background; uint8 (the default and only choice with meshes): (H, W, 3) RGB rounded "
-            "to nearest")
+            py::arg("dtype") = py::none(), py::kw_only(), py::arg("alpha") = py::none(),
+            "The picture of the camera. float32 (the default without meshes): (H, W, 4) RGBA, "
+            "rgb = C + T * background and a = 1 - T (premultiplied RGBA when the background is "
+            "black, the default). uint8 (the default and only choice with meshes): (H, W, 3) "
+            "RGB rounded to nearest, as Open3D's. alpha=True / False asks for RGBA / RGB "
+            "instead (without meshes); render_batch follows the same rule")
         .def(
             "render_to_depth_image",
-            [](SplatOffscreen& r, const std::string& kind) {
-                if (kind != "expected" && kind != "median") {
-                    core::ThrowError("render_to_depth_image: kind '{}' (expected or median)", kind);
-                }
-                if (r.HasMeshes()) {
-                    // The nearer of the meshes' z and the splats' expected z (Filament's merge).
-                    return ArrayFromImage(r.RenderWithMeshes(true), true);
-                }
-                RenderOutput out = r.Render(kind == "expected", kind == "median");
-                return ArrayFromImage(
-                    std::move(kind == "expected" ? out.depth_expected : out.depth_median), true);
+            [](SplatOffscreen& r, const std::string& kind, std::optional<bool> z_in_view_space) {
+                return RenderDepth(r, kind, z_in_view_space);
             },
-            py::arg("kind") = "expected",
-            "(H, W) float32 view-space z: the alpha-weighted mean (expected) or where the "
-            "accumulated alpha reaches one half (median); 0 where no splat is. With meshes: the "
-            "nearer of the mesh's z and the splats' (kind is not used)")
+            py::arg("kind") = "expected", py::kw_only(), py::arg("z_in_view_space") = py::none(),
+            "(H, W) float32 depth of the splats: the alpha-weighted mean of their view z "
+            "(kind 'expected') or where the accumulated alpha reaches one half ('median'). "
+            "z_in_view_space None (the default, as before): view z, 0 where no splat is. True "
+            "(Open3D's): view z, infinity where nothing is. False (Open3D's normalised depth): "
+            "0 at the near plane to 1 at the far plane, infinitely far here: 1 - near_plane / "
+            "z, 1 where nothing is. With meshes: the nearer of the mesh's z and the splats' "
+            "(kind is not used)")
+        .def(
+            "render_to_depth_image",
+            [](SplatOffscreen& r, bool z_in_view_space, const std::string& kind) {
+                return RenderDepth(r, kind, z_in_view_space);
+            },
+            py::arg("z_in_view_space"), py::arg("kind") = "expected",
+            "Open3D's positional form, render_to_depth_image(True): see the first form")
         .def(
             "render_batch",
             [](SplatOffscreen& r, const std::vector<camera::PinholeCamera>& cameras,
-               const std::string& dtype, std::optional<py::array> out) {
+               const std::string& dtype, std::optional<py::array> out, std::optional<bool> alpha,
+               bool rescale) {
                 CheckDtype(dtype);
                 if (cameras.empty()) core::ThrowError("render_batch: no cameras");
                 const bool uint8 = dtype == "uint8";
+                // An `out` of 3 or 4 channels says which it wants when alpha is not given.
+                if (out && !alpha && out->ndim() == 4 &&
+                    (out->shape(3) == 3 || out->shape(3) == 4)) {
+                    alpha = out->shape(3) == 4;
+                }
+                const int channels = Channels(dtype, alpha);
                 const std::vector<py::ssize_t> shape = {py::ssize_t(cameras.size()), r.Height(),
-                                                        r.Width(), 4};
+                                                        r.Width(), channels};
                 py::array images;
                 if (out) {
                     // The caller's array, reused across calls: no fresh pages to fault in
@@ -532,8 +321,8 @@ void BindRendering(py::module_& m) {
                         !out->writeable()) {
                         core::ThrowError(
                             "render_batch: out must be a writeable C-contiguous {} array of "
-                            "shape ({}, {}, {}, 4)",
-                            dtype, shape[0], shape[1], shape[2]);
+                            "shape ({}, {}, {}, {})",
+                            dtype, shape[0], shape[1], shape[2], channels);
                     }
                     images = *out;
                 } else if (uint8) {
@@ -541,18 +330,41 @@ void BindRendering(py::module_& m) {
                 } else {
                     images = py::array_t<float>(shape);
                 }
-                // Rendered straight into the array: one copy from the device's readback buffer,
-                // none on the host when it is a batch_array.
-                r.RenderBatch(cameras, uint8, static_cast<uint8_t*>(images.mutable_data()),
-                              BatchMemoryOf(images));
+                if (channels == 4) {
+                    // Rendered straight into the array: one copy from the device's readback
+                    // buffer, none on the host when it is a batch_array.
+                    r.RenderBatch(cameras, rescale, uint8,
+                                  static_cast<uint8_t*>(images.mutable_data()),
+                                  BatchMemoryOf(images));
+                    return images;
+                }
+                // RGB: the device writes RGBA, so the alpha is dropped on the host.
+                std::vector<py::ssize_t> rgba_shape = shape;
+                rgba_shape[3] = 4;
+                py::array rgba = uint8 ? py::array(py::array_t<uint8_t>(rgba_shape))
+                                       : py::array(py::array_t<float>(rgba_shape));
+                r.RenderBatch(cameras, rescale, uint8, static_cast<uint8_t*>(rgba.mutable_data()));
+                const int64_t pixels = int64_t(cameras.size()) * r.Height() * r.Width();
+                py::gil_scoped_release release;
+                if (uint8) {
+                    DropAlpha(static_cast<const uint8_t*>(rgba.data()),
+                              static_cast<uint8_t*>(images.mutable_data()), pixels);
+                } else {
+                    DropAlpha(static_cast<const float*>(rgba.data()),
+                              static_cast<float*>(images.mutable_data()), pixels);
+                }
                 return images;
             },
             py::arg("cameras"), py::arg("dtype") = "float32", py::arg("out") = py::none(),
-            "(N, H, W, 4) for N cameras in one call: float32 premultiplied RGBA, or uint8 RGBA "
-            "(the device's rounding); each equals render_to_image of that camera. `out`: an "
-            "array of that shape and dtype to render into (reused across calls, it saves "
-            "allocating and faulting in fresh memory each time); one from batch_array is "
-            "written by the GPU directly (Vulkan), with no copy on the host")
+            py::kw_only(), py::arg("alpha") = py::none(), py::arg("rescale") = false,
+            "(N, H, W, C) for N cameras in one call, by render_to_image's rule: float32 RGBA "
+            "(premultiplied over black), uint8 RGB; alpha=True / False asks for the other (an "
+            "`out` of 4 or 3 channels says it too). Each image equals render_to_image of its "
+            "camera (uint8: the device's rounding, within one level). Cameras of another size "
+            "are refused unless rescale=True. `out`: an array of that shape and dtype to "
+            "render into (reused across calls it saves allocating and faulting in fresh "
+            "memory); a 4-channel one from batch_array is written by the GPU directly "
+            "(Vulkan), with no copy on the host: the fastest path, uint8 RGBA included")
         .def(
             "batch_array",
             [](SplatOffscreen& r, int count, const std::string& dtype) {
@@ -563,7 +375,8 @@ void BindRendering(py::module_& m) {
             py::arg("count"), py::arg("dtype") = "float32",
             "An uninitialised (count, H, W, 4) array for render_batch(out=...): page-aligned "
             "host memory that the Vulkan backend lets the GPU write directly (no copy on the "
-            "host; the fastest readback). Any renderer of this size accepts it");
+            "host; the fastest readback). RGBA in both dtypes, as the device writes it. Any "
+            "renderer of this size accepts it");
 }
 
 }  // namespace pybind

@@ -16,7 +16,7 @@ import open3d_gs as o3d
 def render(scene, camera, backend, size):
     renderer = o3d.visualization.rendering.OffscreenRenderer(size[0], size[1], backend)
     renderer.scene.add_geometry("scene", o3d.t.io.read_point_cloud(scene))
-    renderer.setup_camera(camera)
+    renderer.setup_camera(camera, rescale=True)  # the view at --size
     return renderer.render_to_image()
 
 

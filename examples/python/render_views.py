@@ -51,7 +51,8 @@ def main():
     start = time.monotonic()
     for first in range(0, len(views), args.batch):
         chunk = views[first:first + args.batch]
-        images = renderer.render_batch([v.camera for v in chunk], "uint8", out=batch[:len(chunk)])
+        # rescale=True: --width / --height ask for the views at another size.
+        images = renderer.render_batch([v.camera for v in chunk], "uint8", out=batch[:len(chunk)], rescale=True)
         for i, image in enumerate(images):
             write_png(out / f"view_{first + i:03d}.png", np.ascontiguousarray(image[..., :3]))
         done = first + len(chunk)

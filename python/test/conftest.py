@@ -28,12 +28,28 @@ def data():
     return path
 
 
+@pytest.fixture(scope="module")
+def playbot():
+    """playbot_31k (SH degree 2) and its cameras, read once per test module."""
+    path = DATA / "playbot/playbot_31k.ply"
+    if not path.exists():
+        unavailable(f"shared scene {path} is absent")
+    return o3d.t.io.read_point_cloud(str(path)), o3d.camera.read_cameras_json(str(DATA / "playbot/cameras.json"))
+
+
 @pytest.fixture
 def gs_render():
     exe = os.environ.get("GS_RENDER", "")
     if not exe or not os.path.exists(exe):
         unavailable("GS_RENDER does not name the gs-render binary (ctest sets it)")
     return exe
+
+
+@pytest.fixture
+def display():
+    """An X server: Filament (meshes, the viewer) needs one."""
+    if not os.environ.get("DISPLAY"):
+        unavailable("DISPLAY is not set: meshes and the viewer need an X server (run under xvfb-run; ctest does)")
 
 
 @pytest.fixture(params=["vulkan", "cpu"])

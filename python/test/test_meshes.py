@@ -8,15 +8,8 @@ import numpy as np
 import pytest
 
 import open3d_gs as o3d
-from conftest import unavailable
 
 Renderer = o3d.visualization.rendering.OffscreenRenderer
-
-
-@pytest.fixture
-def display():
-    if not os.environ.get("DISPLAY"):
-        unavailable("DISPLAY is not set: meshes need an X server (run under xvfb-run; ctest does)")
 
 
 def wall(n=20):
@@ -59,8 +52,27 @@ def test_a_mesh_in_front_of_splats(display, backend):
     assert abs(depth[60, 40] - 4.0) < 0.05, depth[60, 40]
     with pytest.raises(o3d.Open3DError, match="8-bit"):
         r.render_to_image("float32")
+    with pytest.raises(o3d.Open3DError, match="8-bit RGB"):
+        r.render_to_image(alpha=True)
     with pytest.raises(o3d.Open3DError, match="splat-only"):
         r.render_batch([r.camera])
+    # Open3D's depth conventions with meshes too: the sphere's 1.5 in view space, and the
+    # normalised 1 - near / z.
+    assert abs(r.render_to_depth_image(z_in_view_space=True)[60, 80] - 1.5) < 0.01
+    assert abs(r.render_to_depth_image(False)[60, 80] - (1 - r.near_plane / 1.5)) < 0.01
+
+
+def test_the_background_with_meshes(display, backend):
+    r = Renderer(64, 48, backend, meshes=True)
+    patch = wall(4)
+    patch.point.positions[:, :2] *= 0.2  # 16 splats within 0.4 of the axis: the corners are empty
+    r.scene.add_geometry("wall", patch)
+    r.scene.set_background([0.2, 0.4, 0.6])
+    fy = 24 / np.tan(np.radians(30))
+    r.setup_camera(o3d.camera.PinholeCamera(64, 48, fy, fy, 31.5, 23.5))
+    corner = r.render_to_image()[0, 0].astype(int)
+    # Filament's 8-bit target: within a level of round(background * 255).
+    assert np.abs(corner - np.round(np.array([0.2, 0.4, 0.6]) * 255)).max() <= 1, corner
 
 
 def test_meshes_need_meshes_true():
@@ -69,7 +81,7 @@ def test_meshes_need_meshes_true():
         r.scene.add_geometry("box", o3d.t.geometry.TriangleMesh.create_box())
     points = o3d.visualization.rendering.MaterialRecord()
     points.shader = "defaultUnlit"
-    with pytest.raises(o3d.Open3DError, match="only Gaussian splat clouds"):
+    with pytest.raises(o3d.Open3DError, match="draws Gaussian splat clouds only; set material.shader = 'gaussianSplat'"):
         r.scene.add_geometry("points", wall(), points)
 
 

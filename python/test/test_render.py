@@ -39,7 +39,7 @@ def test_render_equals_gs_render(data, gs_render, backend, tmp_path):
     expected = np.load(npy)
     r = Renderer(160, 160, backend)
     r.scene.add_geometry("playbot", o3d.t.io.read_point_cloud(str(scene)))
-    r.setup_camera(o3d.camera.read_cameras_json(str(cameras))[0].camera)
+    r.setup_camera(o3d.camera.read_cameras_json(str(cameras))[0].camera, rescale=True)
     image = r.render_to_image()
     assert image.shape == (160, 160, 4) and image.dtype == np.float32
     np.testing.assert_array_equal(image, expected)
@@ -53,24 +53,25 @@ def test_render_equals_gs_render(data, gs_render, backend, tmp_path):
 
 def test_batch_equals_single_renders(data, backend):
     pcd = o3d.t.io.read_point_cloud(str(data("playbot/playbot_31k.ply")))
-    views = o3d.camera.read_cameras_json(str(data("playbot/cameras.json")))[:3]
+    # At the renderer's size: cameras of another size would need rescale=True.
+    views = [v.camera.resized(96, 96) for v in o3d.camera.read_cameras_json(str(data("playbot/cameras.json")))[:3]]
     r = Renderer(96, 96, backend)
     r.scene.add_geometry("playbot", pcd)
-    batch = r.render_batch([v.camera for v in views])
+    batch = r.render_batch(views)
     assert batch.shape == (3, 96, 96, 4)
     for i, v in enumerate(views):
-        r.setup_camera(v.camera)
+        r.setup_camera(v)
         np.testing.assert_array_equal(batch[i], r.render_to_image(), err_msg=f"view {i}")
     # Into an array of the caller's, reused: the same images, the same object back.
     out = np.full_like(batch, -1.0)
-    assert r.render_batch([v.camera for v in views], out=out) is out
+    assert r.render_batch(views, out=out) is out
     np.testing.assert_array_equal(out, batch)
     with pytest.raises(o3d.Open3DError, match=r"out must be a writeable C-contiguous float32 array of shape \(3, 96, 96, 4\)"):
-        r.render_batch([v.camera for v in views], out=np.zeros((3, 96, 96, 3), np.float32))
+        r.render_batch(views, out=np.zeros((3, 96, 95, 4), np.float32))
     with pytest.raises(o3d.Open3DError, match="out must be"):
-        r.render_batch([v.camera for v in views], "uint8", out=out)
+        r.render_batch(views, "uint8", out=out)
     # 8-bit batches: the device's (or the CPU's) rounding of the same floats.
-    batch8 = r.render_batch([v.camera for v in views], "uint8")
+    batch8 = r.render_batch(views, "uint8", alpha=True)  # RGBA, as batch_array holds it
     assert batch8.dtype == np.uint8
     assert np.abs(batch8 / 255.0 - np.clip(batch, 0, 1)).max() <= 1.0 / 255 + 1e-6
     # Into a batch_array (on Vulkan the GPU writes it directly): the same bytes, in both
@@ -80,11 +81,11 @@ def test_batch_equals_single_renders(data, backend):
         assert arr.shape == (3, 96, 96, 4) and arr.dtype == expected.dtype
         assert arr.ctypes.data % 65536 == 0
         arr.fill(7)
-        assert r.render_batch([v.camera for v in views], dtype, out=arr) is arr
+        assert r.render_batch(views, dtype, out=arr) is arr
         np.testing.assert_array_equal(arr, expected, err_msg=dtype)
     big = r.batch_array(4)
     big.fill(-1)
-    r.render_batch([v.camera for v in views], out=big[1:])
+    r.render_batch(views, out=big[1:])
     np.testing.assert_array_equal(big[1:], batch)
     assert (big[0] == -1).all()
     del r
@@ -114,7 +115,7 @@ def test_rendering_releases_the_gil(data):
     pcd = o3d.t.io.read_point_cloud(str(data("playbot/playbot_31k.ply")))
     r = Renderer(400, 400, "cpu")  # about a second here: long enough to count
     r.scene.add_geometry("playbot", pcd)
-    r.setup_camera(o3d.camera.read_cameras_json(str(data("playbot/cameras.json")))[0].camera)
+    r.setup_camera(o3d.camera.read_cameras_json(str(data("playbot/cameras.json")))[0].camera, rescale=True)
     done = threading.Event()
     rendering = False
     ticks = 0
@@ -146,7 +147,7 @@ def test_knobs_as_keyword_arguments(data, backend):
         r = Renderer(64, 64, backend, sh_degree=degree)
         assert r.sh_degree == degree
         r.scene.add_geometry("playbot", pcd)
-        r.setup_camera(camera)
+        r.setup_camera(camera, rescale=True)
         images[degree] = r.render_to_image()
     assert np.abs(images[0] - images[2]).max() > 1e-3  # the SH bands above 0 change colours
     r.sh_degree = 0
@@ -231,7 +232,7 @@ def test_render_views_example_writes_every_view(data, tmp_path):
     views = o3d.camera.read_cameras_json(str(cameras))
     r = Renderer(48, 40, "vulkan")
     r.scene.add_geometry("playbot", o3d.t.io.read_point_cloud(str(scene)))
-    expected = r.render_batch([v.camera for v in views], "uint8")
+    expected = r.render_batch([v.camera for v in views], "uint8", rescale=True)
     assert len(list(tmp_path.glob("view_*.png"))) == len(views)
     for i in range(len(views)):
         np.testing.assert_array_equal(read_png_rgb(tmp_path / f"view_{i:03d}.png"),
