@@ -10,6 +10,7 @@ import sys as _sys
 
 from . import _core
 from ._core import Open3DError, camera, t, visualization
+from ._rasterization import rasterization  # gsplat-style: arrays in, images out
 
 # `import open3d_gs.t.io` and `from open3d_gs.camera import PinholeCamera` work as in
 # Open3D: the extension's submodules are registered under the package's names.
