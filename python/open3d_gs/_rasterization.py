@@ -81,8 +81,8 @@ def _require_finite(name, array):
 
 def _normalised_quats(quats):
     """Unit quaternions as the library's readers make them (t/io SplatColumns.cpp): the squared
-    norm in float64; rows already unit to 2^-20 kept bit for bit, the others divided by the
-    norm in float64 and rounded to float32."""
+    norm in float64; rows already unit to 2^-20 kept bit for bit, the others multiplied by
+    1 / norm in float64 and rounded to float32."""
     q = quats.astype(np.float64)
     n2 = np.einsum("ij,ij->i", q, q)
     if (n2 == 0.0).any():
