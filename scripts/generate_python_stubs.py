@@ -205,6 +205,7 @@ def package_stub(package):
 from . import io as io
 from . import t as t
 from . import visualization as visualization
+from ._rasterization import rasterization as rasterization
 
 __version__: str
 

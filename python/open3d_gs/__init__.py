@@ -23,6 +23,7 @@ except ImportError as _error:
 
 from . import _core
 from ._core import Open3DError, Open3DFileNotFoundError, camera, io, t, visualization
+from ._rasterization import rasterization  # gsplat-style: arrays in, images out
 
 __version__ = _core.__version__
 

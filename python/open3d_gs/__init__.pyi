@@ -13,6 +13,7 @@ from . import camera as camera
 from . import io as io
 from . import t as t
 from . import visualization as visualization
+from ._rasterization import rasterization as rasterization
 
 __version__: str
 

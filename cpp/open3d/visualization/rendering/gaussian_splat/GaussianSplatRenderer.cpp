@@ -103,6 +103,11 @@ void GaussianSplatRenderer::Clear() {
     StopStreaming();
     if (!clouds_.empty()) merged_dirty_ = true;
     clouds_.clear();
+    // The backend's copy of the scene (host and device memory) goes now, not at the next
+    // Prepare: a renderer kept for later scenes (open3d_gs.rasterization's cache) must not
+    // hold the last one between calls.
+    backend_->ReleaseResources();
+    has_current_view_ = false;
 }
 
 void GaussianSplatRenderer::StreamSplats(const std::string& path,

@@ -60,6 +60,7 @@ public:
     bool HasCloud(const std::string& name) const { return clouds_.count(name) > 0; }
     bool IsCloudVisible(const std::string& name) const;
     std::vector<std::string> GetCloudNames() const;
+    /// Removes every cloud, ends a stream and frees the backend's scene and view buffers now.
     void Clear();
 
     /// Streams a paged splat file (.gspages, gs-convert --pages) instead of clouds
