@@ -115,6 +115,11 @@ int64_t CountRed(const t::geometry::Image& rgb) {
     return red;
 }
 
+void PressKey(visualization::Visualizer& vis, int key) {
+    vis.OnKey(key, true, false, 0);
+    vis.OnKey(key, false, false, 0);
+}
+
 double MeanAbsDiff(const t::geometry::Image& a, const t::geometry::Image& b, int64_t x0, int64_t y0,
                    int64_t x1, int64_t y1) {
     const int64_t w = a.GetCols(), c = a.GetChannels();

@@ -46,6 +46,8 @@ protected:
     std::unique_ptr<visualization::Visualizer> vis_;
 };
 
+/// A key pressed and released, as GLFW reports it to the window.
+void PressKey(visualization::Visualizer& vis, int key);
 /// Pixels whose colour is the sphere's red (g and b near 0, r clearly up).
 int64_t CountRed(const t::geometry::Image& rgb);
 /// Mean absolute difference per channel over the rectangle [x0, x1) x [y0, y1) of two
