@@ -15,10 +15,8 @@ Scenes in other formats are read with open3d_gs.t.io and their arrays pulled out
 import argparse
 import json
 import pathlib
-import struct
 import sys
 import time
-import zlib
 
 import numpy as np
 
@@ -92,18 +90,6 @@ def gsplat_cameras(entries, width, height):
     return np.array(viewmats), np.array(Ks)
 
 
-def write_png(path, rgb):
-    """An 8-bit RGB PNG with the standard library alone."""
-    h, w, _ = rgb.shape
-    raw = b"".join(b"\x00" + rgb[y].tobytes() for y in range(h))
-
-    def chunk(kind, body):
-        return struct.pack(">I", len(body)) + kind + body + struct.pack(">I", zlib.crc32(kind + body))
-
-    path.write_bytes(b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", w, h, 8, 2, 0, 0, 0))
-                     + chunk(b"IDAT", zlib.compress(raw, 6)) + chunk(b"IEND", b""))
-
-
 def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("scene", help="3DGS PLY (other formats through open3d_gs.t.io)")
@@ -135,7 +121,7 @@ def main():
             backgrounds=backgrounds, render_mode="RGB+ED", backend=args.backend)
         for view, image in zip(chunk, colors):
             rgb8 = np.round(np.clip(image[..., :3], 0.0, 1.0) * 255.0).astype(np.uint8)
-            write_png(out / f"view_{view:03d}.png", rgb8)
+            open3d_gs.io.write_image(out / f"view_{view:03d}.png", rgb8)
             np.save(out / f"depth_{view:03d}.npy", image[..., 3])
     seconds = time.monotonic() - start
     print(f"{len(ids)} views of {width}x{height} ({len(means)} splats, SH degree {meta['sh_degree']}, "

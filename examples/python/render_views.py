@@ -8,24 +8,10 @@ import argparse
 import pathlib
 import sys
 import time
-import zlib
-import struct
 
 import numpy as np
 
 import open3d_gs as o3d
-
-
-def write_png(path, rgb):
-    """An 8-bit RGB PNG with the standard library alone (no imaging package needed)."""
-    h, w, _ = rgb.shape
-    raw = b"".join(b"\x00" + rgb[y].tobytes() for y in range(h))
-
-    def chunk(kind, body):
-        return struct.pack(">I", len(body)) + kind + body + struct.pack(">I", zlib.crc32(kind + body))
-
-    path.write_bytes(b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", w, h, 8, 2, 0, 0, 0))
-                     + chunk(b"IDAT", zlib.compress(raw, 6)) + chunk(b"IEND", b""))
 
 
 def main():
@@ -54,7 +40,7 @@ def main():
         # rescale=True: --width / --height ask for the views at another size.
         images = renderer.render_batch([v.camera for v in chunk], "uint8", out=batch[:len(chunk)], rescale=True)
         for i, image in enumerate(images):
-            write_png(out / f"view_{first + i:03d}.png", np.ascontiguousarray(image[..., :3]))
+            o3d.io.write_image(out / f"view_{first + i:03d}.png", np.ascontiguousarray(image[..., :3]))
         done = first + len(chunk)
         bar = "#" * (30 * done // len(views))
         print(f"\r[{bar:<30}] {done}/{len(views)} views", end="", file=sys.stderr, flush=True)

@@ -8,7 +8,6 @@ import subprocess
 import sys
 import threading
 import time
-import zlib
 
 import numpy as np
 import pytest
@@ -206,19 +205,10 @@ def test_objects_can_go_in_any_order():
 
 
 def read_png_rgb(path):
-    """Decodes the example's PNGs (8-bit RGB, filter 0 on every row, one IDAT) with zlib."""
-    data = path.read_bytes()
-    assert data[:8] == b"\x89PNG\r\n\x1a\n"
-    width, height = int.from_bytes(data[16:20], "big"), int.from_bytes(data[20:24], "big")
-    at, idat = 8, b""
-    while at < len(data):
-        length = int.from_bytes(data[at:at + 4], "big")
-        if data[at + 4:at + 8] == b"IDAT":
-            idat += data[at + 8:at + 8 + length]
-        at += 12 + length
-    rows = np.frombuffer(zlib.decompress(idat), np.uint8).reshape(height, 1 + width * 3)
-    assert (rows[:, 0] == 0).all()
-    return rows[:, 1:].reshape(height, width, 3)
+    """The example's 8-bit RGB PNG (written by o3d.io.write_image through libpng)."""
+    image = o3d.io.read_image(path)
+    assert image.dtype == np.uint8 and image.ndim == 3 and image.shape[2] == 3
+    return image
 
 
 def test_render_views_example_writes_every_view(data, tmp_path):

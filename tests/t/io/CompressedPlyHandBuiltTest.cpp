@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "ExpectReadError.h"
 #include "TestUtility.h"
 #include "open3d/core/Exception.h"
 #include "open3d/t/geometry/SphericalHarmonics.h"
@@ -150,22 +151,6 @@ TEST(CompressedPly, HandBuiltSHElement) {
     };
     for (int ch = 0; ch < 3; ++ch) {
         for (int k = 0; k < 3; ++k) EXPECT_FLOAT_EQ(rest[k * 3 + ch], expect(bytes[ch * 3 + k]));
-    }
-}
-
-// Every malformed file must fail with an Open3DError naming the file and what is wrong.
-void ExpectReadError(const std::string& path, std::initializer_list<const char*> fragments) {
-    PointCloud cloud;
-    try {
-        ReadPointCloud(path, cloud);
-        ADD_FAILURE() << "no error for " << path;
-    } catch (const core::Open3DError& e) {
-        const std::string message = e.what();
-        EXPECT_NE(message.find(path), std::string::npos) << message;
-        for (const char* fragment : fragments) {
-            EXPECT_NE(message.find(fragment), std::string::npos)
-                << "'" << fragment << "' not in: " << message;
-        }
     }
 }
 

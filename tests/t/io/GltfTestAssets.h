@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "ExpectReadError.h"
 #include "open3d/core/Exception.h"
 #include "open3d/t/io/GltfCommon.h"
 #include "open3d/t/io/PointCloudIO.h"
@@ -216,23 +217,7 @@ inline void ExpectMinimalValues(const PointCloud& cloud) {
     EXPECT_EQ(o[2], gltf::kOpaqueLogit);                  // alpha 1 -> 18
 }
 
-// Expects the read to throw with the file name and every fragment in the message.
-inline void ExpectReadError(const std::string& path, const std::vector<std::string>& fragments) {
-    PointCloud cloud(Tensor::FromVector<float>({7, 8, 9}, {1, 3}));
-    const PointCloud before = cloud;
-    try {
-        ReadPointCloud(path, cloud);
-        ADD_FAILURE() << "no error reading " << path;
-    } catch (const Open3DError& e) {
-        const std::string message = e.what();
-        EXPECT_NE(message.find(path), std::string::npos) << message;
-        for (const auto& fragment : fragments) {
-            EXPECT_NE(message.find(fragment), std::string::npos)
-                << "'" << fragment << "' not in: " << message;
-        }
-    }
-    EXPECT_TRUE(cloud == before) << "a failed read changed the output cloud";
-}
+using io::ExpectReadError;  // ExpectReadError.h
 
 }  // namespace gltf_test
 }  // namespace io

@@ -8,6 +8,7 @@
 #include <cstring>
 #include <fstream>
 
+#include "ExpectReadError.h"
 #include "TestUtility.h"
 #include "open3d/core/Exception.h"
 #include "open3d/t/geometry/SphericalHarmonics.h"
@@ -354,21 +355,6 @@ TEST(Ksplat, DefaultSHRangeAndTrailingBytes) {
     // sh[0] (coefficient 1, red) was stored as byte EncodeSH8(sh[0]) over -2 .. 3.
     const double expected = EncodeSH8(first.sh[0]) / 255.0 * 3.0 - 1.5;
     EXPECT_FLOAT_EQ(F(cloud, "f_rest")[0], float(expected));
-}
-
-void ExpectReadError(const std::string& path, std::initializer_list<const char*> fragments) {
-    PointCloud cloud;
-    try {
-        ReadPointCloud(path, cloud);
-        ADD_FAILURE() << "no error for " << path;
-    } catch (const core::Open3DError& e) {
-        const std::string message = e.what();
-        EXPECT_NE(message.find(path), std::string::npos) << message;
-        for (const char* fragment : fragments) {
-            EXPECT_NE(message.find(fragment), std::string::npos)
-                << "'" << fragment << "' not in: " << message;
-        }
-    }
 }
 
 TEST(Ksplat, MalformedFilesGiveCleanErrors) {

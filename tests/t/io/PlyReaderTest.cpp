@@ -6,6 +6,7 @@
 #include <fstream>
 #include <limits>
 
+#include "ExpectReadError.h"
 #include "PlyTestFiles.h"
 #include "TestUtility.h"
 #include "open3d/core/Exception.h"
@@ -23,25 +24,6 @@ using tests::GaussianPropertyNames;
 using tests::PlausibleRows;
 using tests::WriteFloatPly;
 using tests::WriteText;
-
-// Expects ReadPointCloud to throw with every fragment in the message, and the cloud untouched.
-void ExpectReadError(const std::string& path, const std::vector<std::string>& fragments,
-                     const ReadPointCloudOptions& options = {}) {
-    PointCloud cloud(core::Tensor::FromVector<float>({7, 8, 9}, {1, 3}));
-    const PointCloud before = cloud;
-    try {
-        ReadPointCloud(path, cloud, options);
-        ADD_FAILURE() << "no error reading " << path;
-    } catch (const Open3DError& e) {
-        const std::string message = e.what();
-        EXPECT_NE(message.find(path), std::string::npos) << message;
-        for (const auto& fragment : fragments) {
-            EXPECT_NE(message.find(fragment), std::string::npos)
-                << "'" << fragment << "' not in: " << message;
-        }
-    }
-    EXPECT_TRUE(cloud == before) << "a failed read changed the output cloud";
-}
 
 TEST(PlyReader, ReadsEveryDegreeWithDerivedValues) {
     const std::string dir = tests::TempDir();

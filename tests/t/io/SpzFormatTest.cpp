@@ -49,6 +49,7 @@
 #include <fstream>
 #include <random>
 
+#include "ExpectReadError.h"
 #include "TestUtility.h"
 #include "open3d/core/Exception.h"
 #include "open3d/core/Logging.h"
@@ -143,19 +144,6 @@ void PutFixed(Bytes& b, std::array<int32_t, 3> v) {
     for (int32_t x : v) {
         for (int i = 0; i < 3; ++i) b.push_back(uint8_t(uint32_t(x) >> (8 * i)));
     }
-}
-
-void ExpectReadError(const std::string& path, std::initializer_list<const char*> needles) {
-    PointCloud cloud;
-    try {
-        ReadPointCloud(path, cloud);
-        ADD_FAILURE() << path << ": no error";
-    } catch (const core::Open3DError& e) {
-        const std::string msg = e.what();
-        EXPECT_NE(msg.find(path), std::string::npos) << msg;
-        for (const char* needle : needles) EXPECT_NE(msg.find(needle), std::string::npos) << msg;
-    }
-    EXPECT_TRUE(cloud.IsEmpty());
 }
 
 const float* F(const PointCloud& c, const char* name) { return c.GetPointAttr(name).Data<float>(); }
