@@ -26,6 +26,8 @@ Renderer = o3d.visualization.rendering.OffscreenRenderer
 SIZE = 64
 DEADLINE = 600  # seconds; only a hang reaches it
 SCENE, CAMERAS = "playbot/playbot_31k.ply", "playbot/cameras.json"
+# Worker processes and the command import open3d_gs from where this process did.
+PACKAGE_PARENT = os.path.dirname(os.path.dirname(os.path.abspath(o3d.__file__)))
 
 
 @pytest.fixture(scope="module")
@@ -36,10 +38,8 @@ def client():
         Renderer(1, 1, "vulkan")
     except o3d.Open3DError as e:
         unavailable(f"no Vulkan device: {e}")
-    # The workers are spawned processes: they import open3d_gs from where this one did.
-    package_parent = os.path.dirname(os.path.dirname(os.path.abspath(o3d.__file__)))
-    with pytest.MonkeyPatch.context() as mp:
-        mp.setenv("PYTHONPATH", os.pathsep.join([package_parent, os.environ.get("PYTHONPATH", "")]))
+    with pytest.MonkeyPatch.context() as mp:  # the workers are spawned processes
+        mp.setenv("PYTHONPATH", os.pathsep.join([PACKAGE_PARENT, os.environ.get("PYTHONPATH", "")]))
         cluster = LocalCluster(n_workers=2, processes=True, threads_per_worker=1, dashboard_address=None,
                                silence_logs=logging.ERROR)
     with Client(cluster) as c:
@@ -186,8 +186,10 @@ def test_a_killed_workers_views_are_rendered_again(client, reference, tmp_path):
 
 
 def cli(*args, cwd):
+    """The command, run in `cwd` and importing this process's open3d_gs."""
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join([PACKAGE_PARENT, os.environ.get("PYTHONPATH", "")]))
     return subprocess.run([sys.executable, "-m", "open3d_gs.distributed", *map(str, args)], cwd=cwd,
-                          capture_output=True, text=True, timeout=DEADLINE, env=dict(os.environ))
+                          capture_output=True, text=True, timeout=DEADLINE, env=env)
 
 
 def test_command_line_renders_a_job_list_end_to_end(client, reference, tmp_path):
