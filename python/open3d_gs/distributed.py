@@ -186,7 +186,10 @@ class _Pool:
         return ok, dict(self.resources)
 
     def refresh(self):
-        info = self.client.scheduler_info()["workers"]
+        try:  # every worker: Dask since 2025 lists 5 unless told (older Dask ignores the argument)
+            info = self.client.scheduler_info(n_workers=-1)["workers"]
+        except TypeError:
+            info = self.client.scheduler_info()["workers"]
         lost = []
         for address in list(self.members):
             if address not in info:
@@ -240,6 +243,8 @@ def _pick(queue, member, pool, cache_scenes):
     fewest workers hold (so that workers spread over jobs before sharing one)."""
     for i, batch in enumerate(queue):
         if batch.state.key in member["scenes"]:
+            member["scenes"].remove(batch.state.key)
+            member["scenes"].append(batch.state.key)  # most recently used, as in the actor
             return queue.pop(i)
     holders = {}
     for _, m in pool.ready():
@@ -280,6 +285,7 @@ def render_jobs(client, jobs, *, batch=8, retries=3, backend="vulkan", resources
     pool = _Pool(client, backend, cache_scenes, worker_hook, resources, say)
     report = Report(jobs=[s.result for s in states], workers=pool.stats)
     start = time.monotonic()
+    first_sent = None  # the report's seconds run from here: actor start-up is not rendering
     next_refresh, no_worker_since = 0.0, None
 
     def requeue(batches):
@@ -366,6 +372,7 @@ def render_jobs(client, jobs, *, batch=8, retries=3, backend="vulkan", resources
                 b = _pick(queue, m, pool, cache_scenes)
                 if b.state.started is None:
                     b.state.started = time.monotonic()
+                first_sent = first_sent or b.state.started
                 try:
                     future = m["actor"].render(b.state.spec, b.views, return_arrays)
                 except Exception as e:  # noqa: BLE001 - "Worker holding Actor was lost"
@@ -389,7 +396,7 @@ def render_jobs(client, jobs, *, batch=8, retries=3, backend="vulkan", resources
                     fail(s, f"not finished after {timeout:g} s")
         if not progressed:
             time.sleep(poll)
-    report.seconds = time.monotonic() - start
+    report.seconds = time.monotonic() - (first_sent or start)
     for address, m in list(pool.members.items()):
         client.cancel([m["future"]])
     return report

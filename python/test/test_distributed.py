@@ -263,3 +263,42 @@ def test_command_line_errors_name_the_file_and_the_field(data, tmp_path):
     assert done.returncode == 0
     for option in ("--scheduler", "--local-workers", "--batch", "--retries", "--resources", "--report", "view_NNN.png"):
         assert option in done.stdout, option
+
+
+def test_workers_that_declare_a_gpu_are_the_ones_used():
+    """resources="auto": the workers declaring GPU (dask worker --resources GPU=1) if any does,
+    each asked for one GPU; else every worker. None: every worker; a dict: those that have it."""
+    from open3d_gs.distributed import _Pool
+
+    info = {"cpu": {"resources": {}}, "gpu0": {"resources": {"GPU": 1}}, "gpu1": {"resources": {"GPU": 2.0}},
+            "big": {"resources": {"MEMORY": 64e9}}}
+
+    def wanted(resources, workers=info):  # the scheduler's worker records, as scheduler_info gives them
+        return _Pool(None, "vulkan", 2, None, resources, print)._wanted(workers)
+
+    assert wanted("auto") == ({"gpu0", "gpu1"}, {"GPU": 1})
+    assert wanted("auto", {"cpu": {"resources": {}}, "other": {}}) == ({"cpu", "other"}, None)
+    assert wanted(None) == (set(info), None)
+    assert wanted({"GPU": 2}) == ({"gpu1"}, {"GPU": 2})
+    assert wanted({"MEMORY": 1e9}) == ({"big"}, {"MEMORY": 1e9})
+
+
+def test_a_worker_picks_its_vulkan_device_by_index():
+    """OPEN3D_VULKAN_DEVICE_INDEX (a process per GPU, docs/distributed.md): 0 is lavapipe
+    here; an index past the devices and a non-number are refused with the reason."""
+    try:
+        Renderer(1, 1, "vulkan")
+    except o3d.Open3DError as e:
+        unavailable(f"no Vulkan device: {e}")
+    code = ("import open3d_gs as o3d\n"
+            "try:\n    print(o3d.visualization.rendering.OffscreenRenderer(8, 8, 'vulkan').backend)\n"
+            "except o3d.Open3DError as e:\n    print('error:', e)\n")
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join([PACKAGE_PARENT, os.environ.get("PYTHONPATH", "")]))
+    outputs = {}
+    for index in ("0", "7", "first"):
+        done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=DEADLINE,
+                              env=dict(env, OPEN3D_VULKAN_DEVICE_INDEX=index))
+        outputs[index] = done.stdout
+    assert outputs["0"].strip() == "vulkan", outputs
+    assert "no usable device" in outputs["7"] and "not OPEN3D_VULKAN_DEVICE_INDEX=7" in outputs["7"], outputs
+    assert "OPEN3D_VULKAN_DEVICE_INDEX must be a device number" in outputs["first"], outputs
