@@ -42,8 +42,11 @@ prepare() {
   mkdir -p "$pymod/lib"
   # The module's link line, from ninja: objects dropped, our archives and static third-party
   # libraries copied into .pymod/lib, shared ones named by SONAME (they are in .devlibs).
-  local link
-  link=$(cd "$build" && ninja -t commands open3d_gs_core | grep -m1 -- "-o python/open3d_gs/_core")
+  # (ninja's whole output first: grep -m1 in a pipe would end ninja early, a SIGPIPE that
+  # pipefail turns into a failure now and then.)
+  local commands link
+  commands=$(cd "$build" && ninja -t commands open3d_gs_core)
+  link=$(grep -m1 -- "-o python/open3d_gs/_core" <<<"$commands")
   link=${link#: && }  # ": && compiler ... && strip ... && copy ..."
   : >"$pymod/link.txt"
   local word soname
@@ -60,7 +63,7 @@ prepare() {
   # Compile flags of cpp/pybind's first source: defines, language, optimisation, the
   # floating-point contract. Not -Werror (another compiler may warn) nor -flto (GCC there).
   local compile
-  compile=$(cd "$build" && ninja -t commands open3d_gs_core | grep -m1 -- "-c $root/cpp/pybind/")
+  compile=$(grep -m1 -- "-c $root/cpp/pybind/" <<<"$commands")
   for word in $compile; do
     case "$word" in
       -D*_EXPORTS) ;;
@@ -74,13 +77,14 @@ prepare() {
     (cd "$build" && ninja -t deps "${o#"$build"/}")
   done | sed -n 's|^ *\(/usr/include/[^/]*\)/.*|\1|p' | sort -u |
     grep -vE '/(c\+\+|x86_64-linux-gnu|python3[.0-9]*|pybind11|linux|asm|asm-generic|sys|bits)$' >"$pymod/include-dirs.txt"
-  tar -C /usr/include -czf "$pymod/include.tar.gz" $(sed 's|/usr/include/||' "$pymod/include-dirs.txt")
+  local dirs=()
+  mapfile -t dirs < <(sed 's|/usr/include/||' "$pymod/include-dirs.txt")
+  tar -C /usr/include -czf "$pymod/include.tar.gz" "${dirs[@]}"
   tar -C /usr/include -czf "$pymod/pybind11-debian.tar.gz" pybind11
   # Debian's dask and distributed are pure Python (tornado's one extension is abi3).
-  local dist=/usr/lib/python3/dist-packages
-  tar -C "$dist" --exclude=tests --exclude=__pycache__ -czf "$pymod/pydeps.tar.gz" \
-    dask distributed tornado partd locket zict tblib \
-    $(cd "$dist" && ls -d {dask,distributed,tornado,partd,locket,zict,tblib}-*.egg-info)
+  local dist=/usr/lib/python3/dist-packages packages=(dask distributed tornado partd locket zict tblib) p
+  for p in "${packages[@]}"; do packages+=("$(cd "$dist" && echo "$p"-*.egg-info)"); done
+  tar -C "$dist" --exclude=tests --exclude=__pycache__ -czf "$pymod/pydeps.tar.gz" "${packages[@]}"
   echo "prepare: .pymod holds $(du -sh "$pymod" | cut -f1); carry .gl .devlibs .pymod and the scene files:"
   echo "  [\".gl\", \".devlibs\", \".pymod\", \"shared/data/playbot/playbot_125k.ply\", \"shared/data/playbot/cameras.json\"]"
 }
@@ -116,8 +120,8 @@ build() {
   local common=("${flags[@]}" -fPIC -I"$root/cpp" -I"$root/shaders" -isystem "$inc" -isystem "$inc/eigen3")
   # shellcheck disable=SC2206  # the includes are words, as pybind11 prints them
   common+=($includes)
-  printf '%s\n' cpp/pybind/*.cpp | xargs -P "${BUILD_JOBS:-$(nproc)}" -I{} sh -c \
-    'f={}; exec "$0" "$@" -c "$f" -o "'"$obj"'/$(basename "$f" .cpp).o"' "$cxx" "${common[@]}"
+  (cd cpp/pybind && ls -- *.cpp) | sed 's/\.cpp$//' |
+    xargs -P "${BUILD_JOBS:-$(nproc)}" -I{} "$cxx" "${common[@]}" -c "$root/cpp/pybind/{}.cpp" -o "$obj/{}.o"
   local libs=() kind name
   while read -r kind name; do
     if [ "$kind" = static ]; then libs+=("$root/$pymod/lib/$name"); else libs+=("-l:$name"); fi
@@ -133,9 +137,10 @@ build() {
 runtime_libs() {
   local dir=${1:?}
   mkdir -p "$dir"
-  local f
+  local f system
+  system=$(ldconfig -p | awk '{print $1}')
   for f in "$root"/.devlibs/*; do
-    ldconfig -p | awk '{print $1}' | grep -qxF "$(basename "$f")" || ln -sf "$f" "$dir/"
+    grep -qxF "$(basename "$f")" <<<"$system" || ln -sf "$f" "$dir/"
   done
 }
 
@@ -157,7 +162,9 @@ measure() {
   export LD_LIBRARY_PATH="$work/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
   export PYTHONPATH="$work/python:$work/pydeps${PYTHONPATH:+:$PYTHONPATH}"
   export PYTHONUNBUFFERED=1
-  echo "measure: carried libraries in use: $(ls "$work/lib" | tr '\n' ' ')"
+  local carried=("$work"/lib/*)
+  [ -e "${carried[0]}" ] || carried=(none)
+  echo "measure: carried libraries in use (this machine lacks them): ${carried[*]##*/}"
   "$python" -c 'import dask, distributed; print("dask", dask.__version__, "from", dask.__file__, "distributed", distributed.__version__)'
   # The module renders with Vulkan: one view against the CPU reference.
   "$python" - <<'PY'
