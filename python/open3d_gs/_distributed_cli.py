@@ -18,8 +18,9 @@ cameras and output paths at the same names (a shared file system) and import ope
 Prints a line per finished or failed job and a summary (views/s per worker: views over the
 seconds spent in its render calls; in total: views over the run's wall time). A batch lost
 with its worker is rendered again elsewhere (--retries); a job whose scene or cameras cannot
-be read fails alone. Exit status: 0 every job done, 1 a job failed or the cluster could not
-be used, 2 a bad command line or job list (nothing rendered).
+be read fails alone (the summary repeats each failure). Exit status: 0 every job done, 1 a
+job failed or the cluster could not be used, 2 a bad command line or job list (nothing
+rendered).
 """
 
 EPILOG = """\
@@ -36,7 +37,8 @@ CSV job list: a header row naming some of name,scene,cameras,views,resolution,fo
 formats,dtype and a row per job (views "all" or "0-7 12"; formats "png npy").
 Relative paths are relative to the job list's folder. Unknown fields are errors. Outputs
 that would overwrite an input (a scene, a cameras file, a job list) or another job's output
-are refused before anything renders.
+are refused before anything renders; with "views": "all" the file names are known once
+cameras.json is read, and such a job fails alone.
 """
 
 

@@ -97,6 +97,7 @@ class Report:
             lines.append(f"worker {w.address} (pid {w.pid} on {w.host}): {w.views} views in {w.busy_s:.2f} s busy "
                          f"({w.views_per_second:.1f} views/s), {w.loads} scene loads ({w.load_s:.2f} s){lost}")
         failed = sum(j.error is not None for j in self.jobs)
+        lines.extend(f"FAILED {j.name}: {j.error}" for j in self.jobs if j.error is not None)
         lines.append(f"total: {self.views} views in {self.seconds:.2f} s ({self.views_per_second:.1f} views/s) on "
                      f"{sum(w.views > 0 for w in self.workers.values())} workers; {len(self.jobs) - failed} jobs done, {failed} failed; "
                      f"{len(self.lost_workers)} workers lost, {self.retried_views} views rendered again")

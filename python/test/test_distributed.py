@@ -219,7 +219,7 @@ def test_command_line_renders_a_job_list_end_to_end(client, reference, tmp_path)
     assert done.returncode == 1, done.stderr  # one job failed
     check_outputs(tmp_path / "csv-out", [7, 9], reference)
     assert "job broken FAILED: load: Open3DError: Cannot open" in done.stderr, done.stderr
-    assert "1 jobs done, 1 failed" in done.stdout
+    assert "1 jobs done, 1 failed" in done.stdout and "FAILED broken: load: Open3DError" in done.stdout
 
 
 def test_command_line_errors_name_the_file_and_the_field(data, tmp_path):
@@ -259,6 +259,11 @@ def test_command_line_errors_name_the_file_and_the_field(data, tmp_path):
     (tmp_path / "bad.csv").write_text("scene,cameras,colour\na.ply,c.json,red\n")
     done = cli(tmp_path / "bad.csv", "--local-workers", 1, cwd=tmp_path)
     assert done.returncode == 2 and "bad.csv: column 'colour': unknown" in done.stderr, done.stderr
+    # --check reads and checks, prints the jobs, and needs no cluster.
+    done = cli(job_list(views=[3, 4]), "--check", "--scheduler", "tcp://127.0.0.1:1", cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    checked = [json.loads(line) for line in done.stdout.splitlines()]
+    assert [j["views"] for j in checked] == ["all", [3, 4]] and checked[1]["folder"] == str(tmp_path / "out")
     done = cli("--help", cwd=tmp_path)
     assert done.returncode == 0
     for option in ("--scheduler", "--local-workers", "--batch", "--retries", "--resources", "--report", "view_NNN.png"):
