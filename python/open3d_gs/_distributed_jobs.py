@@ -53,7 +53,7 @@ class Job:
 
 
 def _parse_views(value, where):
-    if value is None or value == "all":
+    if value is None or value == "all" or value == "":  # "": an empty CSV cell
         return "all"
     if isinstance(value, str):
         # "0 1 2", "0;1;2", "0,1,2" and ranges "0-7" (inclusive), as written in a CSV cell.

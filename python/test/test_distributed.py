@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 import open3d_gs as o3d
-from conftest import unavailable
+from conftest import DATA, unavailable
 
 try:
     from dask.distributed import Client, LocalCluster
@@ -51,8 +51,7 @@ def client():
 def reference():
     """This process's renders of every view at SIZE: the float32 image of each view alone
     (render_to_image) and render_batch's uint8 images (what a PNG holds)."""
-    root = pathlib.Path(os.environ.get("OPEN3D_DATA_DIR", pathlib.Path(__file__).parents[3] / "shared" / "data"))
-    scene, cameras = root / SCENE, root / CAMERAS
+    scene, cameras = DATA / SCENE, DATA / CAMERAS
     if not scene.exists() or not cameras.exists():
         unavailable(f"shared scene {scene} or {cameras} is absent")
     try:
