@@ -158,7 +158,9 @@ def _plan(state, protected):
                 return False
     width = job.width or cameras[views[0]].camera.width
     height = job.height or cameras[views[0]].camera.height
-    state.spec = dict(dataclasses.asdict(job), views=None, width=width, height=height)
+    # Absolute paths: a worker's working folder need not be the client's.
+    absolute = {k: os.path.abspath(getattr(job, k)) for k in ("scene", "cameras", "folder") if getattr(job, k)}
+    state.spec = dict(dataclasses.asdict(job), views=None, width=width, height=height, **absolute)
     state.result.views = views
     state.remaining = len(views)
     return True
