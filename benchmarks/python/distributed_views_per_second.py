@@ -37,7 +37,7 @@ def one_process(args, jobs, out):
     for job in jobs:
         for first in range(0, len(job.views), args.batch):
             chunk = job.views[first:first + args.batch]
-            images = r.render_batch([views[v].camera for v in chunk], dtype, out=buf[:len(chunk)])
+            images = r.render_batch([views[v].camera for v in chunk], dtype, out=buf[:len(chunk)], rescale=True)
             if args.formats != "none":
                 folder = out / "one" / job.name
                 folder.mkdir(parents=True, exist_ok=True)

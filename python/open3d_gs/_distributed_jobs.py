@@ -52,6 +52,9 @@ class Job:
         return [os.path.join(self.folder, f"view_{view:03d}.{fmt}") for fmt in self.formats]
 
 
+Job.__init__.__doc__ = "A Job from its fields, as the class describes them."
+
+
 def _parse_views(value, where):
     if value is None or value == "all" or value == "":  # "": an empty CSV cell
         return "all"

@@ -77,6 +77,7 @@ class SceneRenderer:
     """
 
     def __init__(self, backend="vulkan", cache_scenes=2, hook=None):
+        """Made on the worker by client.submit(SceneRenderer, ..., actor=True)."""
         import open3d_gs
 
         self._rendering = open3d_gs.visualization.rendering
@@ -125,12 +126,13 @@ class SceneRenderer:
 
     def _render(self, entry, cameras, dtype):
         """render_batch into a batch_array kept per scene and dtype (on Vulkan the GPU writes
-        it directly), grown when a batch is longer than the last."""
+        it directly; RGBA in both dtypes), grown when a batch is longer than the last. Cameras
+        of another size than the job's are scaled to it (rescale)."""
         buffers = entry["buffers"]
         buf = buffers.get(dtype)
         if buf is None or len(buf) < len(cameras):
             buf = buffers[dtype] = entry["renderer"].batch_array(len(cameras), dtype)
-        return entry["renderer"].render_batch(cameras, dtype, out=buf[:len(cameras)])
+        return entry["renderer"].render_batch(cameras, dtype, out=buf[:len(cameras)], rescale=True)
 
     def render(self, job, views, return_arrays=False):
         """Renders `views` (indices into job["cameras"]) of `job` (a dict of Job's fields with

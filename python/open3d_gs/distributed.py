@@ -42,6 +42,7 @@ class JobResult:
 
     @property
     def name(self):
+        """The job's name."""
         return self.job.name
 
 
@@ -62,6 +63,7 @@ class WorkerStats:
 
     @property
     def views_per_second(self):
+        """Views over the seconds inside this worker's render calls."""
         return self.views / self.busy_s if self.busy_s > 0 else 0.0
 
 
@@ -78,17 +80,21 @@ class Report:
 
     @property
     def ok(self):
+        """Whether every job rendered all its views."""
         return all(j.error is None for j in self.jobs)
 
     @property
     def views_per_second(self):
+        """Views over the run's wall time (from the first batch sent to the last result)."""
         return self.views / self.seconds if self.seconds > 0 else 0.0
 
     @property
     def lost_workers(self):
+        """The addresses of the workers lost during the run."""
         return [w.address for w in self.workers.values() if w.lost]
 
     def summary_lines(self):
+        """A line per worker that rendered or was lost, a line per failed job, and the total."""
         lines = []
         for w in self.workers.values():
             if not w.batches and not w.lost:
@@ -104,12 +110,19 @@ class Report:
         return lines
 
     def to_dict(self):
+        """The report as JSON-ready values (the command's --report file)."""
         return {"ok": self.ok, "seconds": self.seconds, "views": self.views,
                 "views_per_second": self.views_per_second, "retried_views": self.retried_views,
                 "jobs": [{"name": j.name, "views": len(j.views), "error": j.error, "seconds": j.seconds,
                           "folder": j.job.folder} for j in self.jobs],
                 "workers": [dict(dataclasses.asdict(w), views_per_second=w.views_per_second)
                             for w in self.workers.values()]}
+
+
+# The dataclasses' generated constructors say what they take (the package documents every
+# public callable, python/test/test_package.py).
+for _cls in (JobResult, WorkerStats, Report):
+    _cls.__init__.__doc__ = f"A {_cls.__name__} from its fields, as the class describes them."
 
 
 class _Batch:
@@ -406,6 +419,7 @@ def render_jobs(client, jobs, *, batch=8, retries=3, backend="vulkan", resources
 
 
 def main(argv=None):
+    """The command `python3 -m open3d_gs.distributed` (its --help); returns the exit status."""
     from ._distributed_cli import main as cli_main
 
     return cli_main(argv)

@@ -49,8 +49,8 @@ def client():
 
 @pytest.fixture(scope="module")
 def reference():
-    """This process's renders of every view at SIZE: the float32 image of each view alone
-    (render_to_image) and render_batch's uint8 images (what a PNG holds)."""
+    """This process's renders of every view at SIZE: the float32 RGBA image of each view alone
+    (render_to_image) and render_batch's uint8 RGBA images (a PNG holds their RGB)."""
     scene, cameras = DATA / SCENE, DATA / CAMERAS
     if not scene.exists() or not cameras.exists():
         unavailable(f"shared scene {scene} or {cameras} is absent")
@@ -62,10 +62,10 @@ def reference():
     views = o3d.camera.read_cameras_json(str(cameras))
     floats = []
     for v in views:
-        r.setup_camera(v.camera)
+        r.setup_camera(v.camera, rescale=True)  # 800 x 800 cameras, scaled to SIZE as the jobs ask
         floats.append(r.render_to_image().copy())
     return {"scene": str(scene), "cameras": str(cameras), "float32": np.stack(floats),
-            "uint8": r.render_batch([v.camera for v in views], "uint8")}
+            "uint8": r.render_batch([v.camera for v in views], "uint8", alpha=True, rescale=True)}
 
 
 def read_png_rgb(path):
@@ -217,8 +217,8 @@ def test_command_line_renders_a_job_list_end_to_end(client, reference, tmp_path)
     done = cli("jobs.csv", "--scheduler", client.scheduler.address, cwd=tmp_path)
     assert done.returncode == 1, done.stderr  # one job failed
     check_outputs(tmp_path / "csv-out", [7, 9], reference)
-    assert "job broken FAILED: load: Open3DError: Cannot open" in done.stderr, done.stderr
-    assert "1 jobs done, 1 failed" in done.stdout and "FAILED broken: load: Open3DError" in done.stdout
+    assert "job broken FAILED: load: Open3DFileNotFoundError: Cannot open" in done.stderr, done.stderr
+    assert "1 jobs done, 1 failed" in done.stdout and "FAILED broken: load: Open3DFileNotFoundError" in done.stdout
 
 
 def test_command_line_errors_name_the_file_and_the_field(data, tmp_path):

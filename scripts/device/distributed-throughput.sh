@@ -62,12 +62,13 @@ prepare() {
   done
   # Compile flags of cpp/pybind's first source: defines, language, optimisation, the
   # floating-point contract. Not -Werror (another compiler may warn) nor -flto (GCC there).
+  # xargs undoes ninja's shell quoting (-DOPEN3D_GS_VERSION=\"0.1.0\" becomes one word).
   local compile
   compile=$(grep -m1 -- "-c $root/cpp/pybind/" <<<"$commands")
-  for word in $compile; do
+  xargs -n1 printf '%s\n' <<<"$compile" | while read -r word; do
     case "$word" in
       -D*_EXPORTS) ;;
-      -D* | -std=* | -O? | -ffp-contract=* | -fvisibility=*) echo "$word" ;;
+      -D* | -std=* | -O? | -ffp-contract=* | -fvisibility=*) printf '%s\n' "$word" ;;
     esac
   done >"$pymod/flags.txt"
   # Third-party headers the bindings include (ninja's dependency records), beyond the C and
@@ -114,7 +115,7 @@ build() {
     echo "build: Debian's pybind11 headers from .pymod (python3 -m pybind11 failed)"
   fi
   local cxx=${CXX:-c++} flags=() suffix
-  read -r -a flags <<<"$(tr '\n' ' ' <"$pymod/flags.txt")"
+  mapfile -t flags <"$pymod/flags.txt"
   suffix=$("$python" -c 'import sysconfig; print(sysconfig.get_config_var("EXT_SUFFIX"))')
   echo "build: compiling cpp/pybind with $($cxx --version | head -1) for $("$python" --version)"
   local common=("${flags[@]}" -fPIC -I"$root/cpp" -I"$root/shaders" -isystem "$inc" -isystem "$inc/eigen3")
@@ -128,7 +129,7 @@ build() {
   done <"$pymod/link.txt"
   "$cxx" -shared -o "$pkg/_core$suffix" "$obj"/*.o "${libs[@]}" -L"$root/.devlibs" \
     -Wl,-rpath-link,"$root/.devlibs" -L/usr/lib/x86_64-linux-gnu
-  cp python/open3d_gs/*.py "$pkg/"
+  cp -r python/open3d_gs/. "$pkg/"  # the Python files, stubs and py.typed
   echo "build: $pkg/_core$suffix"
 }
 
@@ -176,7 +177,7 @@ images = {}
 for backend in ("vulkan", "cpu"):
     r = o3d.visualization.rendering.OffscreenRenderer(64, 64, backend)
     r.scene.add_geometry("scene", scene)
-    r.setup_camera(view)
+    r.setup_camera(view, rescale=True)
     images[backend] = r.render_to_image()
 print("check: vulkan against cpu at 64x64, largest difference", float(np.abs(images["vulkan"] - images["cpu"]).max()))
 PY
