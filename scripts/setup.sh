@@ -14,6 +14,7 @@ packages=(
   libxrandr-dev  # glfw3native.h (the GLX context handed to Filament) includes Xrandr.h
   xvfb xauth libgl1-mesa-dri libgl-dev xdotool
   python3-dev pybind11-dev python3-numpy python3-pytest  # the Python package (docs/python.md)
+  python3-dask python3-distributed  # open3d_gs.distributed, rendering on a Dask cluster (docs/distributed.md)
 )
 
 missing=()

@@ -65,6 +65,8 @@ def public_members():
                 for attr, member in vars(value).items():
                     if attr.startswith("_") and attr not in PYTHON_OWN:
                         continue
+                    if not (callable(member) or isinstance(member, (property, staticmethod, classmethod))):
+                        continue  # a plain class attribute, e.g. a dataclass field's default
                     if isinstance(member, staticmethod):
                         member = member.__func__
                     out.append((f"{where}.{attr}", member, attr))

@@ -13,8 +13,10 @@ cd "$root"
 binaries=("$@")
 [ ${#binaries[@]} -gt 0 ] || binaries=(build/bin/gs-render build/bin/gs-bench)
 
+# Through git rev-parse: in a worktree .git is a file and the exclude list is the main one's.
+exclude=$(git rev-parse --git-path info/exclude)
 for d in .gl .devlibs; do
-  git check-ignore -q "$d" || echo "/$d/" >>.git/info/exclude
+  git check-ignore -q "$d" || echo "/$d/" >>"$exclude"
 done
 
 if ! ls .gl/*.deb >/dev/null 2>&1; then

@@ -211,6 +211,18 @@ std::unique_ptr<VulkanContext> VulkanContext::CreateHeadless(const VulkanContext
     bool validation = options.enable_validation;
     if (auto env = GetEnv("OPEN3D_VULKAN_VALIDATION")) validation = (*env != "0");
     std::string device_filter = GetEnv("OPEN3D_VULKAN_DEVICE").value_or(options.device_name_filter);
+    // Identical GPUs share a name, so a process per GPU (a Dask worker each,
+    // docs/distributed.md) picks its own by position in the enumeration instead.
+    std::optional<size_t> device_index;
+    if (auto env = GetEnv("OPEN3D_VULKAN_DEVICE_INDEX"); env && !env->empty()) {
+        if (env->find_first_not_of("0123456789") != std::string::npos || env->size() > 6) {
+            core::ThrowError(
+                "OPEN3D_VULKAN_DEVICE_INDEX must be a device number (GPU<N> of `vulkaninfo "
+                "--summary`), got '{}'",
+                *env);
+        }
+        device_index = std::stoul(*env);
+    }
 
     uint32_t loader_version = VK_API_VERSION_1_0;
     vkEnumerateInstanceVersion(&loader_version);
@@ -283,10 +295,14 @@ std::unique_ptr<VulkanContext> VulkanContext::CreateHeadless(const VulkanContext
     VkPhysicalDevice best = VK_NULL_HANDLE;
     int best_rank = -1;
     std::string rejected;
-    for (VkPhysicalDevice device : devices) {
+    for (size_t i = 0; i < devices.size(); ++i) {
+        VkPhysicalDevice device = devices[i];
         DeviceQuery query(device);
         std::string name = query.properties.properties.deviceName;
         std::string why = query.WhyUnsuitable();
+        if (why.empty() && device_index && i != *device_index) {
+            why = fmt::format("is device {}, not OPEN3D_VULKAN_DEVICE_INDEX={}", i, *device_index);
+        }
         if (why.empty() && !device_filter.empty() &&
             name.find(device_filter) == std::string::npos) {
             why = fmt::format("does not match the device filter '{}'", device_filter);
