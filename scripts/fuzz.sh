@@ -25,8 +25,10 @@ fuzz_one() {  # name, seed files... (FUZZ_MAX_LEN: longest input, default 64 KiB
   mkdir -p "$corpus"
   for f in "$@"; do [ -f "$f" ] && cp -n "$f" "$corpus/" || true; done
   local log="$build_dir/fuzz-logs/$name.log" status=0
-  "$build_dir/bin/$name" "$corpus" -max_total_time="$seconds" -rss_limit_mb=2048 \
+  ASAN_OPTIONS="${ASAN_OPTIONS:+$ASAN_OPTIONS:}detect_leaks=${FUZZ_DETECT_LEAKS:-1}" \
+    "$build_dir/bin/$name" "$corpus" -max_total_time="$seconds" -rss_limit_mb=2048 \
     -max_len="${FUZZ_MAX_LEN:-65536}" -len_control="${FUZZ_LEN_CONTROL:-100}" \
+    -detect_leaks="${FUZZ_DETECT_LEAKS:-1}" \
     -artifact_prefix="$artifacts/$name-" -print_final_stats=1 >"$log" 2>&1 || status=$?
   # Printed whole when the harness ends (runs overlap). The harness's own reason (a
   # disagreement, a sanitizer report) comes before libFuzzer's stack and statistics: printed
@@ -62,8 +64,11 @@ run fuzz_splat_hierarchy_reader "$root"/tests/fuzz/seeds/*.lod
 run fuzz_splat_page_reader "$root"/tests/fuzz/seeds/*.gspages
 # The harness reads at most ~130 bytes (six splats and a camera) and runs at ~5 inputs/s on
 # lavapipe under ASan (~570 MB resident): without -len_control=0, libFuzzer's slowly growing
-# length limit kept a 20 s run at 4-byte inputs (one splat, all else zero).
-FUZZ_MAX_LEN=256 FUZZ_LEN_CONTROL=0 run fuzz_render_agreement "$root"/tests/fuzz/seeds/render_*.bin
+# length limit kept a 20 s run at 4-byte inputs (one splat, all else zero). Without leak
+# detection, as sanitize.sh runs the tests that make a lavapipe device: lavapipe keeps 128
+# bytes from its own module that LeakSanitizer reports as a leak of an unknown module (an
+# empty input reproduces it, with the harness of any commit); ASan and UBSan still check.
+FUZZ_DETECT_LEAKS=0 FUZZ_MAX_LEN=256 FUZZ_LEN_CONTROL=0 run fuzz_render_agreement "$root"/tests/fuzz/seeds/render_*.bin
 
 failed=()
 for i in "${!pids[@]}"; do
