@@ -13,6 +13,7 @@
 #include <random>
 #include <sstream>
 
+#include "IoTestHelpers.h"
 #include "TestUtility.h"
 #include "open3d/core/Exception.h"
 #include "open3d/t/geometry/SphericalHarmonics.h"
@@ -84,16 +85,6 @@ RawFile ParseRaw(const std::string& path) {
     return raw;
 }
 
-PointCloud Read(const std::string& path) {
-    PointCloud cloud;
-    ReadPointCloud(path, cloud);
-    return cloud;
-}
-
-const float* F(const PointCloud& cloud, const char* name) {
-    return cloud.GetPointAttr(name).Data<float>();
-}
-
 double Sigmoid(double v) { return 1.0 / (1.0 + std::exp(-v)); }
 
 void ExpectIdentical(const PointCloud& a, const PointCloud& b) {
@@ -129,34 +120,35 @@ void ExpectWithinQuantisation(const PointCloud& in, const PointCloud& out, const
         const int64_t i = perm[j];
         const float* b = file.Chunk(j);
         for (int f = 0; f < 3; ++f) {
-            const double a_pos = F(in, "positions")[i * 3 + f];
-            note(0, std::abs(F(out, "positions")[j * 3 + f] - a_pos),
+            const double a_pos = FloatsOf(in, "positions")[i * 3 + f];
+            note(0, std::abs(FloatsOf(out, "positions")[j * 3 + f] - a_pos),
                  (b[3 + f] - b[f]) / bits[f] / 2 + 1.2e-7 * std::abs(a_pos) + 1e-30);
             const double a_log =
-                std::clamp(std::log(double(F(in, "scale")[i * 3 + f])), -20.0, 20.0);
-            note(1, std::abs(std::log(double(F(out, "scale")[j * 3 + f])) - a_log),
+                std::clamp(std::log(double(FloatsOf(in, "scale")[i * 3 + f])), -20.0, 20.0);
+            note(1, std::abs(std::log(double(FloatsOf(out, "scale")[j * 3 + f])) - a_log),
                  (b[9 + f] - b[6 + f]) / bits[f] / 2 + 4e-6);
-            const double a_col = 0.5 + kSH_C0 * F(in, "f_dc")[i * 3 + f];
-            note(2, std::abs(0.5 + kSH_C0 * F(out, "f_dc")[j * 3 + f] - a_col),
+            const double a_col = 0.5 + kSH_C0 * FloatsOf(in, "f_dc")[i * 3 + f];
+            note(2, std::abs(0.5 + kSH_C0 * FloatsOf(out, "f_dc")[j * 3 + f] - a_col),
                  (b[15 + f] - b[12 + f]) / 255 / 2 + 1e-6);
         }
-        note(3, std::abs(Sigmoid(F(out, "opacity")[j]) - Sigmoid(F(in, "opacity")[i])),
+        note(3,
+             std::abs(Sigmoid(FloatsOf(out, "opacity")[j]) - Sigmoid(FloatsOf(in, "opacity")[i])),
              0.5 / 255 + 1e-7);
         // Rotation: the input normalised, its sign making the stored largest positive.
         const int largest = static_cast<int>(file.vertex[j * 4 + 1] >> 30);
-        const float* qa = F(in, "rot") + i * 4;
+        const float* qa = FloatsOf(in, "rot") + i * 4;
         const double norm = std::sqrt(double(qa[0]) * qa[0] + double(qa[1]) * qa[1] +
                                       double(qa[2]) * qa[2] + double(qa[3]) * qa[3]);
         const double sign = qa[largest] < 0 ? -1.0 : 1.0;
         for (int k = 0; k < 4; ++k) {
-            const double error = std::abs(F(out, "rot")[j * 4 + k] - sign * qa[k] / norm);
+            const double error = std::abs(FloatsOf(out, "rot")[j * 4 + k] - sign * qa[k] / norm);
             note(4, error, (k == largest ? 3 : 1) * half_rot + 1e-6);
         }
         for (int c = 0; c < 3; ++c) {
             for (int k = 0; k < nc; ++k) {
                 const uint8_t byte = file.sh[j * nc * 3 + c * nc + k];
-                const double a_sh = F(in, "f_rest")[(i * nc + k) * 3 + c];
-                const double b_sh = F(out, "f_rest")[(j * nc + k) * 3 + c];
+                const double a_sh = FloatsOf(in, "f_rest")[(i * nc + k) * 3 + c];
+                const double b_sh = FloatsOf(out, "f_rest")[(j * nc + k) * 3 + c];
                 if (byte == 0 || byte == 255) {
                     note(5, std::abs(b_sh - std::clamp(a_sh, -4.0, 4.0)), 1.0 / 32 + 1e-6);
                 } else {
@@ -196,8 +188,8 @@ std::vector<int64_t> Identity(int64_t n) {
 TEST(CompressedPly, BikerMatchesPlyOfTheSameCapture) {
     OPEN3D_REQUIRE_DATA(kBikerCompressed);
     OPEN3D_REQUIRE_DATA(kBikerPly);
-    const PointCloud c = Read(tests::DataPath(kBikerCompressed));
-    const PointCloud p = Read(tests::DataPath(kBikerPly));
+    const PointCloud c = ReadCloud(tests::DataPath(kBikerCompressed));
+    const PointCloud p = ReadCloud(tests::DataPath(kBikerPly));
     const RawFile raw = ParseRaw(tests::DataPath(kBikerCompressed));
     ASSERT_EQ(raw.num_chunks, 597);
     ASSERT_EQ(c.NumPoints(), p.NumPoints());
@@ -210,19 +202,22 @@ TEST(CompressedPly, BikerMatchesPlyOfTheSameCapture) {
     for (int64_t i = 0; i < c.NumPoints(); ++i) {
         const float* b = raw.Chunk(i);
         for (int f = 0; f < 3; ++f) {
-            note(0, std::abs(F(c, "positions")[i * 3 + f] - F(p, "positions")[i * 3 + f]),
-                 (b[3 + f] - b[f]) / bits[f] / 2 + 0x1p-13 + 1e-7);
+            note(
+                0,
+                std::abs(FloatsOf(c, "positions")[i * 3 + f] - FloatsOf(p, "positions")[i * 3 + f]),
+                (b[3 + f] - b[f]) / bits[f] / 2 + 0x1p-13 + 1e-7);
             note(1,
-                 std::abs(std::max(std::log(double(F(c, "scale")[i * 3 + f])), -10.0) -
-                          std::log(double(F(p, "scale")[i * 3 + f]))),
+                 std::abs(std::max(std::log(double(FloatsOf(c, "scale")[i * 3 + f])), -10.0) -
+                          std::log(double(FloatsOf(p, "scale")[i * 3 + f]))),
                  (b[9 + f] - b[6 + f]) / bits[f] / 2 + 1.0 / 32 + 1e-5);
-            note(2, std::abs(F(c, "f_dc")[i * 3 + f] - F(p, "f_dc")[i * 3 + f]),
+            note(2, std::abs(FloatsOf(c, "f_dc")[i * 3 + f] - FloatsOf(p, "f_dc")[i * 3 + f]),
                  (b[15 + f] - b[12 + f]) / 255 / 2 / kSH_C0 + 0.5 / (255 * 0.15) + 1e-6);
         }
-        note(3, std::abs(Sigmoid(F(c, "opacity")[i]) - Sigmoid(F(p, "opacity")[i])), 0.5 / 255);
+        note(3, std::abs(Sigmoid(FloatsOf(c, "opacity")[i]) - Sigmoid(FloatsOf(p, "opacity")[i])),
+             0.5 / 255);
         const int largest = static_cast<int>(raw.vertex[i * 4 + 1] >> 30);
-        const float* qc = F(c, "rot") + i * 4;
-        const float* qp = F(p, "rot") + i * 4;
+        const float* qc = FloatsOf(c, "rot") + i * 4;
+        const float* qp = FloatsOf(p, "rot") + i * 4;
         double dot = 0, norm = 0;
         for (int k = 0; k < 4; ++k) {
             dot += double(qc[k]) * qp[k];
@@ -247,7 +242,7 @@ TEST(CompressedPly, BikerMatchesPlyOfTheSameCapture) {
 TEST(CompressedPly, ReencodingTheSharedFileReproducesItsCodes) {
     OPEN3D_REQUIRE_DATA(kBikerCompressed);
     const std::string path = tests::TempDir() + "/biker_again.compressed.ply";
-    WritePointCloud(path, Read(tests::DataPath(kBikerCompressed)));
+    WritePointCloud(path, ReadCloud(tests::DataPath(kBikerCompressed)));
     const RawFile ours = ParseRaw(path);
     const RawFile theirs = ParseRaw(tests::DataPath(kBikerCompressed));
     ASSERT_EQ(ours.n, theirs.n);
@@ -277,7 +272,7 @@ void RoundTrip(const PointCloud& in, const std::string& name) {
     const std::string first = dir + "/" + name + ".compressed.ply";
     const std::string second = dir + "/" + name + "_again.compressed.ply";
     WritePointCloud(first, in);
-    const PointCloud out = Read(first);
+    const PointCloud out = ReadCloud(first);
     const RawFile raw = ParseRaw(first);
     EXPECT_EQ(raw.num_chunks, (in.NumPoints() + 255) / 256);
     EXPECT_EQ(raw.num_rest_props, 3 * geometry::NumSHRestCoeffs(in.GaussianSplatGetSHOrder()));
@@ -285,17 +280,17 @@ void RoundTrip(const PointCloud& in, const std::string& name) {
 
     WritePointCloud(second, out);
     EXPECT_TRUE(FileBytes(first) == FileBytes(second)) << "write -> read -> write changed the file";
-    ExpectIdentical(out, Read(second));
+    ExpectIdentical(out, ReadCloud(second));
 }
 
 TEST(CompressedPly, RoundTripBiker) {
     OPEN3D_REQUIRE_DATA(kBikerPly);
-    RoundTrip(Read(tests::DataPath(kBikerPly)), "biker");
+    RoundTrip(ReadCloud(tests::DataPath(kBikerPly)), "biker");
 }
 
 TEST(CompressedPly, RoundTripPcShortWithSHDegree3) {
     OPEN3D_REQUIRE_DATA(kPcShort);
-    const PointCloud in = Read(tests::DataPath(kPcShort));
+    const PointCloud in = ReadCloud(tests::DataPath(kPcShort));
     ASSERT_EQ(in.GaussianSplatGetSHOrder(), 3);
     RoundTrip(in, "pc_short");
 }
@@ -366,7 +361,7 @@ TEST(CompressedPly, ShuffledInputIsSortedAndRoundTrips) {
     const std::string dir = tests::TempDir();
     const std::string first = dir + "/grid.compressed.ply";
     WritePointCloud(first, in);
-    const PointCloud out = Read(first);
+    const PointCloud out = ReadCloud(first);
     const RawFile raw = ParseRaw(first);
     ASSERT_EQ(out.NumPoints(), n);
 
@@ -376,7 +371,7 @@ TEST(CompressedPly, ShuffledInputIsSortedAndRoundTrips) {
     std::vector<int> seen(n, 0);
     int64_t moved = 0;
     for (int64_t j = 0; j < n; ++j) {
-        const float* p = F(out, "positions") + j * 3;
+        const float* p = FloatsOf(out, "positions") + j * 3;
         const int cx = int(std::lround(p[0] - 3.0f)), cy = int(std::lround(p[1] + 5.0f));
         const int cz = int(std::lround(p[2] - 0.5f));
         ASSERT_TRUE(cx >= 0 && cx < 16 && cy >= 0 && cy < 16 && cz >= 0 && cz < 12) << j;
@@ -390,7 +385,7 @@ TEST(CompressedPly, ShuffledInputIsSortedAndRoundTrips) {
     // the chunks the shuffled input order would make (each about the whole grid).
     auto summed_extent = [](const PointCloud& cloud) {
         double extent = 0;
-        const float* p = F(cloud, "positions");
+        const float* p = FloatsOf(cloud, "positions");
         for (int64_t begin = 0; begin < cloud.NumPoints(); begin += 256) {
             const int64_t end = std::min(cloud.NumPoints(), begin + 256);
             for (int f = 0; f < 3; ++f) {
@@ -411,7 +406,7 @@ TEST(CompressedPly, ShuffledInputIsSortedAndRoundTrips) {
     const std::string second = dir + "/grid_again.compressed.ply";
     WritePointCloud(second, out);
     EXPECT_TRUE(FileBytes(first) == FileBytes(second));
-    ExpectIdentical(out, Read(second));
+    ExpectIdentical(out, ReadCloud(second));
 }
 
 // Values where decoding is many-to-one or the reference's choices are fragile: zero, unit and
@@ -465,10 +460,10 @@ TEST(CompressedPly, WriteReadWriteIsIdenticalOnHardValues) {
         const std::string first = dir + "/hard.compressed.ply";
         const std::string second = dir + "/hard_again.compressed.ply";
         WritePointCloud(first, cloud);
-        const PointCloud read = Read(first);
+        const PointCloud read = ReadCloud(first);
         WritePointCloud(second, read);
         EXPECT_TRUE(FileBytes(first) == FileBytes(second));
-        ExpectIdentical(read, Read(second));
+        ExpectIdentical(read, ReadCloud(second));
     }
 }
 
@@ -480,7 +475,7 @@ TEST(CompressedPly, PartialChunkAndSingleSplat) {
         const PointCloud in = Head(grid, n);
         const std::string path = tests::TempDir() + "/partial.compressed.ply";
         WritePointCloud(path, in);
-        const PointCloud out = Read(path);
+        const PointCloud out = ReadCloud(path);
         ASSERT_EQ(out.NumPoints(), n);
         EXPECT_EQ(out.GaussianSplatGetSHOrder(), 2);
     }

@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "ExpectReadError.h"
+#include "IoTestHelpers.h"
 #include "TestUtility.h"
 #include "open3d/core/Exception.h"
 #include "open3d/t/geometry/SphericalHarmonics.h"
@@ -24,16 +24,6 @@ namespace {
 using core::Tensor;
 using geometry::kSH_C0;
 using geometry::PointCloud;
-
-PointCloud Read(const std::string& path) {
-    PointCloud cloud;
-    ReadPointCloud(path, cloud);
-    return cloud;
-}
-
-const float* F(const PointCloud& cloud, const char* name) {
-    return cloud.GetPointAttr(name).Data<float>();
-}
 
 // A compressed PLY assembled byte by byte: header lines, then the rows of each element.
 struct HandFile {
@@ -90,21 +80,21 @@ TEST(CompressedPly, HandBuiltFilePinsTheBitLayout) {
         SCOPED_TRACE(colour_bounds ? "18 chunk properties" : "12 chunk properties (older files)");
         const std::string path = dir + "/hand.compressed.ply";
         TwoSplats(colour_bounds).Write(path);
-        const PointCloud c = Read(path);
+        const PointCloud c = ReadCloud(path);
         ASSERT_EQ(c.NumPoints(), 2);
-        const float* p = F(c, "positions");
+        const float* p = FloatsOf(c, "positions");
         EXPECT_FLOAT_EQ(p[0], 5);
         EXPECT_FLOAT_EQ(p[1], 7);
         EXPECT_FLOAT_EQ(p[2], 9);
         EXPECT_FLOAT_EQ(p[3], 2047);
         EXPECT_FLOAT_EQ(p[4], 1023);
         EXPECT_FLOAT_EQ(p[5], 0);
-        const float* s = F(c, "scale");
+        const float* s = FloatsOf(c, "scale");
         EXPECT_FLOAT_EQ(s[0], std::exp(1.0f));
         EXPECT_FLOAT_EQ(s[1], std::exp(2.0f));
         EXPECT_FLOAT_EQ(s[2], std::exp(-2.0f));
         EXPECT_FLOAT_EQ(s[3], 1.0f);
-        const float* q = F(c, "rot");
+        const float* q = FloatsOf(c, "rot");
         const double r = std::sqrt(0.5), tiny = (512.0 / 1023 - 0.5) * std::sqrt(2.0);
         EXPECT_FLOAT_EQ(q[0], r);     // code 1023
         EXPECT_FLOAT_EQ(q[1], -r);    // code 0
@@ -116,7 +106,7 @@ TEST(CompressedPly, HandBuiltFilePinsTheBitLayout) {
         EXPECT_FLOAT_EQ(q[7], tiny);
         // Colour: lerp(min, max, code / 255) with bounds (0.25, 0.5, 0) .. (0.75, 1, 1),
         // code / 255 without.
-        const float* dc = F(c, "f_dc");
+        const float* dc = FloatsOf(c, "f_dc");
         auto f_dc = [](double colour) { return float((colour - 0.5) / kSH_C0); };
         EXPECT_FLOAT_EQ(dc[0], f_dc(colour_bounds ? 0.75 : 1.0));
         EXPECT_FLOAT_EQ(dc[1], f_dc(colour_bounds ? 0.5 : 0.0));
@@ -124,7 +114,7 @@ TEST(CompressedPly, HandBuiltFilePinsTheBitLayout) {
         EXPECT_FLOAT_EQ(dc[3], f_dc(colour_bounds ? 0.25 : 0.0));
         EXPECT_FLOAT_EQ(dc[4], f_dc(1.0));
         EXPECT_FLOAT_EQ(dc[5], f_dc(1.0));
-        const float* o = F(c, "opacity");
+        const float* o = FloatsOf(c, "opacity");
         EXPECT_FLOAT_EQ(o[0], -std::log(4.0f));  // alpha 51 / 255 = 0.2
         EXPECT_FLOAT_EQ(o[1], 40.0f);            // alpha 255: the engine's +40
     }
@@ -143,9 +133,10 @@ TEST(CompressedPly, HandBuiltSHElement) {
     for (int k : order) f.data.push_back(static_cast<char>(bytes[k]));
     const std::string path = tests::TempDir() + "/sh.compressed.ply";
     f.Write(path);
-    const PointCloud c = Read(path);
+    const PointCloud c = ReadCloud(path);
     ASSERT_EQ(c.GaussianSplatGetSHOrder(), 1);
-    const float* rest = F(c, "f_rest");  // [1, 3, 3]: f_rest_[ch * 3 + k] -> rest[k * 3 + ch]
+    const float* rest =
+        FloatsOf(c, "f_rest");  // [1, 3, 3]: f_rest_[ch * 3 + k] -> rest[k * 3 + ch]
     auto expect = [](uint8_t b) {
         return b == 0 ? -4.0f : b == 255 ? 4.0f : float(((b + 0.5) / 256 - 0.5) * 8);
     };
@@ -279,7 +270,7 @@ TEST(CompressedPly, EmptyCloud) {
     }
     const std::string path = tests::TempDir() + "/empty.compressed.ply";
     WritePointCloud(path, in);
-    EXPECT_EQ(Read(path).NumPoints(), 0);
+    EXPECT_EQ(ReadCloud(path).NumPoints(), 0);
 }
 
 // Regenerates the hand-built fuzz seed (run with --gtest_also_run_disabled_tests).

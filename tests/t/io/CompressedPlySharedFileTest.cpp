@@ -5,6 +5,7 @@
 #include <cmath>
 #include <string>
 
+#include "IoTestHelpers.h"
 #include "TestUtility.h"
 #include "open3d/t/io/PointCloudIO.h"
 
@@ -16,10 +17,6 @@ namespace {
 using geometry::PointCloud;
 
 constexpr const char* kBikerCompressed = "formats/biker.compressed.ply";
-
-const float* F(const PointCloud& cloud, const char* name) {
-    return cloud.GetPointAttr(name).Data<float>();
-}
 
 struct ExpectedSplat {
     int64_t index;
@@ -95,12 +92,12 @@ TEST(CompressedPly, SharedFileMatchesIndependentValues) {
         SCOPED_TRACE("splat " + std::to_string(e.index));
         const int64_t i = e.index;
         for (int c = 0; c < 3; ++c) {
-            EXPECT_FLOAT_EQ(F(cloud, "positions")[i * 3 + c], e.position[c]);
-            EXPECT_FLOAT_EQ(F(cloud, "scale")[i * 3 + c], e.scale[c]);
-            EXPECT_FLOAT_EQ(F(cloud, "f_dc")[i * 3 + c], e.f_dc[c]);
+            EXPECT_FLOAT_EQ(FloatsOf(cloud, "positions")[i * 3 + c], e.position[c]);
+            EXPECT_FLOAT_EQ(FloatsOf(cloud, "scale")[i * 3 + c], e.scale[c]);
+            EXPECT_FLOAT_EQ(FloatsOf(cloud, "f_dc")[i * 3 + c], e.f_dc[c]);
         }
-        for (int c = 0; c < 4; ++c) EXPECT_FLOAT_EQ(F(cloud, "rot")[i * 4 + c], e.rot[c]);
-        EXPECT_FLOAT_EQ(F(cloud, "opacity")[i], e.opacity);
+        for (int c = 0; c < 4; ++c) EXPECT_FLOAT_EQ(FloatsOf(cloud, "rot")[i * 4 + c], e.rot[c]);
+        EXPECT_FLOAT_EQ(FloatsOf(cloud, "opacity")[i], e.opacity);
     }
 }
 

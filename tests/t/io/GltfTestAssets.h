@@ -14,7 +14,7 @@
 #include <string>
 #include <vector>
 
-#include "ExpectReadError.h"
+#include "IoTestHelpers.h"
 #include "open3d/core/Exception.h"
 #include "open3d/t/io/GltfCommon.h"
 #include "open3d/t/io/PointCloudIO.h"

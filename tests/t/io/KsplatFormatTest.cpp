@@ -8,7 +8,7 @@
 #include <cstring>
 #include <fstream>
 
-#include "ExpectReadError.h"
+#include "IoTestHelpers.h"
 #include "TestUtility.h"
 #include "open3d/core/Exception.h"
 #include "open3d/t/geometry/SphericalHarmonics.h"

@@ -6,7 +6,7 @@
 #include <fstream>
 #include <limits>
 
-#include "ExpectReadError.h"
+#include "IoTestHelpers.h"
 #include "PlyTestFiles.h"
 #include "TestUtility.h"
 #include "open3d/core/Exception.h"

@@ -49,7 +49,7 @@
 #include <fstream>
 #include <random>
 
-#include "ExpectReadError.h"
+#include "IoTestHelpers.h"
 #include "TestUtility.h"
 #include "open3d/core/Exception.h"
 #include "open3d/core/Logging.h"

@@ -1,5 +1,6 @@
-// The t/io tests' check of a refused file: ReadPointCloud throws core::Open3DError whose
-// message names the file and holds every fragment, and the output cloud is left as it was.
+// Helpers of the t/io tests: reading a file into a cloud, a float attribute's data, and the
+// check of a refused file (ReadPointCloud throws core::Open3DError whose message names the
+// file and holds every fragment, and the output cloud is left as it was).
 #pragma once
 
 #include <gtest/gtest.h>
@@ -15,6 +16,18 @@
 namespace open3d {
 namespace t {
 namespace io {
+
+/// The cloud in `path` (throws as ReadPointCloud does).
+inline geometry::PointCloud ReadCloud(const std::string& path) {
+    geometry::PointCloud cloud;
+    ReadPointCloud(path, cloud);
+    return cloud;
+}
+
+/// The float data of attribute `name`.
+inline const float* FloatsOf(const geometry::PointCloud& cloud, const char* name) {
+    return cloud.GetPointAttr(name).Data<float>();
+}
 
 inline void ExpectReadError(const std::string& path, const std::vector<std::string>& fragments,
                             const ReadPointCloudOptions& options = {}) {
