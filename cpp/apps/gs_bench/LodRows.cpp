@@ -95,11 +95,15 @@ void AddLodRows(const Options& opt, const std::vector<int64_t>& budgets, const S
             if (released) backend.SetScene(cloud);
         }
     } restore{backend, job.cloud};
+    // Freed before the new context is made: it takes its room from the device's memory
+    // budget less what the process uses at that moment.
+    if (dynamic_cast<rendering::vulkan::GaussianSplatVulkanBackend*>(&backend) != nullptr) {
+        backend.ReleaseResources();
+        restore.released = true;
+    }
     auto lod_backend = rendering::CreateGaussianSplatBackend(opt.backend);
     auto* vulkan = dynamic_cast<rendering::vulkan::GaussianSplatVulkanBackend*>(lod_backend.get());
     if (vulkan != nullptr) {
-        backend.ReleaseResources();
-        restore.released = true;
         vulkan->SetFramesInFlight(opt.frames_in_flight);
         vulkan->CheckHierarchyFits(job.cloud.NumPoints(),
                                    job.cloud.GetGaussianSplatArrays().sh_degree);
