@@ -27,6 +27,11 @@ namespace rendering {
 namespace vulkan {
 
 /// What a recording depends on. Equal keys: the recorded command buffer is submitted again.
+/// Bytes per pixel of a batch's colour target: RGBA8 or RGBA32F.
+inline VkDeviceSize ColorBytesPerPixel(const BatchOptions& options) {
+    return options.color_uint8 ? 4 : 16;
+}
+
 struct FrameRecordingKey {
     uint32_t views = 0, width = 0, height = 0;
     uint32_t entry_capacity = 0;

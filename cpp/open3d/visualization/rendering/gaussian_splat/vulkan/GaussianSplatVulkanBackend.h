@@ -212,7 +212,8 @@ public:
 private:
     class ReadbackSink;
 
-    // Submission path (GaussianSplatVulkanBackendFrames.cpp).
+    // Submission path (GaussianSplatVulkanBackendSlots.cpp: slots and recordings;
+    // GaussianSplatVulkanBackendFrames.cpp: submission, batches, readback).
     FrameSlot& AcquireSlot();
     void PrepareSlot(FrameSlot& slot, const FrameRecordingKey& key);
     void RecordSlot(FrameSlot& slot, const FrameRecordingKey& key);
