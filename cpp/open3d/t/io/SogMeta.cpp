@@ -216,6 +216,21 @@ void DecodeRotations(const Plane& quats, const std::string& filename, const std:
     });
 }
 
+void DecodePositionsAndRotations(PlaneLoader& planes, const std::string& filename,
+                                 const std::vector<std::string>& means_files,
+                                 const std::vector<double>& mins, const std::vector<double>& maxs,
+                                 const std::string& quats_file, int64_t count, int degree,
+                                 SplatColumns& columns) {
+    {
+        const Plane lo = planes.Load(means_files[0], "means.files[0]");
+        const Plane hi = planes.Load(means_files[1], "means.files[1]");
+        columns.Allocate(filename, count, /*gaussian=*/true, degree);
+        DecodePositions(lo, hi, mins, maxs, count, columns.positions.Data<float>());
+    }
+    const Plane quats = planes.Load(quats_file, "quats.files[0]");
+    DecodeRotations(quats, filename, quats_file, count, columns.rot.Data<float>());
+}
+
 void DecodeShPalette(const Plane& labels, const Rgba8Image& centroids, int nc, int64_t palette,
                      const float value[256], const std::string& filename, const ShFiles& names,
                      int64_t count, float* rest) {

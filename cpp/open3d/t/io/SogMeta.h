@@ -97,6 +97,15 @@ void DecodePositions(const Plane& lo, const Plane& hi, const std::vector<double>
 void DecodeRotations(const Plane& quats, const std::string& filename, const std::string& name,
                      int64_t count, float* rot);
 
+/// Allocates `columns` for `count` splats of SH degree `degree` (the memory check) and fills
+/// their positions (means_files: means_l, means_u) and rotations (quats_file): what every
+/// version stores the same way.
+void DecodePositionsAndRotations(PlaneLoader& planes, const std::string& filename,
+                                 const std::vector<std::string>& means_files,
+                                 const std::vector<double>& mins, const std::vector<double>& maxs,
+                                 const std::string& quats_file, int64_t count, int degree,
+                                 SplatColumns& columns);
+
 /// The names of the SH images, for errors: shN.files[0] (centroids), shN.files[1] (labels).
 struct ShFiles {
     std::string centroids, labels;

@@ -133,16 +133,8 @@ geometry::PointCloud ReadSogV1(const SogFiles& files, const Meta& meta,
     }
 
     SplatColumns columns;
-    {
-        const Plane lo = planes.Load(means_files[0], "means.files[0]");
-        const Plane hi = planes.Load(means_files[1], "means.files[1]");
-        columns.Allocate(filename, count, /*gaussian=*/true, degree);
-        DecodePositions(lo, hi, mins, maxs, count, columns.positions.Data<float>());
-    }
-    {
-        const Plane plane = planes.Load(quats_file, "quats.files[0]");
-        DecodeRotations(plane, filename, quats_file, count, columns.rot.Data<float>());
-    }
+    DecodePositionsAndRotations(planes, filename, means_files, mins, maxs, quats_file, count,
+                                degree, columns);
     {
         const Plane plane = planes.Load(scales_file, "scales.files[0]");
         std::array<Table, 3> linear;
