@@ -112,6 +112,12 @@ struct Header {
         }
     }
     uint64_t StreamBytes(int stream) const { return num_points * BytesPerSplat(stream); }
+    /// Bytes of every stream together for one splat.
+    uint64_t AllStreamsBytesPerSplat() const {
+        uint64_t bytes = 0;
+        for (int k = 0; k < kNumStreams; ++k) bytes += BytesPerSplat(k);
+        return bytes;
+    }
     /// The streams a v4 file holds (the non-empty ones), in file order; returns their count.
     int PresentStreams(std::array<int, kNumStreams>& present) const {
         int count = 0;

@@ -183,10 +183,8 @@ void DecodeSplats(const Source& src, const Header& h,
 // must fit before anything is decompressed: a 61 KB file of RLE zstd frames claiming 1e8
 // splats was refused only after 11 s of decoding at 2 GB.
 void CheckDecodeMemory(const Source& src, const Header& h) {
-    uint64_t stream_bytes_per_splat = 0;
-    for (int k = 0; k < kNumStreams; ++k) stream_bytes_per_splat += h.BytesPerSplat(k);
     CheckSplatColumnsMemory(src.filename, int64_t(h.num_points), /*gaussian=*/true,
-                            std::min(h.sh_degree, kMaxCloudSHDegree), stream_bytes_per_splat,
+                            std::min(h.sh_degree, kMaxCloudSHDegree), h.AllStreamsBytesPerSplat(),
                             "bytes of decompressed streams");
 }
 
@@ -236,8 +234,8 @@ void ReadLegacy(const Source& src, const uint8_t* file, size_t size, SplatColumn
             src.label, h.version);
     }
     CheckHeader(src, h);
-    uint64_t attribute_bytes = 0;
-    for (int k = 0; k < kNumStreams; ++k) attribute_bytes += h.StreamBytes(k);
+    const uint64_t per_splat = h.AllStreamsBytesPerSplat();
+    const uint64_t attribute_bytes = uint64_t(h.num_points) * per_splat;
     CheckDecodeMemory(src, h);
     // Extensions follow the attributes inside the stream; more than kMaxLegacyTailBytes
     // after them is not read (a warning says so).
@@ -252,11 +250,7 @@ void ReadLegacy(const Source& src, const uint8_t* file, size_t size, SplatColumn
             "the rest is not read",
             src.label, kMaxLegacyTailBytes);
     }
-    uint64_t offset = kLegacyHeaderBytes, per_splat = 0;
-    for (int k = 0; k < kNumStreams; ++k) {
-        offset += h.StreamBytes(k);
-        per_splat += h.BytesPerSplat(k);
-    }
+    const uint64_t offset = kLegacyHeaderBytes + attribute_bytes;
     if (offset > bytes.size()) {
         core::ThrowError(
             "{}: SPZ header field 'numPoints' is {}: that needs {} bytes of "
