@@ -14,6 +14,17 @@
 namespace open3d {
 namespace core {
 
+/// What a special file of stat mode `mode` is, in words ("a FIFO", "a socket", "a character
+/// device", "a block device", "a special file"); nullptr for a regular file or a folder.
+inline const char* SpecialFileKind(mode_t mode) {
+    if (S_ISREG(mode) || S_ISDIR(mode)) return nullptr;
+    if (S_ISFIFO(mode)) return "a FIFO";
+    if (S_ISSOCK(mode)) return "a socket";
+    if (S_ISCHR(mode)) return "a character device";
+    if (S_ISBLK(mode)) return "a block device";
+    return "a special file";
+}
+
 /// Throws naming the file unless `filename` exists and is a regular file (or a link to one).
 inline void RequireRegularFile(const std::string& filename) {
     struct stat info;
@@ -21,9 +32,8 @@ inline void RequireRegularFile(const std::string& filename) {
         ThrowError("Cannot open '{}': {}", filename, std::strerror(errno));
     }
     if (S_ISDIR(info.st_mode)) ThrowError("'{}' is a folder, not a file", filename);
-    if (!S_ISREG(info.st_mode)) {
-        ThrowError("'{}' is not a regular file (a FIFO, device or socket); refusing to read it",
-                   filename);
+    if (const char* kind = SpecialFileKind(info.st_mode)) {
+        ThrowError("'{}' is {}, not a regular file; refusing to read it", filename, kind);
     }
 }
 

@@ -1,10 +1,13 @@
 #include "open3d/t/io/InputPaths.h"
 
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cerrno>
 #include <cstring>
 #include <filesystem>
+
+#include "open3d/core/RegularFile.h"
 
 namespace open3d {
 namespace t {
@@ -30,14 +33,12 @@ std::string InputPathProblem(const std::string& path, bool folder_ok) {
         return quoted + " does not exist";
     }
     if (fs::is_directory(status) && !folder_ok) return quoted + " is a folder, not a file";
-    if (!fs::is_directory(status) && !fs::is_regular_file(status)) {
-        // Reading a FIFO blocks until a writer comes, a device may never end: never open them.
-        const char* kind = fs::is_fifo(status)             ? "a FIFO"
-                           : fs::is_socket(status)         ? "a socket"
-                           : fs::is_character_file(status) ? "a character device"
-                           : fs::is_block_file(status)     ? "a block device"
-                                                           : "a special file";
-        return quoted + " is " + kind + ", not a regular file";
+    // Reading a FIFO blocks until a writer comes, a device may never end: never open them.
+    struct stat info;
+    if (::stat(path.c_str(), &info) == 0) {
+        if (const char* kind = core::SpecialFileKind(info.st_mode)) {
+            return quoted + " is " + kind + ", not a regular file";
+        }
     }
     if (::access(path.c_str(), R_OK) != 0) {
         return quoted + " cannot be read (" + std::strerror(errno) + ")";
