@@ -9,44 +9,36 @@ import collections
 import ctypes
 import os
 import socket
-import struct
 import tempfile
 import time
-import zlib
 
 import numpy as np
 
+from ._core import io as _io
+
 
 def write_png(path, rgb):
-    """An 8-bit RGB PNG with the standard library alone (as examples/python/render_views.py)."""
-    h, w, _ = rgb.shape
-    rows = np.empty((h, 1 + w * 3), np.uint8)
-    rows[:, 0] = 0  # filter "none" on every row
-    rows[:, 1:] = rgb.reshape(h, w * 3)
-
-    def chunk(kind, body):
-        return struct.pack(">I", len(body)) + kind + body + struct.pack(">I", zlib.crc32(kind + body))
-
-    data = (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", w, h, 8, 2, 0, 0, 0))
-            + chunk(b"IDAT", zlib.compress(rows.tobytes(), 6)) + chunk(b"IEND", b""))
-    _write_atomically(path, lambda f: f.write(data))
+    """An 8-bit RGB PNG (open3d_gs.io.write_image), written atomically."""
+    _write_atomically(path, lambda tmp: _io.write_image(tmp, np.ascontiguousarray(rgb)))
 
 
 def write_npy(path, array):
-    _write_atomically(path, lambda f: np.save(f, array))
+    _write_atomically(path, lambda tmp: np.save(tmp, array))
 
 
 def _write_atomically(path, write):
-    """Into a temporary file beside `path`, then renamed over it: a worker killed mid-write
-    leaves no truncated image, and the retry's rename replaces whatever was there."""
+    """Into a temporary file beside `path` (its name ends with `path`'s, so the writer picks the
+    same format), then renamed over it: a worker killed mid-write leaves no truncated image,
+    and the retry's rename replaces whatever was there."""
     folder = os.path.dirname(path)
     fd, tmp = tempfile.mkstemp(prefix=".tmp-", suffix=os.path.basename(path), dir=folder)
+    os.close(fd)
     try:
-        with os.fdopen(fd, "wb") as f:
-            write(f)
+        write(tmp)
         os.replace(tmp, path)
     except BaseException:
-        os.unlink(tmp)
+        if os.path.exists(tmp):
+            os.unlink(tmp)
         raise
 
 

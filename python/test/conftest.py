@@ -1,8 +1,10 @@
-"""Shared fixtures of the open3d_gs tests: where the shared scenes and gs-render are, and the
-project's rule for tests that cannot run here (skip locally, fail in CI: CI=true)."""
+"""Shared fixtures of the open3d_gs tests: where the shared scenes and gs-render are, the
+project's rule for tests that cannot run here (skip locally, fail in CI: CI=true), and the
+PNG reader the tests share."""
 import os
 import pathlib
 
+import numpy as np
 import pytest
 
 import open3d_gs as o3d
@@ -61,3 +63,10 @@ def backend(request):
         except o3d.Open3DError as e:
             unavailable(f"no Vulkan device: {e}")
     return request.param
+
+
+def read_png_rgb(path):
+    """An 8-bit RGB PNG the examples and open3d_gs.distributed write (o3d.io.write_image)."""
+    image = o3d.io.read_image(path)
+    assert image.dtype == np.uint8 and image.ndim == 3 and image.shape[2] == 3
+    return image

@@ -9,13 +9,12 @@ import os
 import pathlib
 import subprocess
 import sys
-import zlib
 
 import numpy as np
 import pytest
 
 import open3d_gs as o3d
-from conftest import DATA, unavailable
+from conftest import DATA, read_png_rgb, unavailable
 
 try:
     from dask.distributed import Client, LocalCluster
@@ -66,22 +65,6 @@ def reference():
         floats.append(r.render_to_image().copy())
     return {"scene": str(scene), "cameras": str(cameras), "float32": np.stack(floats),
             "uint8": r.render_batch([v.camera for v in views], "uint8", alpha=True, rescale=True)}
-
-
-def read_png_rgb(path):
-    """Decodes the module's PNGs (8-bit RGB, filter 0 on every row, one IDAT) with zlib."""
-    data = path.read_bytes()
-    assert data[:8] == b"\x89PNG\r\n\x1a\n"
-    width, height = int.from_bytes(data[16:20], "big"), int.from_bytes(data[20:24], "big")
-    at, idat = 8, b""
-    while at < len(data):
-        length = int.from_bytes(data[at:at + 4], "big")
-        if data[at + 4:at + 8] == b"IDAT":
-            idat += data[at + 8:at + 8 + length]
-        at += 12 + length
-    rows = np.frombuffer(zlib.decompress(idat), np.uint8).reshape(height, 1 + width * 3)
-    assert (rows[:, 0] == 0).all()
-    return rows[:, 1:].reshape(height, width, 3)
 
 
 def check_outputs(folder, views, reference, formats=("png",), dtype="uint8"):

@@ -15,7 +15,7 @@ import pytest
 
 import open3d_gs as o3d
 from open3d_gs import rasterization
-from test_render import read_png_rgb
+from conftest import read_png_rgb
 
 Renderer = o3d.visualization.rendering.OffscreenRenderer
 SH_C0 = 0.28209479177387814

@@ -13,6 +13,7 @@ import numpy as np
 import pytest
 
 import open3d_gs as o3d
+from conftest import read_png_rgb
 
 Renderer = o3d.visualization.rendering.OffscreenRenderer
 
@@ -202,13 +203,6 @@ def test_objects_can_go_in_any_order():
     del r  # the scene keeps the renderer alive
     scene.add_geometry("b", small_cloud(seed=2))
     assert scene.geometry_names == ["a", "b"]
-
-
-def read_png_rgb(path):
-    """The example's 8-bit RGB PNG (written by o3d.io.write_image through libpng)."""
-    image = o3d.io.read_image(path)
-    assert image.dtype == np.uint8 and image.ndim == 3 and image.shape[2] == 3
-    return image
 
 
 def test_render_views_example_writes_every_view(data, tmp_path):
