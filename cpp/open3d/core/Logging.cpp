@@ -67,6 +67,11 @@ void LogMessage(LogLevel level, std::string_view message) {
     }
 }
 
+std::string ApplyLogAliases(std::string_view message) {
+    std::lock_guard<std::mutex> lock(g_sink_mutex);
+    return ApplyAliases(message);
+}
+
 ScopedLogAlias::ScopedLogAlias(std::string from, std::string to) {
     std::lock_guard<std::mutex> lock(g_sink_mutex);
     index_ = g_aliases.size();

@@ -27,6 +27,9 @@ void LogMessage(LogLevel level, std::string_view message);
 
 /// While alive, every logged message has each `from` replaced by `to`: a writer that logs
 /// the temporary file it writes to (t::io::OutputFileSet) then names the user's file.
+/// ApplyLogAliases does the same to another text (an error's message).
+std::string ApplyLogAliases(std::string_view message);
+
 class ScopedLogAlias {
 public:
     ScopedLogAlias(std::string from, std::string to);

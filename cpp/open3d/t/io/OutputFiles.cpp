@@ -114,28 +114,18 @@ std::string OutputFileSet::Add(const std::string& final_path) {
 void OutputFileSet::Write(const std::string& final_path,
                           const std::function<void(const std::string& temporary)>& write) {
     const std::string temporary = Add(final_path);
+    // Warnings the writer logs and its error name the user's file (the whole path, then the
+    // bare name: some writers name only that), never the temporary.
+    const core::ScopedLogAlias path_alias(temporary, final_path);
+    const core::ScopedLogAlias name_alias(fs::path(temporary).filename().string(),
+                                          fs::path(final_path).filename().string());
     try {
-        // Warnings the writer logs name the user's file too (whole path, then bare name).
-        const core::ScopedLogAlias path_alias(temporary, final_path);
-        const core::ScopedLogAlias name_alias(fs::path(temporary).filename().string(),
-                                              fs::path(final_path).filename().string());
         write(temporary);
     } catch (const core::Open3DError& e) {
         // The failed output leaves the set: a later Commit must not publish its remains.
         std::remove(temporary.c_str());
         files_.pop_back();
-        std::string message = e.what();
-        const auto replace_all = [&message](const std::string& from, const std::string& to) {
-            for (size_t at = message.find(from); at != std::string::npos;
-                 at = message.find(from, at + to.size())) {
-                message.replace(at, from.size(), to);
-            }
-        };
-        // The whole path first, then a bare file name (some writers name only that).
-        replace_all(temporary, final_path);
-        replace_all(fs::path(temporary).filename().string(),
-                    fs::path(final_path).filename().string());
-        throw core::Open3DError(message);
+        throw core::Open3DError(core::ApplyLogAliases(e.what()));
     }
 }
 
