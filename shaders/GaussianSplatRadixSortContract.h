@@ -52,7 +52,9 @@ OPEN3D_SHADER_CONST uint kRadixSortValuesInBinding = 3u;   // uint[max_count]
 OPEN3D_SHADER_CONST uint kRadixSortKeysOutBinding = 4u;    // uint[max_count]
 OPEN3D_SHADER_CONST uint kRadixSortValuesOutBinding = 5u;  // uint[max_count]
 OPEN3D_SHADER_CONST uint kRadixSortHistogramBinding = 6u;  // uint[bins + bins * max_blocks]
-OPEN3D_SHADER_CONST uint kRadixSortNumBindings = 7u;
+// RadixSweepState of a one-sweep sort (the multi-pass sort binds a placeholder there).
+OPEN3D_SHADER_CONST uint kRadixSortSweepStateBinding = 7u;
+OPEN3D_SHADER_CONST uint kRadixSortNumBindings = 8u;
 // Most passes one sort records: 32-bit keys.
 OPEN3D_SHADER_CONST uint kRadixSortMaxPasses = 4u;
 
@@ -83,6 +85,38 @@ struct RadixSortParams {
     uvec4 pass_blocks[kRadixSortMaxPasses];
     uvec4 pass_rows[kRadixSortMaxPasses];
     uvec4 copy_blocks;
+    // The one-sweep histogram's grid: min(num_blocks, kRadixSweepHistogramGroups)
+    // workgroups, each taking every sweep_groups-th block (x, y, z, sweep_groups).
+    uvec4 sweep_histogram_grid;
+};
+
+// ---- One sweep per digit (RadixSort::Algorithm::kOneSweep, docs/vulkan.md) ----
+// One histogram dispatch counts the digits of every pass at once; then each pass is a
+// single scatter dispatch in which a block finds its output offsets by decoupled look-back:
+// it publishes its own digit counts (aggregate) in a status word per (block, digit), then
+// adds its predecessors' words back to the first one that carries an inclusive prefix.
+// A status word: flag in the top two bits, count below (counts stay below 2^30:
+// RadixSort keeps a one-sweep sort's max_count under it).
+OPEN3D_SHADER_CONST uint kRadixSweepFlagAggregate = 0x40000000u;
+OPEN3D_SHADER_CONST uint kRadixSweepFlagInclusive = 0x80000000u;
+OPEN3D_SHADER_CONST uint kRadixSweepValueMask = 0x3FFFFFFFu;
+// Most workgroups of the one-sweep histogram: each adds its counts to the global
+// histogram with one atomic per non-zero bin, so a sort of many blocks takes several
+// blocks per workgroup instead of more atomics.
+OPEN3D_SHADER_CONST uint kRadixSweepHistogramGroups = 1024u;
+// Specialisation constant (tests only): 1 makes every odd block publish its aggregate
+// and never its inclusive prefix, so look-backs walk across several blocks even where
+// workgroups run one after another (lavapipe with one thread).
+OPEN3D_SHADER_CONST uint kSpecRadixSweepOddBlocksAggregateOnly = 2u;
+
+// Zeroed before every one-sweep sort (vkCmdFillBuffer; RadixSort::RecordClearSweepState).
+struct RadixSweepState {
+    // Digit counts of the kept keys, pass-major: [pass][digit].
+    uint histogram[kRadixSortMaxPasses * kRadixSortBins];
+    // Per pass, the next block index to hand out: blocks take their index in the order
+    // they start, so every block a look-back waits for has started (forward progress).
+    uint next_block[kRadixSortMaxPasses];
+    uint reserved[4];
 };
 
 // Push constants of every radix-sort pipeline.
@@ -102,8 +136,9 @@ struct RadixSortPushConstants {
     // The device's maxComputeWorkGroupCount[0]: the per-block passes' grids
     // (DispatchGridFor) that the setup writes.
     uint max_groups_x;
-    uint reserved1;
-    uint reserved2;
+    uint num_bits;  // the sort's key bits (the one-sweep histogram counts every pass)
+    // 1: a one-sweep sort (the copy then counts the kept pairs from the sweep state)
+    uint sweep;
 };
 
 // ---- Radix sort parameters for an element count ----
@@ -147,6 +182,10 @@ OPEN3D_SHADER_FUNC RadixSortParams RadixSortParamsFor(uint count, uint max_count
         p.pass_rows[pass] = uvec4(kRadixSortBins, 1u, 1u, 0u);
     }
     p.copy_blocks = uvec4(0u, grid.y, 1u, 0u);
+    uint sweep_groups =
+        p.num_blocks < kRadixSweepHistogramGroups ? p.num_blocks : kRadixSweepHistogramGroups;
+    uvec4 sweep_grid = DispatchGridFor(sweep_groups, max_groups_x);
+    p.sweep_histogram_grid = uvec4(sweep_grid.x, sweep_grid.y, 1u, sweep_groups);
     return p;
 }
 
@@ -156,7 +195,12 @@ static_assert(kRadixSortWorkgroupSize == kRadixSortBins, "one invocation per bin
 static_assert(kRadixSortBlockSize == kRadixSortWorkgroupSize * kRadixSortItemsPerInvocation);
 static_assert(kRadixSortWorkgroupSize % kRadixSortMaxSubgroups == 0);
 
-static_assert(sizeof(RadixSortParams) == 192);
+static_assert(sizeof(RadixSortParams) == 208);
+static_assert(offsetof(RadixSortParams, sweep_histogram_grid) == 192);
+static_assert(sizeof(RadixSweepState) == 4 * (kRadixSortMaxPasses * kRadixSortBins + 8));
+static_assert(offsetof(RadixSweepState, next_block) == 4 * kRadixSortMaxPasses * kRadixSortBins);
+static_assert(kRadixSweepFlagAggregate > kRadixSweepValueMask &&
+              (kRadixSweepFlagAggregate & kRadixSweepFlagInclusive) == 0u);
 static_assert(offsetof(RadixSortParams, dispatch_x) == 0);
 static_assert(offsetof(RadixSortParams, dispatch_y) == 4);
 static_assert(offsetof(RadixSortParams, dispatch_z) == 8);
@@ -183,7 +227,8 @@ static_assert(offsetof(RadixSortPushConstants, key_range) == 24);
 static_assert(offsetof(RadixSortPushConstants, num_passes) == 28);
 static_assert(offsetof(RadixSortPushConstants, values_only) == 32);
 static_assert(offsetof(RadixSortPushConstants, max_groups_x) == 36);
-static_assert(offsetof(RadixSortPushConstants, reserved2) == 44);
+static_assert(offsetof(RadixSortPushConstants, num_bits) == 40);
+static_assert(offsetof(RadixSortPushConstants, sweep) == 44);
 static_assert(offsetof(RadixSortParams, reserved0) == 44);
 
 }  // namespace shader

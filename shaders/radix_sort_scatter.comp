@@ -1,14 +1,9 @@
 #version 460
-// Pass 3 of a digit: moves every pair of a block to its sorted position.
-// Ranking: each subgroup owns a contiguous run of the block (lanes x chunks pairs; lane l
-// holds pairs l, l + lanes, ... of it) and ranks its pairs step by step with ballots (the
-// lanes holding the same digit are the intersection of one ballot per digit bit), keeping
-// a running count per digit in shared memory: a pair's rank in its subgroup is that count
-// before its step plus its rank among the step's equal digits. One scan across subgroups
-// then gives each pair its block-local sorted position: the digit's start in the block +
-// the earlier subgroups' count of the digit + its rank in the subgroup. The block's output
-// index of that position is s_out_shift[digit] + position. Three barriers per block, where a
-// scan across subgroups after every chunk of 256 pairs needs four per chunk (docs/perf/h100.md).
+// Pass 3 of a digit (the multi-pass sort): moves every pair of a block to its sorted
+// position. The block ranks its pairs (radix_sort_rank.glsl); the scan left its first
+// output index within each digit, so a pair's output index is s_out_shift[digit] + its
+// block-local position. Three barriers per block, where a scan across subgroups after every
+// chunk of 256 pairs needs four per chunk (docs/perf/h100.md).
 // Writing (kLocalCapacity > 1, where shared memory allows): the pairs go to shared memory at
 // their local positions and the block is written out in sorted order at the end, so each
 // digit's run of the block is one contiguous write. Otherwise (lavapipe's 32 KiB) every
@@ -16,14 +11,9 @@
 // about twice as slow on NVIDIA (docs/perf/h100.md "Radix sort").
 // Dropping (a first pass with drop_max_keys): pairs with key kRadixSortDroppedKey take no
 // rank and are not written, so the block's kept pairs are packed from its output offsets.
-// Stability: subgroups own runs in scan-slot order (gl_SubgroupID), a subgroup ranks its
-// run in element order (steps in order, lanes by gl_SubgroupInvocationID, the order of
-// ballot bits), earlier subgroups take lower positions and blocks take their offsets in
-// block order, so equal digits keep their input order. Correct for any subgroup size of at
+// Stable (blocks take their offsets in block order); correct for any subgroup size of at
 // least kRadixSortWorkgroupSize / kRadixSortMaxSubgroups lanes.
 #extension GL_GOOGLE_include_directive : require
-#extension GL_KHR_shader_subgroup_ballot : require
-#extension GL_KHR_shader_subgroup_shuffle : require
 #include "radix_sort_common.glsl"
 
 layout(local_size_x = kRadixSortWorkgroupSize) in;
@@ -47,23 +37,15 @@ layout(std430, set = 0, binding = kRadixSortHistogramBinding) readonly buffer Hi
     uint histogram[];
 };
 
-const uint kPairWords = kRadixSortBins / 2u;  // two 16-bit digit counters per word
-
 // kRadixSortBlockSize when the block is reordered in shared memory, else 1 (RadixSort.cpp).
 layout(constant_id = kSpecRadixSortLocalCapacity) const uint kLocalCapacity = 1u;
 
 shared uint s_first[kRadixSortBins];      // block-local position of each digit's first pair
 shared uint s_out_shift[kRadixSortBins];  // output index - block-local position, per digit
-// [subgroup][digit / 2]: the subgroup's running count of each digit, then the count of the
-// earlier subgroups (the exclusive scan); digit d sits in half d % 2 of word d / 2. Counts
-// stay <= kRadixSortBlockSize, so the halves never carry into each other.
-shared uint s_counts[kMaxSubgroups * kPairWords];
 shared uint s_keys[kLocalCapacity];  // the block in sorted order
 shared uint s_values[kLocalCapacity];
 
-uint HalfOf(uint word, uint digit) {
-    return (word >> ((digit & 1u) * 16u)) & 0xFFFFu;
-}
+#include "radix_sort_rank.glsl"
 
 void main() {
     uint block = FlatWorkGroupIndex();
@@ -89,73 +71,21 @@ void main() {
         s_first[g_slot] = local_first;
         s_out_shift[g_slot] = digit_base + first - local_first;
     }
-    uint words = gl_NumSubgroups * kPairWords;
-    for (uint w = local; w < words; w += kRadixSortWorkgroupSize) s_counts[w] = 0u;
-    barrier();
-    uint row = gl_SubgroupID * kPairWords;
-
-    // This subgroup's run: lanes x chunks pairs from the position of its first scan slot.
     uint chunks = params.block_size / kRadixSortWorkgroupSize;  // uniform, 1..8
     uint block_begin = block * params.block_size;
-    uint block_end = min(block_begin + params.block_size, count);
-    uint lanes = g_subgroup_lanes;
-    uint first = block_begin + g_subgroup_first_slot * chunks + (g_slot - g_subgroup_first_slot);
-    // All loads first, so that they are in flight together.
-    uint keys[kRadixSortItemsPerInvocation];
-    uint values[kRadixSortItemsPerInvocation];
-    uint ranks[kRadixSortItemsPerInvocation];
-    uint kept = 0u;  // bit k: pair k is in the block and not a dropped key
-    for (uint k = 0u; k < kRadixSortItemsPerInvocation; ++k) {
-        uint index = first + k * lanes;
-        bool valid = k < chunks && index < block_end;
-        keys[k] = valid ? keys_in[index] : 0u;
-        values[k] = valid ? values_in[index] : 0u;
-    }
-    for (uint k = 0u; k < kRadixSortItemsPerInvocation; ++k) {
-        if (k >= chunks) break;  // uniform
-        bool valid = first + k * lanes < block_end && IsKept(keys[k]);
-        if (valid) kept |= 1u << k;
-        uint digit = DigitOf(keys[k]);
-        // Valid lanes of this subgroup with the same digit.
-        uvec4 peers = subgroupBallot(valid);
-        for (uint b = 0u; b < pc.digit_bits; ++b) {
-            bool bit = ((digit >> b) & 1u) != 0u;
-            uvec4 ballot = subgroupBallot(bit);
-            peers &= bit ? ballot : ~ballot;
-        }
-        uint rank = subgroupBallotExclusiveBitCount(peers);
-        uint before = 0u;
-        if (valid && rank == 0u) {
-            before = atomicAdd(s_counts[row + (digit >> 1u)],
-                               subgroupBallotBitCount(peers) << ((digit & 1u) * 16u));
-        }
-        // The first of the peers added their count; every peer needs the count before it.
-        uint leader = valid ? subgroupBallotFindLSB(peers) : gl_SubgroupInvocationID;
-        ranks[k] = HalfOf(subgroupShuffle(before, leader), digit) + rank;
-    }
-    barrier();
-    // Exclusive scan over subgroups, both digits of a word at once.
-    if (local < kPairWords) {
-        uint running = 0u;
-        for (uint s = 0u; s < gl_NumSubgroups; ++s) {
-            uint w = s * kPairWords + local;
-            uint c = s_counts[w];
-            s_counts[w] = running;
-            running += c;
-        }
-    }
-    barrier();
+    RankBlock(block_begin, min(block_begin + params.block_size, count), chunks);
+    ScanSubgroupCounts();
     for (uint k = 0u; k < kRadixSortItemsPerInvocation; ++k) {
         if (k >= chunks) break;
-        if ((kept & (1u << k)) == 0u) continue;
-        uint digit = DigitOf(keys[k]);
-        uint position = s_first[digit] + HalfOf(s_counts[row + (digit >> 1u)], digit) + ranks[k];
+        if ((g_kept & (1u << k)) == 0u) continue;
+        uint digit = DigitOf(g_keys[k]);
+        uint position = LocalPosition(k, s_first[digit]);
         if (kLocalCapacity > 1u) {
-            s_keys[position] = keys[k];
-            s_values[position] = values[k];
+            s_keys[position] = g_keys[k];
+            s_values[position] = g_values[k];
         } else {
-            if (write_keys) keys_out[s_out_shift[digit] + position] = keys[k];
-            values_out[s_out_shift[digit] + position] = values[k];
+            if (write_keys) keys_out[s_out_shift[digit] + position] = g_keys[k];
+            values_out[s_out_shift[digit] + position] = g_values[k];
         }
     }
     if (kLocalCapacity == 1u) return;

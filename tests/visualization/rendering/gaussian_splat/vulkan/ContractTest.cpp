@@ -23,7 +23,8 @@ TEST(GaussianSplatContract, CompilesAsCpp) {
     // Reaching this line means every static_assert in the header held.
     EXPECT_EQ(shader::kRadixSortBlockSize,
               shader::kRadixSortWorkgroupSize * shader::kRadixSortItemsPerInvocation);
-    EXPECT_EQ(sizeof(shader::RadixSortParams), 192u);
+    EXPECT_EQ(sizeof(shader::RadixSortParams), 208u);
+    EXPECT_EQ(sizeof(shader::RadixSweepState), 4128u);
     EXPECT_EQ(sizeof(shader::RadixSortPushConstants), 48u);
 }
 
@@ -93,6 +94,9 @@ TEST_F(GaussianSplatContractGpu, ShaderLayoutMatchesCpp) {
     push.key_range = 207;
     push.num_passes = 208;
     push.values_only = 209;
+    push.max_groups_x = 210;
+    push.num_bits = 211;
+    push.sweep = 212;
     SubmitAndWait(Context(), Pool(), [&](VkCommandBuffer cmd) {
         VkDescriptorBufferInfo infos[kBindings] = {
             {params.Get(), 0, VK_WHOLE_SIZE},        {push_out.Get(), 0, VK_WHOLE_SIZE},
@@ -138,6 +142,8 @@ TEST_F(GaussianSplatContractGpu, ShaderLayoutMatchesCpp) {
     }
     EXPECT_EQ(p.copy_blocks.x, 190u);
     EXPECT_EQ(p.copy_blocks.w, 193u);
+    EXPECT_EQ(p.sweep_histogram_grid.x, 194u);
+    EXPECT_EQ(p.sweep_histogram_grid.w, 197u);
     shader::RadixSortPushConstants q;
     std::memcpy(&q, push_out.GetMapped(), sizeof(q));
     EXPECT_EQ(q.shift, 201u);
@@ -149,6 +155,9 @@ TEST_F(GaussianSplatContractGpu, ShaderLayoutMatchesCpp) {
     EXPECT_EQ(q.key_range, 207u);
     EXPECT_EQ(q.num_passes, 208u);
     EXPECT_EQ(q.values_only, 209u);
+    EXPECT_EQ(q.max_groups_x, 210u);
+    EXPECT_EQ(q.num_bits, 211u);
+    EXPECT_EQ(q.sweep, 212u);
 
     // The stage structs: every named member at its C++ offset (numbered as the probe writes).
     shader::GaussianViewParams v;

@@ -259,6 +259,16 @@ void GaussianGeometryStage::Record(VkCommandBuffer cmd, const GeometryStageScene
                           buffers.sort_scratch.params.offset, sizeof(depth_sort), &depth_sort);
     }
     vkCmdUpdateBuffer(cmd, counters, counters_offset, sizeof(initial_counters), &initial_counters);
+    // Both sorts' one-sweep states start at zero (the multi-pass sort reads neither).
+    RadixSortScratch depth_sort_scratch = buffers.sort_scratch;
+    RadixSortScratch tile_sort_scratch = buffers.sort_scratch;
+    tile_sort_scratch.sweep_state = buffers.tile_sort_sweep_state;
+    if (sort_.GetAlgorithm() == RadixSort::Algorithm::kOneSweep) {
+        RadixSort::RecordClearSweepState(cmd, depth_sort_scratch.sweep_state);
+        RadixSort::RecordClearSweepState(cmd, tile_sort_scratch.sweep_state);
+        depth_sort_scratch.sweep_state_cleared = true;
+        tile_sort_scratch.sweep_state_cleared = true;
+    }
     if (choices.binned) {
         // Every tile's count starts at 0 (and the composite's tile counter, which it zeroes
         // again itself).
@@ -364,7 +374,7 @@ void GaussianGeometryStage::Record(VkCommandBuffer cmd, const GeometryStageScene
     if (!packed_key) {
         begin(TimedPass::kDepthSort);
         const RadixSort::DropMaxKeys drop_culled{counter_range(kCounterVisibleIndex)};
-        sort_.Record(cmd, buffers.depth_keys, buffers.splat_indices, buffers.sort_scratch,
+        sort_.Record(cmd, buffers.depth_keys, buffers.splat_indices, depth_sort_scratch,
                      counter_range(kCounterNumSplatsIndex), std::max(n, 1u), 32,
                      RadixSort::Params::kWrittenByProducer, &drop_culled,
                      RadixSort::PassCount::kFromKeyRange, RadixSort::Output::kValuesOnly);
@@ -414,7 +424,7 @@ void GaussianGeometryStage::Record(VkCommandBuffer cmd, const GeometryStageScene
     // 7. Stable sort by tile index only: each tile keeps the depth order of step 3. The
     // packed key sorts all 32 bits (4 passes, as the seed), then shifts back to tiles.
     begin(TimedPass::kTileSort);
-    sort_.Record(cmd, buffers.entry_keys, buffers.entry_values, buffers.sort_scratch,
+    sort_.Record(cmd, buffers.entry_keys, buffers.entry_values, tile_sort_scratch,
                  counter_range(kCounterEntriesIndex), std::max(capacity, 1u),
                  packed_key ? kSortKeyBits : choices.tile_bits,
                  RadixSort::Params::kWrittenByProducer);

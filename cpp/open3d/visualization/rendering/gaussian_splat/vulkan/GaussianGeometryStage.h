@@ -87,7 +87,10 @@ struct GeometryStageViewBuffers {
     BufferRange scan;           ///< after Record: first visible_count words = entry offsets
     BufferRange entry_keys;     ///< after Record: tile index per entry, ascending
     BufferRange entry_values;   ///< after Record: splat index per entry, front to back
+    /// Shared by both sorts; its sweep_state is the depth sort's.
     RadixSortScratch sort_scratch;
+    /// The tile sort's RadixSweepState (both are cleared with the frame's first transfers).
+    BufferRange tile_sort_sweep_state;
     BufferRange tile_counts;  ///< scratch: each visible splat's tile count, by splat index
     /// The composite's state buffer (GaussianCompositeStage::StateBytes of the view's size,
     /// from its start): with per-tile bins (view.choices.binned) the stage counts, fills and

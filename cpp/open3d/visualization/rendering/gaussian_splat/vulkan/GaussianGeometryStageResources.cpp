@@ -362,6 +362,8 @@ void GeometryStageViewResources::Allocate(const VulkanContext& context, uint32_t
     values_alt = make(need.sort.values_alt_bytes, need.sort.scratch_usage);
     histogram = make(need.sort.histogram_bytes, need.sort.scratch_usage);
     sort_params = make(need.sort.params_bytes, need.sort.params_usage);
+    depth_sweep_state = make(need.sort.sweep_state_bytes, need.sort.sweep_state_usage);
+    tile_sweep_state = make(need.sort.sweep_state_bytes, need.sort.sweep_state_usage);
     lod_buckets = Buffer();
     lod_histogram = Buffer();
     lod_visibility = Buffer();
@@ -420,7 +422,8 @@ GeometryStageViewBuffers GeometryStageViewResources::Buffers() const {
     view.entry_keys = entry_keys.Range();
     view.entry_values = entry_values.Range();
     view.sort_scratch = {keys_alt.Range(), values_alt.Range(), histogram.Range(),
-                         sort_params.Range()};
+                         sort_params.Range(), depth_sweep_state.Range()};
+    view.tile_sort_sweep_state = tile_sweep_state.Range();
     if (lod_inner_) {
         view.lod_buckets = lod_buckets.Range();
         view.lod_histogram = lod_histogram.Range();

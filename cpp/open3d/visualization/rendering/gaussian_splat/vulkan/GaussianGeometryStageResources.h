@@ -52,6 +52,7 @@ public:
 
     Buffer view_params, projected, counters, depth_keys, splat_indices, tile_counts, scan;
     Buffer entry_keys, entry_values, keys_alt, values_alt, histogram, sort_params;
+    Buffer depth_sweep_state, tile_sweep_state;
     /// Empty without a hierarchy.
     Buffer lod_buckets, lod_histogram, lod_visibility, lod_group_counts, lod_list, lod_walk;
 

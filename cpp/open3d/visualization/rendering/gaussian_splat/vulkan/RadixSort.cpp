@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <array>
+#include <cstdlib>
+#include <string>
 
 #include "GaussianSplatRadixSortContract.h"
 #include "open3d/core/Exception.h"
@@ -54,8 +56,26 @@ uint64_t ScatterSharedBytes(uint32_t max_subgroups, uint32_t local_capacity) {
 
 }  // namespace
 
-RadixSort::RadixSort(const VulkanContext& context) : context_(&context) {
+namespace {
+
+RadixSort::Algorithm ChooseAlgorithm(RadixSort::Algorithm requested, const VulkanDeviceInfo& info) {
+    if (requested != RadixSort::Algorithm::kForDevice) return requested;
+    if (const char* env = std::getenv("OPEN3D_RADIX_SORT"); env != nullptr && *env != '\0') {
+        const std::string value = env;
+        if (value == "onesweep") return RadixSort::Algorithm::kOneSweep;
+        if (value == "multipass") return RadixSort::Algorithm::kMultiPass;
+        core::ThrowError("OPEN3D_RADIX_SORT is '{}': use onesweep or multipass (or unset it)",
+                         value);
+    }
+    return info.type == "CPU" ? RadixSort::Algorithm::kMultiPass : RadixSort::Algorithm::kOneSweep;
+}
+
+}  // namespace
+
+RadixSort::RadixSort(const VulkanContext& context, Algorithm algorithm, RadixSortOptions options)
+    : context_(&context) {
     const auto& info = context.GetDeviceInfo();
+    algorithm_ = ChooseAlgorithm(algorithm, info);
     const uint32_t min_subgroup = kRadixSortWorkgroupSize / kRadixSortMaxSubgroups;
     if (info.min_subgroup_size < min_subgroup) {
         core::ThrowError(
@@ -72,15 +92,18 @@ RadixSort::RadixSort(const VulkanContext& context) : context_(&context) {
     struct {
         uint32_t max_subgroups;
         uint32_t local_capacity;
-    } constants{kRadixSortWorkgroupSize / info.min_subgroup_size, 1u};
+        uint32_t odd_blocks_aggregate_only;
+    } constants{kRadixSortWorkgroupSize / info.min_subgroup_size, 1u,
+                options.odd_blocks_aggregate_only ? 1u : 0u};
     constants.local_capacity = ScatterSharedBytes(constants.max_subgroups, kRadixSortBlockSize) <=
                                        info.max_compute_shared_memory
                                    ? kRadixSortBlockSize
                                    : 1u;
     local_reorder_ = constants.local_capacity > 1u;
-    const std::array<VkSpecializationMapEntry, 2> entries{
+    const std::array<VkSpecializationMapEntry, 3> entries{
         {{kSpecRadixSortSubgroups, 0, sizeof(uint32_t)},
-         {kSpecRadixSortLocalCapacity, sizeof(uint32_t), sizeof(uint32_t)}}};
+         {kSpecRadixSortLocalCapacity, sizeof(uint32_t), sizeof(uint32_t)},
+         {kSpecRadixSweepOddBlocksAggregateOnly, 2 * sizeof(uint32_t), sizeof(uint32_t)}}};
     const VkSpecializationInfo specialization{static_cast<uint32_t>(entries.size()), entries.data(),
                                               sizeof(constants), &constants};
     const auto create = [&](std::span<const uint32_t> spirv, const char* name) {
@@ -91,6 +114,14 @@ RadixSort::RadixSort(const VulkanContext& context) : context_(&context) {
     scan_ = create(spirv::kRadixSortScan, "radix_sort_scan");
     scatter_ = create(spirv::kRadixSortScatter, "radix_sort_scatter");
     copy_ = create(spirv::kRadixSortCopy, "radix_sort_copy");
+    if (algorithm_ == Algorithm::kOneSweep) {
+        sweep_histogram_ = create(spirv::kRadixSortSweepHistogram, "radix_sort_sweep_histogram");
+        sweep_scatter_ = create(spirv::kRadixSortSweepScatter, "radix_sort_sweep_scatter");
+    }
+}
+
+void RadixSort::RecordClearSweepState(VkCommandBuffer cmd, const BufferRange& sweep_state) {
+    vkCmdFillBuffer(cmd, sweep_state.buffer, sweep_state.offset, sizeof(RadixSweepState), 0u);
 }
 
 uint32_t RadixSort::MaxCountFor(uint64_t max_storage_buffer_range) {
@@ -117,9 +148,13 @@ RadixSortStorageRequirements RadixSort::GetStorageRequirements(uint32_t max_coun
     RadixSortStorageRequirements requirements;
     requirements.keys_alt_bytes = Words(max_count);
     requirements.values_alt_bytes = Words(max_count);
+    // The multi-pass sort's digit totals and per-block counts, or the one-sweep sort's two
+    // tables of look-back status words.
+    const uint64_t blocks = MaxBlocks(max_count);
     requirements.histogram_bytes =
-        Words(kRadixSortBins + uint64_t(kRadixSortBins) * MaxBlocks(max_count));
+        Words(std::max(kRadixSortBins + kRadixSortBins * blocks, 2 * kRadixSortBins * blocks));
     requirements.params_bytes = sizeof(RadixSortParams);
+    requirements.sweep_state_bytes = sizeof(RadixSweepState);
     return requirements;
 }
 
@@ -152,13 +187,14 @@ void RadixSort::CheckArguments(const BufferRange& keys, const BufferRange& value
         const BufferRange& range;
         VkDeviceSize bytes;
     };
-    const std::array<Check, 6> checks{
+    const std::array<Check, 7> checks{
         {{"keys", keys, Words(max_count)},
          {"values", values, Words(max_count)},
          {"scratch.keys_alt", scratch.keys_alt, need.keys_alt_bytes},
          {"scratch.values_alt", scratch.values_alt, need.values_alt_bytes},
          {"scratch.histogram", scratch.histogram, need.histogram_bytes},
-         {"scratch.params", scratch.params, need.params_bytes}}};
+         {"scratch.params", scratch.params, need.params_bytes},
+         {"scratch.sweep_state", scratch.sweep_state, need.sweep_state_bytes}}};
     for (const Check& check : checks) {
         if (check.range.buffer == VK_NULL_HANDLE) {
             core::ThrowError("RadixSort: {} has no buffer", check.name);
@@ -184,25 +220,66 @@ uint32_t RadixSort::GetTargetBlocks() const {
     return context_->GetDeviceInfo().type == "CPU" ? 16u : kRadixSortTargetBlocks;
 }
 
+void RadixSort::BindBuffers(VkCommandBuffer cmd, const RadixSortScratch& scratch,
+                            const BufferRange& count_in, uint32_t max_count,
+                            const BufferRange& keys_in, const BufferRange& values_in,
+                            const BufferRange& keys_out, const BufferRange& values_out) const {
+    // The count may sit at any 4-byte offset: bound from the aligned offset below it, the
+    // uint indexed with a push constant (count_index).
+    const VkDeviceSize alignment = context_->GetDeviceInfo().min_storage_buffer_offset_alignment;
+    std::array<VkDescriptorBufferInfo, kRadixSortNumBindings> buffers{};
+    buffers[kRadixSortParamsBinding] = {scratch.params.buffer, scratch.params.offset,
+                                        sizeof(RadixSortParams)};
+    buffers[kRadixSortCountBinding] = {
+        count_in.buffer, count_in.offset - count_in.offset % alignment, VK_WHOLE_SIZE};
+    buffers[kRadixSortKeysInBinding] = {keys_in.buffer, keys_in.offset, Words(max_count)};
+    buffers[kRadixSortValuesInBinding] = {values_in.buffer, values_in.offset, Words(max_count)};
+    buffers[kRadixSortKeysOutBinding] = {keys_out.buffer, keys_out.offset, Words(max_count)};
+    buffers[kRadixSortValuesOutBinding] = {values_out.buffer, values_out.offset, Words(max_count)};
+    buffers[kRadixSortHistogramBinding] = {scratch.histogram.buffer, scratch.histogram.offset,
+                                           GetStorageRequirements(max_count).histogram_bytes};
+    buffers[kRadixSortSweepStateBinding] = {scratch.sweep_state.buffer, scratch.sweep_state.offset,
+                                            sizeof(RadixSweepState)};
+    std::array<VkWriteDescriptorSet, kRadixSortNumBindings> writes{};
+    for (uint32_t i = 0; i < kRadixSortNumBindings; ++i) {
+        writes[i].sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET;
+        writes[i].dstBinding = i;
+        writes[i].descriptorCount = 1;
+        writes[i].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+        writes[i].pBufferInfo = &buffers[i];
+    }
+    context_->GetCmdPushDescriptorSet()(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_layout_.Get(),
+                                        0, kRadixSortNumBindings, writes.data());
+}
+
 void RadixSort::Record(VkCommandBuffer cmd, const BufferRange& keys, const BufferRange& values,
                        const RadixSortScratch& scratch, const BufferRange& count,
                        uint32_t max_count, uint32_t num_bits, Params params,
                        const DropMaxKeys* drop, PassCount pass_count, Output output) const {
     CheckArguments(keys, values, scratch, count, max_count, num_bits);
     if (drop) RequireCountRange(drop->kept_count, "kept_count");
+    if (GetNumPasses(num_bits) == 0) return;  // no key bits: every order is sorted
+    // Status words hold counts below 2^30 (kRadixSweepValueMask).
+    if (algorithm_ == Algorithm::kOneSweep && max_count <= kRadixSweepValueMask) {
+        RecordOneSweep(cmd, keys, values, scratch, count, max_count, num_bits, params, drop,
+                       output);
+    } else {
+        RecordMultiPass(cmd, keys, values, scratch, count, max_count, num_bits, params, drop,
+                        pass_count, output);
+    }
+}
+
+void RadixSort::RecordMultiPass(VkCommandBuffer cmd, const BufferRange& keys,
+                                const BufferRange& values, const RadixSortScratch& scratch,
+                                const BufferRange& count, uint32_t max_count, uint32_t num_bits,
+                                Params params, const DropMaxKeys* drop, PassCount pass_count,
+                                Output output) const {
     const uint32_t num_passes = GetNumPasses(num_bits);
-    if (num_passes == 0) return;  // no key bits: every order is sorted
     // A range can only save passes after the first.
     const bool by_range = pass_count == PassCount::kFromKeyRange && num_passes > 1;
-
-    // The count may sit at any 4-byte offset: bind from the aligned offset below it and
-    // index the uint with a push constant.
     const VkDeviceSize alignment = context_->GetDeviceInfo().min_storage_buffer_offset_alignment;
-    const auto count_binding_offset = [alignment](const BufferRange& range) {
-        return range.offset - range.offset % alignment;
-    };
     const auto count_index = [&](const BufferRange& range) {
-        return static_cast<uint32_t>((range.offset - count_binding_offset(range)) / 4);
+        return static_cast<uint32_t>((range.offset % alignment) / 4);
     };
     BufferRange count_in = count;  // what the setup dispatch reads
     RadixSortPushConstants push{};
@@ -212,44 +289,18 @@ void RadixSort::Record(VkCommandBuffer cmd, const BufferRange& keys, const Buffe
     push.num_passes = num_passes;
     push.values_only = output == Output::kValuesOnly ? 1u : 0u;
     push.max_groups_x = GetMaxGroupsX();
+    push.num_bits = num_bits;
 
     const VkPipelineLayout layout = pipeline_layout_.Get();
     const auto bind = [&](const BufferRange& keys_in, const BufferRange& values_in,
                           const BufferRange& keys_out, const BufferRange& values_out) {
-        std::array<VkDescriptorBufferInfo, kRadixSortNumBindings> buffers{};
-        buffers[kRadixSortParamsBinding] = {scratch.params.buffer, scratch.params.offset,
-                                            sizeof(RadixSortParams)};
-        buffers[kRadixSortCountBinding] = {count_in.buffer, count_binding_offset(count_in),
-                                           VK_WHOLE_SIZE};
-        buffers[kRadixSortKeysInBinding] = {keys_in.buffer, keys_in.offset, Words(max_count)};
-        buffers[kRadixSortValuesInBinding] = {values_in.buffer, values_in.offset, Words(max_count)};
-        buffers[kRadixSortKeysOutBinding] = {keys_out.buffer, keys_out.offset, Words(max_count)};
-        buffers[kRadixSortValuesOutBinding] = {values_out.buffer, values_out.offset,
-                                               Words(max_count)};
-        buffers[kRadixSortHistogramBinding] = {scratch.histogram.buffer, scratch.histogram.offset,
-                                               GetStorageRequirements(max_count).histogram_bytes};
-        std::array<VkWriteDescriptorSet, kRadixSortNumBindings> writes{};
-        for (uint32_t i = 0; i < kRadixSortNumBindings; ++i) {
-            writes[i].sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET;
-            writes[i].dstBinding = i;
-            writes[i].descriptorCount = 1;
-            writes[i].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
-            writes[i].pBufferInfo = &buffers[i];
-        }
-        context_->GetCmdPushDescriptorSet()(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, layout, 0,
-                                            kRadixSortNumBindings, writes.data());
+        BindBuffers(cmd, scratch, count_in, max_count, keys_in, values_in, keys_out, values_out);
     };
     const auto push_constants = [&]() {
         vkCmdPushConstants(cmd, layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(push), &push);
     };
     // Every dispatch reads what the previous one wrote, including indirect arguments.
-    const auto barrier = [&]() {
-        RecordMemoryBarrier(
-            cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
-            VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_DRAW_INDIRECT_BIT,
-            VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT |
-                VK_ACCESS_2_INDIRECT_COMMAND_READ_BIT);
-    };
+    const auto barrier = [&]() { RecordComputeToComputeAndIndirect(cmd); };
     const VkBuffer params_buffer = scratch.params.buffer;
     const VkDeviceSize params_offset = scratch.params.offset;
 

@@ -2,13 +2,17 @@
 // caller allocates the scratch buffers from GetStorageRequirements and Record() only
 // records commands. The element count is read on the GPU from the producer's buffer.
 //
-// Algorithm (docs/vulkan.md): LSD, 8-bit digits, ceil(num_bits / 8) passes (fewer with
-// PassCount::kFromKeyRange). Per pass:
-// histogram (per-block digit counts) -> scan (one workgroup per digit) -> scatter (stable
-// in-workgroup ranking from subgroup ballots), each per-block pass dispatched indirectly
-// with the block count a setup shader writes: blocks of 256..2048 elements, at most
-// kRadixSortTargetBlocks of them while 2048-element blocks are not needed. Stable for any subgroup
-// size; keys bits at and above num_bits are carried but do not affect the order.
+// Algorithm (docs/vulkan.md): LSD, 8-bit digits, ceil(num_bits / 8) passes, blocks of
+// 256..2048 elements (at most kRadixSortTargetBlocks of them while 2048-element blocks are not
+// needed) dispatched indirectly with the block count a setup shader or the producer writes.
+// Two ways to run the passes (Algorithm):
+// - multi-pass: per pass histogram (per-block digit counts) -> scan (one workgroup per digit)
+//   -> scatter (stable in-workgroup ranking from subgroup ballots), fewer passes with
+//   PassCount::kFromKeyRange;
+// - one sweep: one histogram of every pass's digits, then one scatter per pass in which each
+//   block finds its offsets by decoupled look-back on the blocks before it.
+// Stable for any subgroup size; keys bits at and above num_bits are carried but do not affect
+// the order.
 #pragma once
 
 #include <vulkan/vulkan.h>
@@ -28,15 +32,19 @@ struct VulkanDeviceInfo;
 
 /// Bytes and usage of the scratch buffers a sort of up to max_count pairs needs.
 struct RadixSortStorageRequirements {
-    VkDeviceSize keys_alt_bytes = 0;    ///< uint32 [max_count]
-    VkDeviceSize values_alt_bytes = 0;  ///< uint32 [max_count]
-    VkDeviceSize histogram_bytes = 0;   ///< uint32 [256 + 256 * max blocks]
-    VkDeviceSize params_bytes = 0;      ///< shader::RadixSortParams
+    VkDeviceSize keys_alt_bytes = 0;     ///< uint32 [max_count]
+    VkDeviceSize values_alt_bytes = 0;   ///< uint32 [max_count]
+    VkDeviceSize histogram_bytes = 0;    ///< uint32 [256 + 256 * max blocks]
+    VkDeviceSize params_bytes = 0;       ///< shader::RadixSortParams
+    VkDeviceSize sweep_state_bytes = 0;  ///< shader::RadixSweepState
     /// Usage of keys_alt, values_alt and histogram.
     VkBufferUsageFlags scratch_usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
     /// Usage of params (it holds the indirect dispatch arguments).
     VkBufferUsageFlags params_usage =
         VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT;
+    /// Usage of sweep_state (it is cleared with vkCmdFillBuffer).
+    VkBufferUsageFlags sweep_state_usage =
+        VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
 };
 
 /// Scratch ranges, each at least as large as required and with an offset that is a
@@ -49,6 +57,20 @@ struct RadixSortScratch {
     /// `count` is the number sorted and `flags` has kErrorCountsClamped when the producer's
     /// count exceeded max_count.
     BufferRange params;
+    /// shader::RadixSweepState: the one-sweep sort's digit histogram and block counters,
+    /// zero before each sort (the multi-pass sort binds it without reading it).
+    BufferRange sweep_state;
+    /// true: the caller zeroed sweep_state (RecordClearSweepState) and made that visible to
+    /// COMPUTE_SHADER reads and writes, e.g. with its other transfers at the start of a
+    /// frame. false: a one-sweep Record clears it itself, behind a barrier of its own.
+    bool sweep_state_cleared = false;
+};
+
+/// Test switches of the one-sweep scatter.
+struct RadixSortOptions {
+    /// Odd blocks publish only their own counts, never their inclusive prefix, so every
+    /// look-back walks past them (covers the aggregate path where workgroups run in order).
+    bool odd_blocks_aggregate_only = false;
 };
 
 class RadixSort {
@@ -70,9 +92,24 @@ public:
     /// that write the parameters themselves pass it.
     uint32_t GetMaxGroupsX() const;
 
+    /// How the passes run (the class comment). kForDevice: one sweep on GPUs; the multi-pass
+    /// sort on CPU devices (lavapipe), where a look-back may wait for a workgroup whose
+    /// thread the OS has descheduled and lavapipe ends a loop after 65,535 iterations
+    /// (docs/environment-notes.md). The environment variable OPEN3D_RADIX_SORT=onesweep or
+    /// =multipass overrides kForDevice (tests and measurements).
+    enum class Algorithm { kForDevice, kMultiPass, kOneSweep };
+
     /// Creates the pipelines. Throws core::Open3DError when the device's subgroups can be
-    /// smaller than 4 invocations (the shaders size shared arrays by subgroup count).
-    explicit RadixSort(const VulkanContext& context);
+    /// smaller than 8 invocations (the shaders size shared arrays by subgroup count), and for
+    /// an OPEN3D_RADIX_SORT value it does not know.
+    explicit RadixSort(const VulkanContext& context, Algorithm algorithm = Algorithm::kForDevice,
+                       RadixSortOptions options = {});
+    /// kMultiPass or kOneSweep: what Record runs (a one-sweep sorter still runs the
+    /// multi-pass sort for a max_count whose counts would not fit a status word, 2^30 or more).
+    Algorithm GetAlgorithm() const { return algorithm_; }
+    /// Zeroes a one-sweep sort's state (a transfer write: the caller barriers before the sort
+    /// and sets RadixSortScratch::sweep_state_cleared).
+    static void RecordClearSweepState(VkCommandBuffer cmd, const BufferRange& sweep_state);
 
     /// Scratch sizes for up to `max_count` pairs. Throws when max_count > kMaxCount (Record
     /// checks the device's GetMaxCount).
@@ -113,9 +150,10 @@ public:
     /// and only the passes up to the highest non-zero digit of max - base run: a setup
     /// dispatch after the first pass gives the others zero workgroups and copies an odd
     /// number of passes back to `keys` and `values`. `scratch.params` then has key_min,
-    /// key_max and range_passes. Geometry stage's depth keys (float bits) of a frame whose
-    /// farthest visible splat is less than 2 to 4 times as far as the nearest span less
-    /// than 2^24: three passes instead of four.
+    /// key_max and range_passes. The one-sweep sort ignores it: every pass runs, and a pass
+    /// whose kept keys all share their digit (from the histogram it knows in advance) copies.
+    /// Geometry stage's depth keys (float bits) of a frame whose farthest visible splat is less
+    /// than 2 to 4 times as far as the nearest span less than 2^24: three passes instead of four.
     enum class PassCount {
         kAll,  ///< ceil(num_bits / 8)
         kFromKeyRange,
@@ -150,6 +188,20 @@ public:
                 Output output = Output::kKeysAndValues) const;
 
 private:
+    // Pushes the sort's bindings: the given key/value buffers in and out, the scratch, and
+    // the count at its aligned binding.
+    void BindBuffers(VkCommandBuffer cmd, const RadixSortScratch& scratch,
+                     const BufferRange& count_in, uint32_t max_count, const BufferRange& keys_in,
+                     const BufferRange& values_in, const BufferRange& keys_out,
+                     const BufferRange& values_out) const;
+    void RecordMultiPass(VkCommandBuffer cmd, const BufferRange& keys, const BufferRange& values,
+                         const RadixSortScratch& scratch, const BufferRange& count,
+                         uint32_t max_count, uint32_t num_bits, Params params,
+                         const DropMaxKeys* drop, PassCount pass_count, Output output) const;
+    void RecordOneSweep(VkCommandBuffer cmd, const BufferRange& keys, const BufferRange& values,
+                        const RadixSortScratch& scratch, const BufferRange& count,
+                        uint32_t max_count, uint32_t num_bits, Params params,
+                        const DropMaxKeys* drop, Output output) const;
     void CheckArguments(const BufferRange& keys, const BufferRange& values,
                         const RadixSortScratch& scratch, const BufferRange& count,
                         uint32_t max_count, uint32_t num_bits) const;
@@ -162,6 +214,9 @@ private:
     UniquePipeline scan_;
     UniquePipeline scatter_;
     UniquePipeline copy_;
+    UniquePipeline sweep_histogram_;
+    UniquePipeline sweep_scatter_;
+    Algorithm algorithm_ = Algorithm::kMultiPass;
     bool local_reorder_ = false;
 };
 

@@ -127,6 +127,7 @@ void main() {
         params_out.pass_rows[pass] = uvec4(150u, 151u, 152u, 153u) + 10u * pass;
     }
     params_out.copy_blocks = uvec4(190u, 191u, 192u, 193u);
+    params_out.sweep_histogram_grid = uvec4(194u, 195u, 196u, 197u);
     // Push constants read by member name, written back member by member.
     push_out.shift = pc.shift;
     push_out.digit_bits = pc.digit_bits;
@@ -137,5 +138,8 @@ void main() {
     push_out.key_range = pc.key_range;
     push_out.num_passes = pc.num_passes;
     push_out.values_only = pc.values_only;
+    push_out.max_groups_x = pc.max_groups_x;
+    push_out.num_bits = pc.num_bits;
+    push_out.sweep = pc.sweep;
     WriteStageStructs();
 }

@@ -1,0 +1,48 @@
+#!/usr/bin/env bash
+# The radix sort's two algorithms side by side on the GPU device machine, from binaries built
+# here (docs/vulkan.md "GPU radix sort"): the sort, geometry stage and frame suites with the
+# device's default (one sweep on a GPU), then gs-bench frames with OPEN3D_RADIX_SORT=multipass
+# and =onesweep alternating scene by scene, so that both see the same clocks.
+# Prepare here:
+#   mkdir -p .devbin && cp build/bin/{gs-bench,tests_gaussian_splat_vulkan} .devbin/ && strip .devbin/*
+#   bash scripts/device/prepare.sh .devbin/gs-bench .devbin/tests_gaussian_splat_vulkan
+# The call carries .gl, .devlibs, .devbin and the scene files (shared/ is a link and travels
+# only path by path): playbot_125k.ply, chair.splat, biker_152k.ply and their cameras.json.
+#   bash scripts/device/sort-ab.sh OUT_DIR
+set -uo pipefail
+out=${1:?usage: bash scripts/device/sort-ab.sh OUT_DIR}
+mkdir -p "$out"
+for f in .gl/*.deb; do dpkg -x "$f" /; done
+ldconfig
+export VK_DRIVER_FILES=${VK_DRIVER_FILES:-/usr/local/nvidia/share/vulkan/icd.d/nvidia_icd.json}
+export LD_LIBRARY_PATH=$PWD/.devlibs
+export OPEN3D_DATA_DIR=$PWD/shared/data OPEN3D_VULKAN_VALIDATION=0 OPEN3D_TEST_REQUIRE_VULKAN=1
+nvidia-smi --query-gpu=name,driver_version,clocks.sm,clocks.max.sm --format=csv | tee "$out/gpu.txt"
+
+echo "== suites (the device's default sort)"
+timeout 300 .devbin/tests_gaussian_splat_vulkan \
+  --gtest_filter='*RadixSort*:RealScenes/GeometryStageScenes*:SubmissionPath*:GeometryStageFeatures*:VulkanBackend*:LodCut*:CommandTally*' \
+  --gtest_output=xml:"$out/suites.xml" >"$out/suites.log" 2>&1
+echo "suites exit $?: $(grep -E '^\[  (PASSED|FAILED) ' "$out/suites.log" | tr '\n' ' ')"
+grep -E '^\[  FAILED  \]' "$out/suites.log" | head -20
+
+d=shared/data
+bench() {  # NAME ARGS...: one gs-bench run per algorithm
+  local name=$1
+  shift
+  for algo in multipass onesweep; do
+    OPEN3D_RADIX_SORT=$algo timeout 240 .devbin/gs-bench "$@" --knobs default --repeat 50 \
+      --warm-up 2 --reference-max-splats 0 --json "$out/$name-$algo.json" >"$out/$name-$algo.log" 2>&1
+    echo "== $name $algo (exit $?)"
+    grep -E "^default|dispatches" "$out/$name-$algo.log"
+  done
+}
+hd=(--resolution 1920x1080 --resolution 3840x2160)
+bench playbot -i $d/playbot/playbot_125k.ply --cameras $d/playbot/cameras.json "${hd[@]}"
+bench chair -i $d/chair/chair.splat --cameras $d/chair/cameras.json "${hd[@]}"
+bench biker -i $d/biker/biker_152k.ply --cameras $d/biker/cameras.json "${hd[@]}"
+bench first1 -i $d/playbot/playbot_125k.ply --cameras $d/playbot/cameras.json --first 1 "${hd[@]}"
+bench first1000 -i $d/playbot/playbot_125k.ply --cameras $d/playbot/cameras.json --first 1000 "${hd[@]}"
+bench grid7 -i $d/playbot/playbot_125k.ply --cameras $d/playbot/cameras.json --grid 7 "${hd[@]}"
+bench batch -i $d/playbot/playbot_125k.ply --cameras $d/playbot/cameras.json --resolution 800x800 --batch 24
+nvidia-smi --query-gpu=clocks.sm --format=csv | tee -a "$out/gpu.txt"
