@@ -20,7 +20,7 @@ export OPEN3D_DATA_DIR=$PWD/shared/data OPEN3D_VULKAN_VALIDATION=0 OPEN3D_TEST_R
 nvidia-smi --query-gpu=name,driver_version,clocks.sm,clocks.max.sm --format=csv | tee "$out/gpu.txt"
 
 echo "== suites (the device's default sort)"
-timeout 300 .devbin/tests_gaussian_splat_vulkan \
+timeout 150 .devbin/tests_gaussian_splat_vulkan \
   --gtest_filter='*RadixSort*:RealScenes/GeometryStageScenes*:SubmissionPath*:GeometryStageFeatures*:VulkanBackend*:LodCut*:CommandTally*' \
   --gtest_output=xml:"$out/suites.xml" >"$out/suites.log" 2>&1
 echo "suites exit $?: $(grep -E '^\[  (PASSED|FAILED) ' "$out/suites.log" | tr '\n' ' ')"
@@ -31,7 +31,7 @@ bench() {  # NAME ARGS...: one gs-bench run per algorithm
   local name=$1
   shift
   for algo in multipass onesweep; do
-    OPEN3D_RADIX_SORT=$algo timeout 240 .devbin/gs-bench "$@" --knobs default --repeat 50 \
+    OPEN3D_RADIX_SORT=$algo timeout 90 .devbin/gs-bench "$@" --knobs default --repeat 50 \
       --warm-up 2 --reference-max-splats 0 --json "$out/$name-$algo.json" >"$out/$name-$algo.log" 2>&1
     echo "== $name $algo (exit $?)"
     grep -E "^default|dispatches" "$out/$name-$algo.log"

@@ -156,6 +156,13 @@ void RecordComputeToComputeAndIndirect(VkCommandBuffer cmd) {
             VK_ACCESS_2_INDIRECT_COMMAND_READ_BIT);
 }
 
+void RecordComputeToCompute(VkCommandBuffer cmd) {
+    RecordMemoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                        VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT | VK_ACCESS_2_SHADER_STORAGE_READ_BIT,
+                        VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                        VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
+}
+
 }  // namespace vulkan
 }  // namespace rendering
 }  // namespace visualization

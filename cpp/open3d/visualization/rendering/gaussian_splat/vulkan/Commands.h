@@ -103,6 +103,10 @@ void RecordMemoryBarrier(VkCommandBuffer cmd, VkPipelineStageFlags2 src_stages,
 /// arguments of indirect dispatches.
 void RecordComputeToComputeAndIndirect(VkCommandBuffer cmd);
 
+/// Compute writes before a later dispatch's storage reads and writes only: for dispatches whose
+/// indirect arguments an earlier barrier already made visible (a lighter wait on some drivers).
+void RecordComputeToCompute(VkCommandBuffer cmd);
+
 }  // namespace vulkan
 }  // namespace rendering
 }  // namespace visualization

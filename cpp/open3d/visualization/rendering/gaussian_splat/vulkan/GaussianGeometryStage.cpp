@@ -34,6 +34,9 @@ uint32_t DivCeil(uint64_t a, uint64_t b) { return static_cast<uint32_t>((a + b -
 
 // Everything a geometry stage dispatch may read next: storage data and indirect arguments.
 void ComputeBarrier(VkCommandBuffer cmd) { RecordComputeToComputeAndIndirect(cmd); }
+// Before a dispatch whose indirect size was made visible by an earlier barrier (the host's
+// frame-start writes, or a ComputeBarrier after the pass that wrote it): storage only.
+void StorageBarrier(VkCommandBuffer cmd) { RecordComputeToCompute(cmd); }
 
 }  // namespace
 
@@ -330,7 +333,8 @@ void GaussianGeometryStage::Record(VkCommandBuffer cmd, const GeometryStageScene
         const uvec4 grid = DispatchGridFor(DivCeil(n, kProjectWorkgroupSize), max_groups_x);
         RecordDispatch(cmd, grid.x, grid.y, 1);
     }
-    ComputeBarrier(cmd);
+    // Next: the depth sort (host-written sizes) or the after-project dispatch args (direct).
+    StorageBarrier(cmd);
 
     // 2. Packed key: the scan and the emit follow the append order of the visible splats,
     // sized on the GPU from visible_count.
@@ -378,7 +382,7 @@ void GaussianGeometryStage::Record(VkCommandBuffer cmd, const GeometryStageScene
                      counter_range(kCounterNumSplatsIndex), std::max(n, 1u), 32,
                      RadixSort::Params::kWrittenByProducer, &drop_culled,
                      RadixSort::PassCount::kFromKeyRange, RadixSort::Output::kValuesOnly);
-        ComputeBarrier(cmd);
+        StorageBarrier(cmd);  // the scan's sizes are the host's in the exact order
         end(TimedPass::kDepthSort);
     }
     begin(TimedPass::kScanEmit);
@@ -399,6 +403,9 @@ void GaussianGeometryStage::Record(VkCommandBuffer cmd, const GeometryStageScene
                                counters_offset +
                                    offsetof(GaussianGeometryStageCounters, scan_levels) +
                                    level * sizeof(GaussianScanLevel));
+        // The next level's size sits in the counters this level writes to (its total, error
+        // flags): the validation layer tracks a bound buffer as one range, so it wants the
+        // indirect access in the barrier although the words differ.
         ComputeBarrier(cmd);
     }
 
@@ -408,7 +415,7 @@ void GaussianGeometryStage::Record(VkCommandBuffer cmd, const GeometryStageScene
     vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, dispatch_args_.Get());
     vkCmdPushConstants(cmd, layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(args), &args);
     RecordDispatch(cmd, 1, 1, 1);
-    ComputeBarrier(cmd);
+    ComputeBarrier(cmd);  // the emit's size is in the counters written here (see above)
 
     // 6. Emit (tile, splat) entries in list order at the scanned offsets: tile keys in
     // depth order, or packed (tile, truncated depth) keys.

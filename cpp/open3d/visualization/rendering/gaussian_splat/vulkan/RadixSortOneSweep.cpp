@@ -69,7 +69,9 @@ void RadixSort::RecordOneSweep(VkCommandBuffer cmd, const BufferRange& keys,
     BindBuffers(cmd, scratch, count, max_count, keys, values, scratch.keys_alt, scratch.values_alt);
     push.drop_max_keys = drop ? 1u : 0u;
     dispatch(sweep_histogram_.Get(), offsetof(RadixSortParams, sweep_histogram_grid));
-    RecordComputeToComputeAndIndirect(cmd);
+    // From here every dispatch takes its size from the params made visible above (or by the
+    // producer), so the barriers between the passes wait for storage only.
+    RecordComputeToCompute(cmd);
 
     for (uint32_t pass = 0; pass < num_passes; ++pass) {
         // Ping-pong: even passes read the caller's buffers, odd passes the scratch.
@@ -85,7 +87,7 @@ void RadixSort::RecordOneSweep(VkCommandBuffer cmd, const BufferRange& keys,
         push.drop_max_keys = pass == 0 && drop ? 1u : 0u;
         // Every pass takes the first pass's grid; blocks past the kept pairs end at once.
         dispatch(sweep_scatter_.Get(), offsetof(RadixSortParams, dispatch_x));
-        if (pass + 1 < num_passes || num_passes % 2 == 1) RecordComputeToComputeAndIndirect(cmd);
+        if (pass + 1 < num_passes || num_passes % 2 == 1) RecordComputeToCompute(cmd);
     }
     if (num_passes % 2 == 1) {
         // The sorted pairs are in the scratch: copy the kept ones back.
