@@ -8,6 +8,7 @@
 namespace open3d {
 namespace pybind {
 
+void BindBoundingBoxes(pybind11::module_& t_geometry);
 void BindGeometry(pybind11::module_& t_geometry);
 void BindMesh(pybind11::module_& t_geometry);
 void BindMaterial(pybind11::module_& rendering);

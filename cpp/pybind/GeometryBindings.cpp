@@ -98,21 +98,6 @@ std::vector<int64_t> Indices(const py::handle& value, int64_t n) {
     return indices;
 }
 
-// The rows whose flag is `keep`, in order.
-std::vector<int64_t> RowsWhere(const std::vector<uint8_t>& flags, bool keep) {
-    std::vector<int64_t> rows;
-    for (size_t i = 0; i < flags.size(); ++i) {
-        if (bool(flags[i]) == keep) rows.push_back(int64_t(i));
-    }
-    return rows;
-}
-
-// Open3D's t.geometry.AxisAlignedBoundingBox, reduced to what a splat scene needs.
-struct AxisAlignedBoundingBox {
-    Eigen::Vector3d min_bound = Eigen::Vector3d::Zero();
-    Eigen::Vector3d max_bound = Eigen::Vector3d::Zero();
-};
-
 }  // namespace
 
 void BindGeometry(py::module_& m) {
@@ -157,6 +142,12 @@ void BindGeometry(py::module_& m) {
             "keys", [](const PointAttributes& a) { return a.cloud->cloud.GetPointAttrNames(); },
             "The attribute names, sorted")
         .def(
+            "__iter__",
+            [](const PointAttributes& a) {
+                return py::iter(py::cast(a.cloud->cloud.GetPointAttrNames()));
+            },
+            "The attribute names, sorted (for name in pcd.point, as over a dict)")
+        .def(
             "__getattr__",
             [](const PointAttributes& a, const std::string& name) -> py::array {
                 if (!a.cloud->cloud.HasPointAttr(name)) {
@@ -181,40 +172,6 @@ void BindGeometry(py::module_& m) {
                                    fmt::join(a.cloud->cloud.GetPointAttrNames(), ", "));
             },
             "The attribute names");
-
-    py::class_<AxisAlignedBoundingBox>(
-        m, "AxisAlignedBoundingBox",
-        "The box of a cloud's positions (get_axis_aligned_bounding_box), as Open3D's: min_bound "
-        "and max_bound, float64 (3,)")
-        .def(py::init([](const Eigen::Vector3d& min_bound, const Eigen::Vector3d& max_bound) {
-                 return AxisAlignedBoundingBox{min_bound, max_bound};
-             }),
-             py::arg("min_bound"), py::arg("max_bound"), "A box from its two corners")
-        .def_readwrite("min_bound", &AxisAlignedBoundingBox::min_bound, "The lowest corner")
-        .def_readwrite("max_bound", &AxisAlignedBoundingBox::max_bound, "The highest corner")
-        .def(
-            "get_center",
-            [](const AxisAlignedBoundingBox& b) -> Eigen::Vector3d {
-                return (b.min_bound + b.max_bound) / 2;
-            },
-            "The middle of the box")
-        .def(
-            "get_extent",
-            [](const AxisAlignedBoundingBox& b) -> Eigen::Vector3d {
-                return b.max_bound - b.min_bound;
-            },
-            "The side lengths")
-        .def(
-            "volume",
-            [](const AxisAlignedBoundingBox& b) { return (b.max_bound - b.min_bound).prod(); },
-            "The product of the side lengths")
-        .def(
-            "__repr__",
-            [](const AxisAlignedBoundingBox& b) {
-                return fmt::format("AxisAlignedBoundingBox(min_bound=[{}], max_bound=[{}])",
-                                   fmt::join(b.min_bound, ", "), fmt::join(b.max_bound, ", "));
-            },
-            "The corners");
 
     py::class_<PyPointCloud, Cloud>(
         m, "PointCloud",
@@ -287,9 +244,33 @@ void BindGeometry(py::module_& m) {
         .def(
             "get_axis_aligned_bounding_box",
             [](const PyPointCloud& c) {
-                return AxisAlignedBoundingBox{Bound(c.cloud, false), Bound(c.cloud, true)};
+                return t::geometry::AxisAlignedBoundingBox(Bound(c.cloud, false),
+                                                           Bound(c.cloud, true));
             },
             "The box of the positions (get_min_bound to get_max_bound)")
+        .def(
+            "crop",
+            [](const PyPointCloud& c, const t::geometry::AxisAlignedBoundingBox& box, bool invert) {
+                return Wrap(c.cloud.Crop(box, invert));
+            },
+            py::arg("aabb"), py::arg("invert") = false,
+            "A new cloud of the points (splats by their centres) inside the box, every attribute "
+            "copied bit for bit; with invert, of the points outside")
+        .def(
+            "crop",
+            [](const PyPointCloud& c, const t::geometry::OrientedBoundingBox& box, bool invert) {
+                return Wrap(c.cloud.Crop(box, invert));
+            },
+            py::arg("obb"), py::arg("invert") = false,
+            "A new cloud of the points (splats by their centres) inside the oriented box; with "
+            "invert, of the points outside")
+        .def(
+            "remove_by_index",
+            [](const PyPointCloud& c, const py::object& indices) {
+                return Wrap(c.cloud.RemoveByIndex(Indices(indices, c.cloud.NumPoints())));
+            },
+            py::arg("indices"),
+            "A new cloud without the points at indices (select_by_index with invert)")
         // The transforms write the attributes in place: views stay valid and see the result.
         .def(
             "translate",
@@ -335,13 +316,7 @@ void BindGeometry(py::module_& m) {
         .def(
             "select_by_index",
             [](const PyPointCloud& c, const py::object& indices, bool invert) {
-                std::vector<int64_t> rows = Indices(indices, c.cloud.NumPoints());
-                if (invert) {
-                    std::vector<uint8_t> picked(size_t(c.cloud.NumPoints()), 0);
-                    for (int64_t i : rows) picked[size_t(i)] = 1;
-                    rows = RowsWhere(picked, false);
-                }
-                return Wrap(SelectRows(c.cloud, rows));
+                return Wrap(c.cloud.SelectByIndex(Indices(indices, c.cloud.NumPoints()), invert));
             },
             py::arg("indices"), py::arg("invert") = false,
             "A new cloud of the points at indices (in that order), or with invert of every "
@@ -359,8 +334,8 @@ void BindGeometry(py::module_& m) {
                         std::string(py::str(array.attr("shape"))));
                 }
                 const py::array_t<uint8_t> flags = array.attr("view")("uint8");
-                const std::vector<uint8_t> keep(flags.data(), flags.data() + flags.size());
-                return Wrap(SelectRows(c.cloud, RowsWhere(keep, !invert)));
+                const std::vector<bool> keep(flags.data(), flags.data() + flags.size());
+                return Wrap(c.cloud.SelectByMask(keep, invert));
             },
             py::arg("boolean_mask"), py::arg("invert") = false,
             "A new cloud of the points whose mask entry is True (False with invert)")

@@ -82,6 +82,7 @@ class Open3DFileNotFoundError(FileNotFoundError, Open3DError):
     py::module_ visualization = m.def_submodule("visualization", "draw");
     py::module_ rendering =
         visualization.def_submodule("rendering", "OffscreenRenderer without a display");
+    open3d::pybind::BindBoundingBoxes(t_geometry);
     open3d::pybind::BindGeometry(t_geometry);
     open3d::pybind::BindMesh(t_geometry);
     open3d::pybind::BindMaterial(rendering);

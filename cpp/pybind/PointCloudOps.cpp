@@ -32,11 +32,6 @@ bool HasGaussianAttribute(const t::geometry::PointCloud& cloud) {
            cloud.HasPointAttr(gs::kFRest);
 }
 
-int64_t RowBytes(const core::Tensor& tensor) {
-    const int64_t rows = tensor.GetShape().empty() ? 1 : tensor.GetShape(0);
-    return rows == 0 ? 0 : tensor.NumBytes() / rows;
-}
-
 core::SizeVector WithRows(core::SizeVector shape, int64_t rows) {
     if (shape.empty()) shape.push_back(rows);
     shape[0] = rows;
@@ -62,34 +57,6 @@ core::Tensor Concatenate(const std::string& name, const core::Tensor& a, const c
 }
 
 }  // namespace
-
-t::geometry::PointCloud SelectRows(const t::geometry::PointCloud& cloud,
-                                   const std::vector<int64_t>& indices) {
-    const int64_t n = cloud.NumPoints();
-    for (int64_t i : indices) {
-        if (i < 0 || i >= n) {
-            core::ThrowError("select_by_index: index {} is out of range for {} points", i, n);
-        }
-    }
-    t::geometry::PointCloud out;
-    // Positions first: SetPointAttr checks the other attributes' rows against them.
-    std::vector<std::string> names = cloud.GetPointAttrNames();
-    std::stable_partition(names.begin(), names.end(),
-                          [](const std::string& name) { return name == gs::kPositions; });
-    for (const std::string& name : names) {
-        const core::Tensor& source = cloud.GetPointAttr(name);
-        const int64_t row = RowBytes(source);
-        core::Tensor selected = core::Tensor::Empty(
-            WithRows(source.GetShape(), int64_t(indices.size())), source.GetDtype());
-        const auto* from = static_cast<const uint8_t*>(source.RawData());
-        auto* to = static_cast<uint8_t*>(selected.RawData());
-        for (size_t k = 0; k < indices.size(); ++k) {
-            std::memcpy(to + k * row, from + indices[k] * row, size_t(row));
-        }
-        out.SetPointAttr(name, std::move(selected));
-    }
-    return out;
-}
 
 t::geometry::PointCloud Append(const t::geometry::PointCloud& a, const t::geometry::PointCloud& b) {
     const std::vector<std::string> names_a = a.GetPointAttrNames();

@@ -1,5 +1,5 @@
 // Open3D's PointCloud methods that the C++ cloud lacks, for Python (docs/python.md "Open3D
-// habits"): selecting rows, appending clouds, bounds, and a 4x4 transform that carries the
+// habits"): appending clouds, bounds, and a 4x4 transform that carries the
 // Gaussian attributes along. Each throws core::Open3DError and leaves its input unchanged.
 #pragma once
 
@@ -12,10 +12,6 @@
 
 namespace open3d {
 namespace pybind {
-
-/// A cloud of the rows `indices` (in that order, repeats kept) of every attribute.
-t::geometry::PointCloud SelectRows(const t::geometry::PointCloud& cloud,
-                                   const std::vector<int64_t>& indices);
 
 /// `a`'s points then `b`'s. Gaussian splat clouds merge as the renderer's scene does
 /// (MergeGaussianSplatClouds: the higher SH degree, zero coefficients for the bands a cloud

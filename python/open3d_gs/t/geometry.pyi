@@ -16,9 +16,12 @@ import open3d_gs.visualization.rendering
 
 
 class AxisAlignedBoundingBox:
-    """The box of a cloud's positions (get_axis_aligned_bounding_box), as Open3D's: min_bound and max_bound, float64 (3,)"""
+    """An axis-aligned box, as Open3D's: min_bound and max_bound, float64 (3,). Closed: a point on a face is inside"""
     def __init__(self, min_bound: numpy.typing.ArrayLike, max_bound: numpy.typing.ArrayLike) -> None:
-        """A box from its two corners"""
+        """A box from its two corners; raises for a non-finite bound or min_bound above max_bound on an axis"""
+        ...
+    def contains(self, point: numpy.typing.ArrayLike) -> bool:
+        """Whether the point is inside or on the box"""
         ...
     def get_center(self) -> numpy.ndarray:
         """The middle of the box"""
@@ -43,6 +46,32 @@ class AxisAlignedBoundingBox:
         ...
 
 
+class OrientedBoundingBox:
+    """A box of edge lengths extent along the columns of the rotation R, centred at center, as Open3D's. Closed: a point on a face is inside"""
+    @property
+    def R(self) -> numpy.ndarray:
+        """The rotation (3, 3)"""
+        ...
+    def __init__(self, center: numpy.typing.ArrayLike, R: numpy.typing.ArrayLike, extent: numpy.typing.ArrayLike) -> None:
+        """A box from its centre, rotation (3, 3) and edge lengths; raises for a non-finite value, a negative edge or an R that is not a rotation"""
+        ...
+    @property
+    def center(self) -> numpy.ndarray:
+        """The centre"""
+        ...
+    def contains(self, point: numpy.typing.ArrayLike) -> bool:
+        """Whether the point is inside or on the box"""
+        ...
+    @staticmethod
+    def create_from_axis_aligned_bounding_box(aabox: AxisAlignedBoundingBox) -> OrientedBoundingBox:
+        """The axis-aligned box as an oriented one (R = I)"""
+        ...
+    @property
+    def extent(self) -> numpy.ndarray:
+        """The edge lengths"""
+        ...
+
+
 class PointAttributes:
     """The per-point attributes of a PointCloud by name: reading one gives a numpy view of the cloud's memory (no copy), assigning one copies the array in (converted to float32 unless it is float32, uint8 or uint16; NaN and infinity refused)."""
     def __contains__(self, name: str) -> bool:
@@ -56,6 +85,9 @@ class PointAttributes:
         ...
     def __getitem__(self, name: str) -> numpy.ndarray:
         """A numpy view of the attribute (no copy); KeyError-like Open3DError when absent"""
+        ...
+    def __iter__(self) -> Iterator:
+        """The attribute names, sorted (for name in pcd.point, as over a dict)"""
         ...
     def __len__(self) -> int:
         """The number of attributes"""
@@ -97,6 +129,14 @@ class PointCloud:
     def clone(self) -> PointCloud:
         """A deep copy"""
         ...
+    @overload
+    def crop(self, aabb: AxisAlignedBoundingBox, invert: bool = ...) -> PointCloud:
+        """A new cloud of the points (splats by their centres) inside the box, every attribute copied bit for bit; with invert, of the points outside"""
+        ...
+    @overload
+    def crop(self, obb: OrientedBoundingBox, invert: bool = ...) -> PointCloud:
+        """A new cloud of the points (splats by their centres) inside the oriented box; with invert, of the points outside"""
+        ...
     def get_axis_aligned_bounding_box(self) -> AxisAlignedBoundingBox:
         """The box of the positions (get_min_bound to get_max_bound)"""
         ...
@@ -124,6 +164,9 @@ class PointCloud:
     @property
     def point(self) -> PointAttributes:
         """The attributes by name (pcd.point['scale'] or pcd.point.scale)"""
+        ...
+    def remove_by_index(self, indices: object) -> PointCloud:
+        """A new cloud without the points at indices (select_by_index with invert)"""
         ...
     def rotate(self, R: numpy.typing.ArrayLike, center: Optional[numpy.typing.ArrayLike] = ...) -> PointCloud:
         """Proper rotation about center (default: the cloud's centre, get_center(), as Open3D's Geometry3D.rotate(R) does): positions, rot and the SH coefficients follow; returns the cloud. A reflection or a scaled matrix is refused"""

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "open3d/core/Tensor.h"
+#include "open3d/t/geometry/BoundingBox.h"
 
 namespace open3d {
 namespace t {
@@ -94,6 +95,25 @@ public:
     PointCloud& Transform(const Eigen::Matrix4d& transformation);
     /// Mean of positions (zero for an empty cloud).
     Eigen::Vector3d GetCenter() const;
+
+    // Selection (PointCloudSelect.cpp, docs/editing.md): new clouds of some of the rows, every
+    // attribute (Gaussian or not) copied bit for bit; the source is unchanged. Each throws
+    // core::Open3DError before copying anything when an argument does not fit the cloud.
+
+    /// The rows at `indices`, in that order (repeats kept); with invert, every row not
+    /// among them, in cloud order (repeats ignored). Throws naming an index out of range.
+    PointCloud SelectByIndex(const std::vector<int64_t>& indices, bool invert = false) const;
+    /// The rows whose mask entry is true (false with invert); the mask has one entry a row.
+    PointCloud SelectByMask(const std::vector<bool>& mask, bool invert = false) const;
+    /// The points (splats by their centres) inside the closed box; with invert, the others.
+    PointCloud Crop(const AxisAlignedBoundingBox& box, bool invert = false) const;
+    PointCloud Crop(const OrientedBoundingBox& box, bool invert = false) const;
+    /// Every row but `indices` (SelectByIndex with invert): Open3D's removal.
+    PointCloud RemoveByIndex(const std::vector<int64_t>& indices) const {
+        return SelectByIndex(indices, true);
+    }
+    /// The smallest axis-aligned box around the positions (empty for an empty cloud).
+    AxisAlignedBoundingBox GetAxisAlignedBoundingBox() const;
 
     bool operator==(const PointCloud& other) const { return attrs_ == other.attrs_; }
 

@@ -1,0 +1,66 @@
+"""Editing a splat cloud (docs/editing.md): crop by an axis-aligned or oriented box, remove rows;
+every attribute of the kept splats is the source's bit for bit, and the boxes refuse what is not
+a box."""
+import numpy as np
+import pytest
+
+import open3d_gs as o3d
+
+geometry = o3d.t.geometry
+
+
+def test_crop_by_an_axis_aligned_box_keeps_the_splats_inside(playbot):
+    pcd, _ = playbot
+    lo, hi = pcd.get_min_bound(), pcd.get_max_bound()
+    box = geometry.AxisAlignedBoundingBox(lo + 0.25 * (hi - lo), hi - 0.25 * (hi - lo))
+    p = pcd.point.positions.astype(np.float64)  # the box test runs in float64
+    inside = np.all((p >= box.min_bound) & (p <= box.max_bound), axis=1)
+    assert 0 < inside.sum() < len(pcd)
+    cropped = pcd.crop(box)
+    for name in pcd.point:
+        np.testing.assert_array_equal(cropped.point[name], pcd.point[name][inside], err_msg=name)
+    assert len(pcd.crop(box, invert=True)) == len(pcd) - inside.sum()
+    assert len(pcd.crop(pcd.get_axis_aligned_bounding_box())) == len(pcd)
+
+
+def test_crop_by_an_oriented_box_tests_in_the_box_frame(playbot):
+    pcd, _ = playbot
+    a = np.radians(30)
+    R = np.array([[np.cos(a), -np.sin(a), 0], [np.sin(a), np.cos(a), 0], [0, 0, 1]])
+    center = pcd.get_center()
+    extent = 0.5 * (pcd.get_max_bound() - pcd.get_min_bound())
+    box = geometry.OrientedBoundingBox(center, R, extent)
+    local = (pcd.point.positions.astype(np.float64) - center) @ R  # R^T (p - c), row-wise
+    inside = np.all(np.abs(local) <= extent / 2, axis=1)
+    assert 0 < inside.sum() < len(pcd)
+    cropped = pcd.crop(box)
+    for name in pcd.point:
+        np.testing.assert_array_equal(cropped.point[name], pcd.point[name][inside], err_msg=name)
+    np.testing.assert_array_equal(box.R, R)
+    assert box.contains(center)
+
+
+def test_remove_by_index_is_select_by_index_inverted(playbot):
+    pcd, _ = playbot
+    removed = pcd.remove_by_index([0, 10, 10, len(pcd) - 1])
+    assert len(removed) == len(pcd) - 3
+    np.testing.assert_array_equal(removed.point.f_dc,
+                                  pcd.select_by_index([0, 10, len(pcd) - 1], invert=True).point.f_dc)
+    with pytest.raises(o3d.Open3DError, match="out of range"):
+        pcd.remove_by_index([len(pcd)])
+
+
+def test_boxes_refuse_what_is_not_a_box():
+    with pytest.raises(o3d.Open3DError, match="min_bound 1 exceeds max_bound 0 on axis y"):
+        geometry.AxisAlignedBoundingBox([0, 1, 0], [1, 0, 1])
+    box = geometry.AxisAlignedBoundingBox([0, 0, 0], [1, 1, 1])
+    with pytest.raises(o3d.Open3DError, match="exceeds max_bound"):
+        box.min_bound = [2, 0, 0]  # a setter builds a checked box too
+    np.testing.assert_array_equal(box.min_bound, [0, 0, 0])  # unchanged
+    with pytest.raises(o3d.Open3DError, match="not a rotation"):
+        geometry.OrientedBoundingBox([0, 0, 0], np.diag([1.0, 1.0, -1.0]), [1, 1, 1])
+    with pytest.raises(o3d.Open3DError, match="negative edge"):
+        geometry.OrientedBoundingBox([0, 0, 0], np.eye(3), [1, -1, 1])
+    obb = geometry.OrientedBoundingBox.create_from_axis_aligned_bounding_box(box)
+    np.testing.assert_array_equal(obb.extent, [1, 1, 1])
+    assert obb.contains([1, 1, 1]) and not obb.contains([1, 1, 1.001])
