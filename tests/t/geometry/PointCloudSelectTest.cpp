@@ -27,29 +27,9 @@ namespace {
 using core::Dtype;
 using core::Tensor;
 
-Tensor Uniform(std::mt19937& rng, const core::SizeVector& shape, float lo, float hi) {
-    Tensor t(shape, Dtype::Float32);
-    std::uniform_real_distribution<float> uniform(lo, hi);
-    float* p = t.Data<float>();
-    for (int64_t i = 0; i < t.NumElements(); ++i) p[i] = uniform(rng);
-    return t;
-}
-
-// n splats of SH degree 3 in [-1, 1]^3, with a uint8 label attribute beside them.
+// n splats of SH degree 3 in [-5, 5)^3, with a uint8 label attribute beside them.
 PointCloud MakeSplats(int64_t n, bool with_label, uint32_t seed = 7) {
-    std::mt19937 rng(seed);
-    PointCloud cloud(Uniform(rng, {n, 3}, -1.0f, 1.0f));
-    cloud.SetPointAttr(gs_attr::kScale, Uniform(rng, {n, 3}, 0.01f, 0.1f));
-    Tensor rot({n, 4}, Dtype::Float32);
-    for (int64_t i = 0; i < n; ++i) {
-        const Eigen::Quaterniond q(RandomRotation(rng));
-        const float w[4] = {float(q.w()), float(q.x()), float(q.y()), float(q.z())};
-        std::memcpy(rot.Data<float>() + 4 * i, w, sizeof(w));
-    }
-    cloud.SetPointAttr(gs_attr::kRot, rot);
-    cloud.SetPointAttr(gs_attr::kOpacity, Uniform(rng, {n, 1}, -3.0f, 3.0f));
-    cloud.SetPointAttr(gs_attr::kFDc, Uniform(rng, {n, 3}, -1.0f, 1.0f));
-    cloud.SetPointAttr(gs_attr::kFRest, Uniform(rng, {n, 15, 3}, -0.2f, 0.2f));
+    PointCloud cloud = MakeSplatCloud(n, 3, seed);
     if (with_label) {
         Tensor label({n, 1}, Dtype::UInt8);
         for (int64_t i = 0; i < n; ++i) label.Data<uint8_t>()[i] = uint8_t(i * 37);
@@ -78,11 +58,6 @@ PointCloud Read(const std::string& path) {
     PointCloud cloud;
     io::ReadPointCloud(path, cloud);
     return cloud;
-}
-
-Eigen::Vector3d Position(const PointCloud& cloud, int64_t i) {
-    const float* p = cloud.GetPointPositions().Data<float>() + 3 * i;
-    return Eigen::Vector3d(p[0], p[1], p[2]);
 }
 
 TEST(PointCloudSelect, SelectByIndexKeepsOrderRepeatsAndEveryAttribute) {
@@ -145,23 +120,23 @@ TEST(PointCloudSelect, CropKeepsThePointsInsideTheClosedBox) {
 }
 
 TEST(PointCloudSelect, OrientedBoxRotatesItsTest) {
-    // A 2 x 0.2 x 0.2 box rotated 45 degrees about z: (0.6, 0.6, 0) lies along its long axis
-    // (distance 0.849 < 1), (0.6, -0.6, 0) across it (0.849 > 0.1), both inside an
-    // axis-aligned box of the same edges.
+    // A 10 x 1 x 1 box rotated 45 degrees about z: (3, 3, 0) lies along its long axis
+    // (distance 4.24 < 5), (3, -3, 0) across it (4.24 > 0.5), both inside an axis-aligned
+    // box of the same edges.
     const Eigen::Matrix3d R =
         Eigen::AngleAxisd(M_PI / 4, Eigen::Vector3d::UnitZ()).toRotationMatrix();
-    const OrientedBoundingBox box(Eigen::Vector3d::Zero(), R, Eigen::Vector3d(2, 0.2, 0.2));
-    EXPECT_TRUE(box.Contains(Eigen::Vector3d(0.6, 0.6, 0)));
-    EXPECT_FALSE(box.Contains(Eigen::Vector3d(0.6, -0.6, 0)));
-    EXPECT_FALSE(box.Contains(Eigen::Vector3d(0.6, 0.6, 0.11)));
+    const OrientedBoundingBox box(Eigen::Vector3d::Zero(), R, Eigen::Vector3d(10, 1, 1));
+    EXPECT_TRUE(box.Contains(Eigen::Vector3d(3, 3, 0)));
+    EXPECT_FALSE(box.Contains(Eigen::Vector3d(3, -3, 0)));
+    EXPECT_FALSE(box.Contains(Eigen::Vector3d(3, 3, 0.51)));
     const PointCloud cloud = MakeSplats(2000, true);
     const PointCloud inside = cloud.Crop(box);
     int64_t k = 0;
     for (int64_t i = 0; i < cloud.NumPoints(); ++i) {
         // The same test written out: the point in the box's frame, against half the edges.
         const Eigen::Vector3d local = R.transpose() * Position(cloud, i);
-        if (std::abs(local.x()) <= 1.0 && std::abs(local.y()) <= 0.1 &&
-            std::abs(local.z()) <= 0.1) {
+        if (std::abs(local.x()) <= 5.0 && std::abs(local.y()) <= 0.5 &&
+            std::abs(local.z()) <= 0.5) {
             ExpectRowEqual(inside, k++, cloud, i);
         }
     }
@@ -193,7 +168,7 @@ TEST(PointCloudSelect, BoxesRefuseWhatIsNotABox) {
 // cloud's splats come back encoded against its own statistics (docs/editing.md).
 TEST(PointCloudSelect, EditsCommuteWithEveryPerSplatFormat) {
     const PointCloud cloud = MakeSplats(700, false);
-    const AxisAlignedBoundingBox box(Eigen::Vector3d(-0.5, -1, -1), Eigen::Vector3d(0.7, 1, 1));
+    const AxisAlignedBoundingBox box(Eigen::Vector3d(-2.5, -5, -5), Eigen::Vector3d(3.5, 5, 5));
     const std::string dir = tests::TempDir();
     for (const std::string ext : {".ply", ".splat", ".spz", ".glb", ".gltf"}) {
         SCOPED_TRACE(ext);

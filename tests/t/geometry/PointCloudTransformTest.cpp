@@ -30,43 +30,9 @@ namespace {
 using core::Dtype;
 using core::Tensor;
 
-Tensor RandomTensor(std::mt19937& rng, const core::SizeVector& shape, float lo, float hi) {
-    Tensor t(shape, Dtype::Float32);
-    std::uniform_real_distribution<float> uniform(lo, hi);
-    float* p = t.Data<float>();
-    for (int64_t i = 0; i < t.NumElements(); ++i) p[i] = uniform(rng);
-    return t;
-}
-
 PointCloud MakePlainCloud(int64_t n, uint32_t seed) {
     std::mt19937 rng(seed);
     return PointCloud(RandomTensor(rng, {n, 3}, -5.f, 5.f));
-}
-
-PointCloud MakeSplatCloud(int64_t n, int degree, uint32_t seed) {
-    std::mt19937 rng(seed);
-    PointCloud cloud(RandomTensor(rng, {n, 3}, -5.f, 5.f));
-    cloud.SetPointAttr(gs_attr::kScale, RandomTensor(rng, {n, 3}, 0.01f, 1.f));
-    Tensor rot({n, 4}, Dtype::Float32);
-    std::normal_distribution<double> normal;
-    for (int64_t i = 0; i < n; ++i) {
-        const Eigen::Vector4d q =
-            Eigen::Vector4d(normal(rng), normal(rng), normal(rng), normal(rng)).normalized();
-        for (int k = 0; k < 4; ++k) rot.Data<float>()[4 * i + k] = static_cast<float>(q[k]);
-    }
-    cloud.SetPointAttr(gs_attr::kRot, rot);
-    cloud.SetPointAttr(gs_attr::kOpacity, RandomTensor(rng, {n, 1}, -3.f, 3.f));
-    cloud.SetPointAttr(gs_attr::kFDc, RandomTensor(rng, {n, 3}, -1.f, 1.f));
-    if (degree > 0) {
-        cloud.SetPointAttr(gs_attr::kFRest,
-                           RandomTensor(rng, {n, NumSHRestCoeffs(degree), 3}, -1.f, 1.f));
-    }
-    return cloud;
-}
-
-Eigen::Vector3d Position(const PointCloud& cloud, int64_t i) {
-    const float* p = cloud.GetPointPositions().Data<float>() + 3 * i;
-    return Eigen::Vector3d(p[0], p[1], p[2]);
 }
 
 // Sigma = R_q S^2 R_q^T, as the renderer builds it from the stored attributes.

@@ -269,6 +269,20 @@ void RadixSort::Record(VkCommandBuffer cmd, const BufferRange& keys, const Buffe
     }
 }
 
+RadixSortPushConstants RadixSort::PushConstantsFor(const BufferRange& count, uint32_t max_count,
+                                                   uint32_t num_bits, Output output) const {
+    const VkDeviceSize alignment = context_->GetDeviceInfo().min_storage_buffer_offset_alignment;
+    RadixSortPushConstants push{};
+    push.count_index = static_cast<uint32_t>((count.offset % alignment) / 4);
+    push.max_count = max_count;
+    push.target_blocks = GetTargetBlocks();
+    push.num_passes = GetNumPasses(num_bits);
+    push.values_only = output == Output::kValuesOnly ? 1u : 0u;
+    push.max_groups_x = GetMaxGroupsX();
+    push.num_bits = num_bits;
+    return push;
+}
+
 void RadixSort::RecordMultiPass(VkCommandBuffer cmd, const BufferRange& keys,
                                 const BufferRange& values, const RadixSortScratch& scratch,
                                 const BufferRange& count, uint32_t max_count, uint32_t num_bits,
@@ -282,14 +296,7 @@ void RadixSort::RecordMultiPass(VkCommandBuffer cmd, const BufferRange& keys,
         return static_cast<uint32_t>((range.offset % alignment) / 4);
     };
     BufferRange count_in = count;  // what the setup dispatch reads
-    RadixSortPushConstants push{};
-    push.count_index = count_index(count);
-    push.max_count = max_count;
-    push.target_blocks = GetTargetBlocks();
-    push.num_passes = num_passes;
-    push.values_only = output == Output::kValuesOnly ? 1u : 0u;
-    push.max_groups_x = GetMaxGroupsX();
-    push.num_bits = num_bits;
+    RadixSortPushConstants push = PushConstantsFor(count, max_count, num_bits, output);
 
     const VkPipelineLayout layout = pipeline_layout_.Get();
     const auto bind = [&](const BufferRange& keys_in, const BufferRange& values_in,

@@ -19,6 +19,7 @@
 
 #include <cstdint>
 
+#include "GaussianSplatRadixSortContract.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/Buffer.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/VulkanHandle.h"
 
@@ -188,6 +189,10 @@ public:
                 Output output = Output::kKeysAndValues) const;
 
 private:
+    // The push constants every dispatch of a sort starts from (the passes set shift,
+    // digit_bits and drop_max_keys).
+    shader::RadixSortPushConstants PushConstantsFor(const BufferRange& count, uint32_t max_count,
+                                                    uint32_t num_bits, Output output) const;
     // Pushes the sort's bindings: the given key/value buffers in and out, the scratch, and
     // the count at its aligned binding.
     void BindBuffers(VkCommandBuffer cmd, const RadixSortScratch& scratch,

@@ -23,15 +23,7 @@ void RadixSort::RecordOneSweep(VkCommandBuffer cmd, const BufferRange& keys,
                                const BufferRange& count, uint32_t max_count, uint32_t num_bits,
                                Params params, const DropMaxKeys* drop, Output output) const {
     const uint32_t num_passes = GetNumPasses(num_bits);
-    const VkDeviceSize alignment = context_->GetDeviceInfo().min_storage_buffer_offset_alignment;
-    RadixSortPushConstants push{};
-    push.count_index = static_cast<uint32_t>((count.offset % alignment) / 4);
-    push.max_count = max_count;
-    push.target_blocks = GetTargetBlocks();
-    push.num_passes = num_passes;
-    push.values_only = output == Output::kValuesOnly ? 1u : 0u;
-    push.max_groups_x = GetMaxGroupsX();
-    push.num_bits = num_bits;
+    RadixSortPushConstants push = PushConstantsFor(count, max_count, num_bits, output);
     push.sweep = 1u;
     const VkPipelineLayout layout = pipeline_layout_.Get();
     const auto dispatch = [&](VkPipeline pipeline, VkDeviceSize args_member) {
