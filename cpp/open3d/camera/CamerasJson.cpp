@@ -1,6 +1,7 @@
 #include "open3d/camera/CamerasJson.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 
 #include <fstream>
@@ -58,6 +59,11 @@ CameraView ParseEntry(const Json& entry, const std::string& where) {
     view.id = Integer(entry, "id", where);
     if (entry.contains("img_name") && entry["img_name"].is_string()) {
         view.img_name = entry["img_name"].get<std::string>();
+    }
+    if (entry.contains("time")) {
+        const double time = Number(entry, "time", where);
+        if (!std::isfinite(time)) core::ThrowError("{}: field 'time' must be finite", where);
+        view.time = time;
     }
     PinholeCamera& cam = view.camera;
     cam.width = Integer(entry, "width", where);

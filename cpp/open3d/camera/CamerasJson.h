@@ -3,6 +3,7 @@
 // camera-to-world, rows as nested lists). The principal point is the image centre.
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -16,6 +17,9 @@ struct CameraView {
     int id = 0;
     std::string img_name;
     PinholeCamera camera;
+    /// Seconds on a camera path (an optional "time" field, which the 3DGS trainer never
+    /// writes; docs/camera-paths.md).
+    std::optional<double> time;
 };
 
 /// Reads every view, in file order. Throws core::Open3DError naming the file (and the
