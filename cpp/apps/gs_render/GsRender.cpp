@@ -14,6 +14,7 @@
 #include "../InputPathValidators.h"
 #include "../NumberValidators.h"
 #include "../RunReportingErrors.h"
+#include "CameraPathRender.h"
 #include "FilamentRender.h"
 #include "open3d/camera/CamerasJson.h"
 #include "open3d/camera/PinholeCamera.h"
@@ -66,6 +67,9 @@ struct Options {
     int frames = 1;
     uint64_t lod_budget = 0;  // 0: no level of detail
     std::string lod;          // hierarchy file; default <input>.lod, else built here
+    std::string camera_path;  // --camera-path: render a path instead of one view
+    double fps = 30.0;
+    double seconds_per_keyframe = 2.0;
 };
 
 Eigen::Vector3d ToVec(const std::vector<double>& v) { return Eigen::Vector3d(v[0], v[1], v[2]); }
@@ -74,10 +78,42 @@ using apps::kFinite;
 using apps::kPositive;
 using apps::kUnit;
 
+gs_render::CameraPathOptions PathOptions(const Options& opt) {
+    gs_render::CameraPathOptions path;
+    path.path_file = opt.camera_path;
+    path.fps = opt.fps;
+    path.seconds_per_keyframe = opt.seconds_per_keyframe;
+    path.width = opt.width;
+    path.height = opt.height;
+    path.output = opt.output;
+    return path;
+}
+
 // Every output is checked before the scene is read: a run that cannot write its result
 // fails at once instead of after loading and rendering, and the extension decides the
 // format (a .jpg depth output was written as PNG bytes).
 void CheckOutputs(const Options& opt) {
+    if (!opt.camera_path.empty()) {
+        const char* single = !opt.depth_output.empty()    ? "--depth-output"
+                             : !opt.float_output.empty()  ? "--float-output"
+                             : opt.filament || opt.sphere ? "--filament/--sphere"
+                             : opt.lod_budget > 0         ? "--lod-budget"
+                             : !opt.cameras.empty()       ? "--cameras"
+                             : !opt.eye.empty() || !opt.center.empty() || opt.fov
+                                 ? "--eye/--center/--fov"
+                                 : nullptr;
+        if (single != nullptr) {
+            core::ThrowError(
+                "{} is for a single view; --camera-path '{}' renders the path's "
+                "cameras into -o only",
+                single, opt.camera_path);
+        }
+        gs_render::CheckCameraPathOutput(PathOptions(opt));
+        t::io::CheckOutputIsNotAnInput(
+            "-o/--output", opt.output,
+            {{"--input", opt.input}, {"--camera-path", opt.camera_path}});
+        return;
+    }
     struct Output {
         const char* flag;
         const std::string& path;
@@ -285,6 +321,32 @@ t::geometry::SplatHierarchy LoadOrBuildHierarchy(const Options& opt,
     return hierarchy;
 }
 
+rendering::RenderConfig MakeConfig(const Options& opt) {
+    rendering::RenderConfig config;
+    config.sh_degree = opt.sh_degree;
+    config.antialias = opt.antialias;
+    config.near_plane = opt.near_plane;
+    config.depth_order = opt.depth_order == "reference" ? rendering::DepthOrder::kReference
+                                                        : rendering::DepthOrder::kCameraRelative;
+    if (!opt.background.empty()) config.background = ToVec(opt.background);
+    return config;
+}
+
+// The backend asked for; the default (Vulkan) falls back to the CPU reference, an explicit
+// choice fails.
+std::unique_ptr<rendering::GaussianSplatBackend> MakeBackend(const Options& opt) {
+    try {
+        return rendering::CreateGaussianSplatBackend(opt.backend);
+    } catch (const core::Open3DError& e) {
+        if (opt.backend_given || opt.backend != "vulkan") throw;
+        std::fprintf(stderr,
+                     "gs-render: no usable Vulkan device, rendering with the CPU reference "
+                     "instead (slower; pass --backend cpu to silence this).\n  reason: %s\n",
+                     e.what());
+        return rendering::CreateGaussianSplatBackend("cpu");
+    }
+}
+
 int Run(const Options& opt) {
     CheckOutputs(opt);
     const std::optional<camera::PinholeCamera> json_view = ReadChosenView(opt);
@@ -312,30 +374,18 @@ int Run(const Options& opt) {
                 static_cast<long long>(cloud.NumPoints()), cloud.GaussianSplatGetSHOrder(),
                 load_ms);
 
+    if (!opt.camera_path.empty()) {
+        std::unique_ptr<rendering::GaussianSplatBackend> path_backend = MakeBackend(opt);
+        path_backend->SetScene(cloud);
+        gs_render::RenderCameraPath(PathOptions(opt), *path_backend, MakeConfig(opt));
+        std::printf("total time %.1f ms\n", core::MillisecondsSince(start));
+        return 0;
+    }
     const camera::PinholeCamera cam = ChooseCamera(opt, json_view, cloud, default_scene);
     CheckImageMemory(opt, cam);
-    rendering::RenderConfig config;
-    config.sh_degree = opt.sh_degree;
-    config.antialias = opt.antialias;
-    config.near_plane = opt.near_plane;
-    config.depth_order = opt.depth_order == "reference" ? rendering::DepthOrder::kReference
-                                                        : rendering::DepthOrder::kCameraRelative;
-    if (!opt.background.empty()) config.background = ToVec(opt.background);
-
-    std::string backend_name = opt.backend;
-    std::unique_ptr<rendering::GaussianSplatBackend> backend;
-    try {
-        backend = rendering::CreateGaussianSplatBackend(backend_name);
-    } catch (const core::Open3DError& e) {
-        // The default (Vulkan) falls back to the CPU reference; an explicit choice fails.
-        if (opt.backend_given || backend_name != "vulkan") throw;
-        std::fprintf(stderr,
-                     "gs-render: no usable Vulkan device, rendering with the CPU reference "
-                     "instead (slower; pass --backend cpu to silence this).\n  reason: %s\n",
-                     e.what());
-        backend_name = "cpu";
-        backend = rendering::CreateGaussianSplatBackend(backend_name);
-    }
+    rendering::RenderConfig config = MakeConfig(opt);
+    std::unique_ptr<rendering::GaussianSplatBackend> backend = MakeBackend(opt);
+    const std::string backend_name = backend->GetName();
     if (opt.filament || opt.sphere) {
         gs_render::FilamentRenderOptions fo;
         fo.backend = backend_name;
@@ -512,6 +562,20 @@ int main(int argc, char** argv) {
                    "With --filament/--sphere: render this many frames, each running the whole "
                    "pipeline, and print the mean time of all but the first")
         ->check(CLI::Range(1, 100000))
+        ->capture_default_str();
+    app.add_option("--camera-path", opt.camera_path,
+                   "Render a camera path instead of one view: a cameras.json whose entries are "
+                   "the keyframes (at their 'time' fields in seconds, else "
+                   "--seconds-per-keyframe apart), every frame into -o: .png gives "
+                   "<name>_00000.png, ... beside it, .mp4 an H.264 video through the ffmpeg "
+                   "program (docs/camera-paths.md)")
+        ->check(CLI::ExistingFile);
+    app.add_option("--fps", opt.fps, "--camera-path: frames per second")
+        ->check(kPositive)
+        ->capture_default_str();
+    app.add_option("--seconds-per-keyframe", opt.seconds_per_keyframe,
+                   "--camera-path: keyframe spacing where the entries have no 'time'")
+        ->check(kPositive)
         ->capture_default_str();
     try {
         app.parse(argc, argv);

@@ -110,7 +110,13 @@ PinholeCamera CameraPath::At(double time) const {
         std::upper_bound(keyframes_.begin(), keyframes_.end(), time,
                          [](double value, const CameraKeyframe& k) { return value < k.time; });
     const size_t i = size_t(next - keyframes_.begin()) - 1;
-    if (keyframes_[i].time == time) return keyframes_[i].camera;
+    // A time within rounding of a keyframe's (i / fps against k x seconds per keyframe) is
+    // that keyframe: its frame is the keyframe's camera exactly.
+    for (size_t k : {i, i + 1}) {
+        if (std::abs(keyframes_[k].time - time) <= 1e-9 * std::max(1.0, std::abs(time))) {
+            return keyframes_[k].camera;
+        }
+    }
     const PinholeCamera& a = keyframes_[i].camera;
     const PinholeCamera& b = keyframes_[i + 1].camera;
     const double u = (time - keyframes_[i].time) / (keyframes_[i + 1].time - keyframes_[i].time);

@@ -2,7 +2,7 @@
 // Positions follow a centripetal Catmull-Rom spline through the keyframes' centres (no cusps or
 // self-intersections where keyframes bunch up), orientations a squad of their rotations (C1
 // like the positions), the fields of view and the principal point change linearly. A time
-// that is a keyframe's gives that keyframe's camera exactly.
+// within 1e-9 (relative) of a keyframe's gives that keyframe's camera exactly.
 #pragma once
 
 #include <vector>
