@@ -15,6 +15,7 @@
 #include "Bindings.h"
 #include "PathArgs.h"
 #include "PyCamera.h"
+#include "open3d/camera/CameraPath.h"
 #include "open3d/camera/CamerasJson.h"
 #include "open3d/camera/PinholeCamera.h"
 #include "open3d/core/Exception.h"
@@ -183,7 +184,9 @@ void BindCamera(py::module_& m) {
     py::class_<camera::CameraView>(m, "CameraView", "One entry of a 3DGS cameras.json")
         .def_readonly("id", &camera::CameraView::id, "The entry's id")
         .def_readonly("img_name", &camera::CameraView::img_name, "The name of the training image")
-        .def_readonly("camera", &camera::CameraView::camera, "The view as a PinholeCamera");
+        .def_readonly("camera", &camera::CameraView::camera, "The view as a PinholeCamera")
+        .def_readonly("time", &camera::CameraView::time,
+                      "Seconds on a camera path (the optional 'time' field), or None");
     m.def(
         "read_cameras_json",
         [](const std::filesystem::path& filename) {
@@ -193,6 +196,43 @@ void BindCamera(py::module_& m) {
         "Every view of a 3DGS cameras.json (a str or os.PathLike), in file order; raises "
         "naming the file, the entry and the field for malformed input, and "
         "Open3DFileNotFoundError (also a FileNotFoundError) for a missing file.");
+
+    py::class_<camera::CameraPath>(
+        m, "CameraPath",
+        "Keyframed cameras and the cameras between them (docs/camera-paths.md): centripetal "
+        "Catmull-Rom centres, squad rotations, fields of view linear; a keyframe's time gives "
+        "its camera exactly")
+        .def(py::init([](const std::vector<double>& times,
+                         const std::vector<camera::PinholeCamera>& cameras) {
+                 if (times.size() != cameras.size()) {
+                     core::ThrowError("CameraPath: {} times for {} cameras", times.size(),
+                                      cameras.size());
+                 }
+                 std::vector<camera::CameraKeyframe> keyframes;
+                 for (size_t i = 0; i < times.size(); ++i)
+                     keyframes.push_back({times[i], cameras[i]});
+                 return camera::CameraPath(std::move(keyframes));
+             }),
+             py::arg("times"), py::arg("cameras"),
+             "A path through cameras (PinholeCamera, one image size) at times in seconds, "
+             "strictly increasing")
+        .def_static(
+            "from_cameras_json",
+            [](const std::filesystem::path& filename, double seconds_per_keyframe) {
+                return camera::CameraPath::FromViews(camera::ReadCamerasJson(InputPath(filename)),
+                                                     seconds_per_keyframe);
+            },
+            py::arg("filename"), py::arg("seconds_per_keyframe") = 2.0,
+            "A cameras.json's views as keyframes: at their 'time' fields, or "
+            "seconds_per_keyframe apart")
+        .def_property_readonly("duration", &camera::CameraPath::GetDuration, "Seconds")
+        .def("at", &camera::CameraPath::At, py::arg("time"),
+             "The camera at a time in seconds (clamped to the path)")
+        .def(
+            "frames", [](const camera::CameraPath& path, double fps) { return path.Frames(fps); },
+            py::arg("fps") = 30.0,
+            "The cameras at start + i / fps for i = 0 .. floor(duration * fps), both ends; "
+            "render them with OffscreenRenderer.render_batch");
 }
 
 }  // namespace pybind

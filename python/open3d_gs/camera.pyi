@@ -15,6 +15,27 @@ import open3d_gs.visualization
 import open3d_gs.visualization.rendering
 
 
+class CameraPath:
+    """Keyframed cameras and the cameras between them (docs/camera-paths.md): centripetal Catmull-Rom centres, squad rotations, fields of view linear; a keyframe's time gives its camera exactly"""
+    def __init__(self, times: List[float], cameras: List[PinholeCamera]) -> None:
+        """A path through cameras (PinholeCamera, one image size) at times in seconds, strictly increasing"""
+        ...
+    def at(self, time: float) -> PinholeCamera:
+        """The camera at a time in seconds (clamped to the path)"""
+        ...
+    @property
+    def duration(self) -> float:
+        """Seconds"""
+        ...
+    def frames(self, fps: float = ...) -> List[PinholeCamera]:
+        """The cameras at start + i / fps for i = 0 .. floor(duration * fps), both ends; render them with OffscreenRenderer.render_batch"""
+        ...
+    @staticmethod
+    def from_cameras_json(filename: str | os.PathLike[str], seconds_per_keyframe: float = ...) -> CameraPath:
+        """A cameras.json's views as keyframes: at their 'time' fields, or seconds_per_keyframe apart"""
+        ...
+
+
 class CameraView:
     """One entry of a 3DGS cameras.json"""
     @property
@@ -28,6 +49,10 @@ class CameraView:
     @property
     def img_name(self) -> str:
         """The name of the training image"""
+        ...
+    @property
+    def time(self) -> Optional[float]:
+        """Seconds on a camera path (the optional 'time' field), or None"""
         ...
 
 
