@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # The radix sort's two algorithms side by side on the GPU device machine, from binaries built
 # here (docs/vulkan.md "GPU radix sort"): the sort, geometry stage and frame suites with the
-# device's default (one sweep on a GPU), then gs-bench frames with OPEN3D_RADIX_SORT=multipass
-# and =onesweep alternating scene by scene, so that both see the same clocks.
+# one-sweep sort, then gs-bench frames with OPEN3D_RADIX_SORT=multipass and =onesweep
+# alternating scene by scene, so that both see the same clocks.
 # Prepare here:
 #   mkdir -p .devbin && cp build/bin/{gs-bench,tests_gaussian_splat_vulkan} .devbin/ && strip .devbin/*
 #   bash scripts/device/prepare.sh .devbin/gs-bench .devbin/tests_gaussian_splat_vulkan
@@ -23,8 +23,8 @@ export OPEN3D_DATA_DIR=$PWD/shared/data OPEN3D_VULKAN_VALIDATION=0 OPEN3D_TEST_R
 nvidia-smi --query-gpu=name,driver_version,clocks.sm,clocks.max.sm --format=csv | tee "$out/gpu.txt"
 
 if [[ $what != bench ]]; then
-  echo "== suites (the device's default sort)"
-  timeout 150 .devbin/tests_gaussian_splat_vulkan \
+  echo "== suites with the one-sweep sort"
+  OPEN3D_RADIX_SORT=onesweep timeout 150 .devbin/tests_gaussian_splat_vulkan \
     --gtest_filter='*RadixSort*:RealScenes/GeometryStageScenes*:SubmissionPath*:GeometryStageFeatures*:VulkanBackend*:LodCut*:CommandTally*' \
     --gtest_output=xml:"$out/suites.xml" >"$out/suites.log" 2>&1
   echo $? >"$out/suites.rc"

@@ -58,8 +58,8 @@ uint64_t ScatterSharedBytes(uint32_t max_subgroups, uint32_t local_capacity) {
 
 namespace {
 
-RadixSort::Algorithm ChooseAlgorithm(RadixSort::Algorithm requested, const VulkanDeviceInfo& info) {
-    if (requested != RadixSort::Algorithm::kForDevice) return requested;
+RadixSort::Algorithm ChooseAlgorithm(RadixSort::Algorithm requested) {
+    if (requested != RadixSort::Algorithm::kDefault) return requested;
     if (const char* env = std::getenv("OPEN3D_RADIX_SORT"); env != nullptr && *env != '\0') {
         const std::string value = env;
         if (value == "onesweep") return RadixSort::Algorithm::kOneSweep;
@@ -67,7 +67,7 @@ RadixSort::Algorithm ChooseAlgorithm(RadixSort::Algorithm requested, const Vulka
         core::ThrowError("OPEN3D_RADIX_SORT is '{}': use onesweep or multipass (or unset it)",
                          value);
     }
-    return info.type == "CPU" ? RadixSort::Algorithm::kMultiPass : RadixSort::Algorithm::kOneSweep;
+    return RadixSort::Algorithm::kMultiPass;
 }
 
 }  // namespace
@@ -75,7 +75,7 @@ RadixSort::Algorithm ChooseAlgorithm(RadixSort::Algorithm requested, const Vulka
 RadixSort::RadixSort(const VulkanContext& context, Algorithm algorithm, RadixSortOptions options)
     : context_(&context) {
     const auto& info = context.GetDeviceInfo();
-    algorithm_ = ChooseAlgorithm(algorithm, info);
+    algorithm_ = ChooseAlgorithm(algorithm);
     const uint32_t min_subgroup = kRadixSortWorkgroupSize / kRadixSortMaxSubgroups;
     if (info.min_subgroup_size < min_subgroup) {
         core::ThrowError(

@@ -93,17 +93,18 @@ public:
     /// that write the parameters themselves pass it.
     uint32_t GetMaxGroupsX() const;
 
-    /// How the passes run (the class comment). kForDevice: one sweep on GPUs; the multi-pass
-    /// sort on CPU devices (lavapipe), where a look-back may wait for a workgroup whose
-    /// thread the OS has descheduled and lavapipe ends a loop after 65,535 iterations
-    /// (docs/environment-notes.md). The environment variable OPEN3D_RADIX_SORT=onesweep or
-    /// =multipass overrides kForDevice (tests and measurements).
-    enum class Algorithm { kForDevice, kMultiPass, kOneSweep };
+    /// How the passes run (the class comment). kDefault: the multi-pass sort, unless the
+    /// environment variable OPEN3D_RADIX_SORT=onesweep (or =multipass) says otherwise. The one
+    /// sweep is opt-in until it has run and been timed on a GPU (docs/vulkan.md "One sweep");
+    /// on CPU devices (lavapipe) it is for tests only: a look-back may wait for a workgroup whose
+    /// thread the OS has descheduled, and lavapipe ends a loop after 65,535 iterations
+    /// (docs/environment-notes.md).
+    enum class Algorithm { kDefault, kMultiPass, kOneSweep };
 
     /// Creates the pipelines. Throws core::Open3DError when the device's subgroups can be
     /// smaller than 8 invocations (the shaders size shared arrays by subgroup count), and for
     /// an OPEN3D_RADIX_SORT value it does not know.
-    explicit RadixSort(const VulkanContext& context, Algorithm algorithm = Algorithm::kForDevice,
+    explicit RadixSort(const VulkanContext& context, Algorithm algorithm = Algorithm::kDefault,
                        RadixSortOptions options = {});
     /// kMultiPass or kOneSweep: what Record runs (a one-sweep sorter still runs the
     /// multi-pass sort for a max_count whose counts would not fit a status word, 2^30 or more).
