@@ -107,8 +107,10 @@ def test_a_thousand_renders_keep_memory_bounded(backend):
     for _ in range(1000):
         r.render_to_image()
     # Each render returns 64 KiB; a leak of one image per render would be 62 MB. Measured
-    # here: 0.0 MB of growth on both backends (the bound leaves room for allocator noise).
-    assert rss_mb() - start < 8.0
+    # here: 0.0 MB of growth on both backends on an idle machine, up to 8.8 MB on lavapipe
+    # while the whole suite ran beside it on two cores (its threads' allocator arenas): the
+    # bound leaves room for that noise and still catches a leak of a third of an image a render.
+    assert rss_mb() - start < 20.0
 
 
 def test_rendering_releases_the_gil(data):
