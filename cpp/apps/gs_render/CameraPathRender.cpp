@@ -72,8 +72,8 @@ public:
             "-video_size", std::to_string(width) + "x" + std::to_string(height), "-framerate",
             fmt::format("{}", fps), "-i", "-",
             // yuv420p wants even sizes: an odd one gets a row or column of padding.
-            "-vf", "pad=ceil(iw/2)*2:ceil(ih/2)*2", "-c:v", "libx264", "-pix_fmt", "yuv420p",
-            "-movflags", "+faststart", "-f", "mp4", path};
+            "-vf", "pad=ceil(iw/2)*2:ceil(ih/2)*2", "-c:v", "libx264", "-preset", "veryfast",
+            "-pix_fmt", "yuv420p", "-movflags", "+faststart", "-f", "mp4", path};
         std::vector<char*> argv;
         for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
         argv.push_back(nullptr);
@@ -173,18 +173,21 @@ size_t RenderCameraPath(const CameraPathOptions& options, rendering::GaussianSpl
         const size_t end = std::min(frames.size(), begin + batch);
         const std::vector<camera::PinholeCamera> views(frames.begin() + begin,
                                                        frames.begin() + end);
-        // Float colour converted by the same WriteImage as a single render's PNG, so a frame
-        // at a keyframe is that view's gs-render image byte for byte.
-        const std::vector<rendering::RenderOutput> outputs = backend.RenderBatch(views, config);
+        // PNG frames: float colour converted by the same WriteImage as a single render's PNG,
+        // so a frame at a keyframe is that view's gs-render image byte for byte. Video: 8-bit
+        // colour from the device (a quarter of the bytes to read back).
+        rendering::BatchOptions batch_options;
+        batch_options.color_uint8 = video;
+        const std::vector<rendering::RenderOutput> outputs =
+            backend.RenderBatch(views, config, batch_options);
         for (size_t k = 0; k < outputs.size(); ++k) {
-            const t::geometry::Image color = outputs[k].color.SelectChannels(0, 3);
             if (video) {
-                const t::geometry::Image bytes = rendering::ColorToUInt8(outputs[k].color);
-                const uint8_t* rgba = bytes.Data<uint8_t>();
+                const uint8_t* rgba = outputs[k].color.Data<uint8_t>();
                 for (size_t p = 0; p < size_t(w) * h; ++p)
                     std::memcpy(&rgb[3 * p], &rgba[4 * p], 3);
                 ffmpeg->Write(rgb.data(), rgb.size());
             } else {
+                const t::geometry::Image color = outputs[k].color.SelectChannels(0, 3);
                 t::io::OutputFileSet files;
                 files.Write(FramePath(options.output, begin + k),
                             [&](const std::string& p) { t::io::WriteImage(p, color); });
