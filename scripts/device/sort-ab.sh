@@ -8,7 +8,8 @@
 #   bash scripts/device/prepare.sh .devbin/gs-bench .devbin/tests_gaussian_splat_vulkan
 # The call carries .gl, .devlibs, .devbin and the scene files (shared/ is a link and travels
 # only path by path): playbot_125k.ply, chair.splat, biker_152k.ply and their cameras.json.
-#   bash scripts/device/sort-ab.sh OUT_DIR [all | suites | bench]
+#   bash scripts/device/sort-ab.sh OUT_DIR [all | suites | bench | quick]
+# (quick: the suites, then playbot_125k and its first splat only, for a short lease)
 # (suites, then other work, then bench: the frames are timed only where the one-sweep suites
 # passed).
 set -uo pipefail
@@ -51,6 +52,10 @@ bench() {  # NAME ARGS...: one gs-bench run per algorithm
 }
 hd=(--resolution 1920x1080 --resolution 3840x2160)
 bench playbot -i $d/playbot/playbot_125k.ply --cameras $d/playbot/cameras.json "${hd[@]}"
+[[ $what == quick ]] && {
+  bench first1 -i $d/playbot/playbot_125k.ply --cameras $d/playbot/cameras.json --first 1 "${hd[@]}"
+  exit 0
+}
 bench chair -i $d/chair/chair.splat --cameras $d/chair/cameras.json "${hd[@]}"
 bench biker -i $d/biker/biker_152k.ply --cameras $d/biker/cameras.json "${hd[@]}"
 bench first1 -i $d/playbot/playbot_125k.ply --cameras $d/playbot/cameras.json --first 1 "${hd[@]}"
