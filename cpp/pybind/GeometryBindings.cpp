@@ -17,6 +17,7 @@
 #include "PointCloudOps.h"
 #include "PyPointCloud.h"
 #include "open3d/core/Exception.h"
+#include "open3d/visualization/rendering/gaussian_splat/cpu/ViewSelection.h"
 
 namespace py = pybind11;
 
@@ -271,6 +272,25 @@ void BindGeometry(py::module_& m) {
             },
             py::arg("indices"),
             "A new cloud without the points at indices (select_by_index with invert)")
+        .def(
+            "select_in_view",
+            // The camera as an object: PinholeCamera is bound after this module, so a typed
+            // argument would leave a C++ name in the signature (and the stubs).
+            [](const PyPointCloud& c, const py::object& camera,
+               const std::vector<Eigen::Vector2d>& polygon, bool include_occluded) {
+                c.cloud.ValidateGaussianSplat();
+                const std::vector<int64_t> rows = visualization::rendering::cpu::SelectSplatsInView(
+                    c.cloud, camera.cast<camera::PinholeCamera>(),
+                    visualization::rendering::RenderConfig(), polygon, include_occluded);
+                return py::array_t<int64_t>(py::ssize_t(rows.size()), rows.data());
+            },
+            py::arg("camera"), py::arg("polygon"), py::arg("include_occluded") = false,
+            "Indices (int64, ascending) of the splats whose centre the camera (a "
+            "PinholeCamera) projects inside "
+            "polygon (pixel (x, y) pairs, at least 3: a rectangle's corners or a lasso) and "
+            "that the view shows there (a blend weight of at least 1/255 at a pixel inside, "
+            "the CPU reference's rules); include_occluded also takes what lies behind and what "
+            "is too faint to show. Use with select_by_index or remove_by_index")
         // The transforms write the attributes in place: views stay valid and see the result.
         .def(
             "translate",

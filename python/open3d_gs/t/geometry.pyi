@@ -180,6 +180,9 @@ class PointCloud:
     def select_by_mask(self, boolean_mask: object, invert: bool = ...) -> PointCloud:
         """A new cloud of the points whose mask entry is True (False with invert)"""
         ...
+    def select_in_view(self, camera: object, polygon: List[numpy.typing.ArrayLike], include_occluded: bool = ...) -> numpy.ndarray:
+        """Indices (int64, ascending) of the splats whose centre the camera (a PinholeCamera) projects inside polygon (pixel (x, y) pairs, at least 3: a rectangle's corners or a lasso) and that the view shows there (a blend weight of at least 1/255 at a pixel inside, the CPU reference's rules); include_occluded also takes what lies behind and what is too faint to show. Use with select_by_index or remove_by_index"""
+        ...
     def set_point_attr(self, name: str, value: object, *, allow_non_finite: bool = ...) -> None:
         """pcd.point[name] = value with the opt-out: float32, uint8 and uint16 arrays are copied as they are, other real dtypes (float64, float16, integers, lists) converted to float32; opacity (N,) is taken as (N, 1). NaN and infinity are refused naming the attribute and the first row holding one, unless allow_non_finite (the renderer's sort and blend do not survive them)"""
         ...
