@@ -17,6 +17,7 @@
 #include "PointCloudOps.h"
 #include "PyPointCloud.h"
 #include "open3d/core/Exception.h"
+#include "open3d/visualization/rendering/gaussian_splat/cpu/Picking.h"
 #include "open3d/visualization/rendering/gaussian_splat/cpu/ViewSelection.h"
 
 namespace py = pybind11;
@@ -272,6 +273,30 @@ void BindGeometry(py::module_& m) {
             },
             py::arg("indices"),
             "A new cloud without the points at indices (select_by_index with invert)")
+        .def(
+            "pick",
+            [](const PyPointCloud& c, const py::object& camera, int x, int y) {
+                c.cloud.ValidateGaussianSplat();
+                const visualization::rendering::cpu::PickResult pick =
+                    visualization::rendering::cpu::PickPixel(
+                        c.cloud, camera.cast<camera::PinholeCamera>(),
+                        visualization::rendering::RenderConfig(), x, y);
+                py::dict out;
+                out["hit"] = pick.hit;
+                out["splat"] = pick.splat;
+                out["weight"] = pick.weight;
+                out["alpha"] = pick.alpha;
+                out["expected_depth"] = pick.expected_depth;
+                out["median_depth"] = pick.median_depth;
+                out["point"] = pick.point;
+                return out;
+            },
+            py::arg("camera"), py::arg("x"), py::arg("y"),
+            "Picks pixel (x, y) of the camera's (a PinholeCamera) view, as the CPU reference "
+            "composites it: a dict with hit, splat (the index of the splat of largest blend "
+            "weight there, -1 for none), weight, alpha (1 - T), expected_depth and median_depth "
+            "(view z, as the depth images hold them) and point (the world point on the pixel's "
+            "ray at the expected depth)")
         .def(
             "select_in_view",
             // The camera as an object: PinholeCamera is bound after this module, so a typed

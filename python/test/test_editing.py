@@ -88,3 +88,27 @@ def test_select_in_view_takes_the_centres_inside_the_polygon(playbot):
     assert set(shown) <= set(everything) and 0 < len(shown) < len(everything)
     edited = pcd.remove_by_index(shown)
     assert len(edited) == len(pcd) - len(shown)
+
+
+def test_pick_gives_the_dominant_splat_and_the_point_at_the_depth(playbot):
+    pcd, views = playbot
+    camera = views[0].camera.resized(64, 64)
+    r = o3d.visualization.rendering.OffscreenRenderer(64, 64, "cpu")
+    r.scene.add_geometry("scene", pcd)
+    r.setup_camera(camera)
+    depth = r.render_to_depth_image()
+    alpha = r.render_to_image()[..., 3]
+    hits = 0
+    for x, y in [(32, 32), (20, 40), (45, 25), (0, 0)]:
+        pick = pcd.pick(camera, x, y)
+        assert pick["hit"] == (alpha[y, x] > 0)
+        if not pick["hit"]:
+            continue
+        hits += 1
+        assert np.float32(pick["expected_depth"]) == depth[y, x]
+        assert pick["alpha"] == pytest.approx(alpha[y, x], abs=1e-6)
+        assert 0 <= pick["splat"] < len(pcd) and 0 < pick["weight"] <= pick["alpha"]
+        view = camera.world_to_camera[:3, :3] @ pick["point"] + camera.world_to_camera[:3, 3]
+        assert view[2] == pytest.approx(pick["expected_depth"], rel=1e-12)
+        assert camera.fx * view[0] / view[2] + camera.cx == pytest.approx(x, abs=1e-9)
+    assert hits >= 3

@@ -161,6 +161,9 @@ class PointCloud:
     def num_points(self) -> int:
         """The number of points"""
         ...
+    def pick(self, camera: object, x: int, y: int) -> dict:
+        """Picks pixel (x, y) of the camera's (a PinholeCamera) view, as the CPU reference composites it: a dict with hit, splat (the index of the splat of largest blend weight there, -1 for none), weight, alpha (1 - T), expected_depth and median_depth (view z, as the depth images hold them) and point (the world point on the pixel's ray at the expected depth)"""
+        ...
     @property
     def point(self) -> PointAttributes:
         """The attributes by name (pcd.point['scale'] or pcd.point.scale)"""

@@ -1,0 +1,60 @@
+#include "open3d/visualization/rendering/gaussian_splat/cpu/Picking.h"
+
+#include <Eigen/Dense>
+
+#include <cmath>
+#include <vector>
+
+#include "open3d/core/Exception.h"
+#include "open3d/visualization/rendering/gaussian_splat/cpu/PixelBlend.h"
+#include "open3d/visualization/rendering/gaussian_splat/cpu/Projection.h"
+#include "open3d/visualization/rendering/gaussian_splat/cpu/TileLists.h"
+
+namespace open3d {
+namespace visualization {
+namespace rendering {
+namespace cpu {
+
+PickResult PickPixel(const t::geometry::PointCloud& cloud, const camera::PinholeCamera& camera,
+                     const RenderConfig& config, int x, int y) {
+    camera.Validate();
+    if (x < 0 || y < 0 || x >= camera.width || y >= camera.height) {
+        core::ThrowError("PickPixel: pixel ({}, {}) is outside the {}x{} image", x, y, camera.width,
+                         camera.height);
+    }
+    const std::vector<ProjectedSplat> splats = ProjectSplats(cloud, camera, config);
+    const TileGrid grid = TileGrid::ForImage(camera.width, camera.height);
+    const TileLists lists = BuildTileLists(splats, grid, config);
+    const int64_t tile = int64_t(y / kTileSize) * grid.tiles_x + x / kTileSize;
+    std::vector<TileSplat> local;
+    for (uint64_t k = lists.offsets[tile]; k < lists.offsets[tile + 1]; ++k) {
+        local.push_back(MakeTileSplat(splats[lists.splat_indices[k]], lists.splat_indices[k]));
+    }
+    PickResult pick;
+    double weighted_depth = 0.0;
+    const double transmittance =
+        BlendPixel(local, x, y, HUGE_VAL, [&](const TileSplat& s, double w, double t_after) {
+            if (w > pick.weight) {
+                pick.weight = w;
+                pick.splat = s.index;
+            }
+            weighted_depth += s.depth * w;
+            if (pick.median_depth == 0.0 && 1.0 - t_after >= 0.5) pick.median_depth = s.depth;
+        });
+    pick.alpha = 1.0 - transmittance;
+    pick.hit = pick.splat >= 0;
+    if (!pick.hit) return pick;
+    pick.expected_depth = weighted_depth / pick.alpha;
+    // The ray through the pixel's centre, scaled to view z = expected depth, to the world.
+    const Eigen::Vector3d view((x - camera.cx) / camera.fx * pick.expected_depth,
+                               (y - camera.cy) / camera.fy * pick.expected_depth,
+                               pick.expected_depth);
+    const Eigen::Matrix3d R = camera.GetRotation();
+    pick.point = R.transpose() * (view - camera.GetTranslation());
+    return pick;
+}
+
+}  // namespace cpu
+}  // namespace rendering
+}  // namespace visualization
+}  // namespace open3d
