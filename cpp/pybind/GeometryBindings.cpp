@@ -246,8 +246,9 @@ void BindGeometry(py::module_& m) {
         .def(
             "get_axis_aligned_bounding_box",
             [](const PyPointCloud& c) {
-                return t::geometry::AxisAlignedBoundingBox(Bound(c.cloud, false),
-                                                           Bound(c.cloud, true));
+                // An empty cloud's box has zero corners, as get_min_bound says.
+                const t::geometry::AxisAlignedBoundingBox box = c.cloud.GetAxisAlignedBoundingBox();
+                return t::geometry::AxisAlignedBoundingBox(box.GetMinBound(), box.GetMaxBound());
             },
             "The box of the positions (get_min_bound to get_max_bound)")
         .def(

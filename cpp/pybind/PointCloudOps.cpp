@@ -91,20 +91,9 @@ t::geometry::PointCloud Append(const t::geometry::PointCloud& a, const t::geomet
 }
 
 Eigen::Vector3d Bound(const t::geometry::PointCloud& cloud, bool max) {
-    if (!cloud.HasPointAttr(gs::kPositions) || cloud.NumPoints() == 0) {
-        return Eigen::Vector3d::Zero();
-    }
-    const float* p = cloud.GetPointPositions().Data<float>();
-    Eigen::Vector3f bound(p[0], p[1], p[2]);
-    for (int64_t i = 1; i < cloud.NumPoints(); ++i) {
-        const Eigen::Vector3f v(p[3 * i], p[3 * i + 1], p[3 * i + 2]);
-        if (max) {
-            bound = bound.cwiseMax(v);
-        } else {
-            bound = bound.cwiseMin(v);
-        }
-    }
-    return bound.cast<double>();
+    // The library's box (zero corners for an empty cloud).
+    const t::geometry::AxisAlignedBoundingBox box = cloud.GetAxisAlignedBoundingBox();
+    return max ? box.GetMaxBound() : box.GetMinBound();
 }
 
 void TransformCloud(t::geometry::PointCloud& cloud, const Eigen::Matrix4d& transformation) {

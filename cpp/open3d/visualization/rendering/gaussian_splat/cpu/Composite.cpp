@@ -54,12 +54,7 @@ void CompositeTiles(const std::vector<ProjectedSplat>& splats, const TileLists& 
         [&](int64_t tile) {
             const int tx = static_cast<int>(tile % grid.tiles_x);
             const int ty = static_cast<int>(tile / grid.tiles_x);
-            std::vector<TileSplat> local;
-            local.reserve(lists.offsets[tile + 1] - lists.offsets[tile]);
-            for (uint64_t k = lists.offsets[tile]; k < lists.offsets[tile + 1]; ++k) {
-                local.push_back(
-                    MakeTileSplat(splats[lists.splat_indices[k]], lists.splat_indices[k]));
-            }
+            const std::vector<TileSplat> local = TileSplats(splats, lists, tile);
             const int x_end = std::min(width, (tx + 1) * kTileSize);
             const int y_end = std::min(height, (ty + 1) * kTileSize);
             for (int py = ty * kTileSize; py < y_end; ++py) {

@@ -26,10 +26,7 @@ PickResult PickPixel(const t::geometry::PointCloud& cloud, const camera::Pinhole
     const TileGrid grid = TileGrid::ForImage(camera.width, camera.height);
     const TileLists lists = BuildTileLists(splats, grid, config);
     const int64_t tile = int64_t(y / kTileSize) * grid.tiles_x + x / kTileSize;
-    std::vector<TileSplat> local;
-    for (uint64_t k = lists.offsets[tile]; k < lists.offsets[tile + 1]; ++k) {
-        local.push_back(MakeTileSplat(splats[lists.splat_indices[k]], lists.splat_indices[k]));
-    }
+    const std::vector<TileSplat> local = TileSplats(splats, lists, tile);
     PickResult pick;
     double weighted_depth = 0.0;
     const double transmittance =

@@ -11,6 +11,7 @@
 
 #include "open3d/visualization/rendering/gaussian_splat/cpu/Composite.h"
 #include "open3d/visualization/rendering/gaussian_splat/cpu/Projection.h"
+#include "open3d/visualization/rendering/gaussian_splat/cpu/TileLists.h"
 
 namespace open3d {
 namespace visualization {
@@ -49,6 +50,17 @@ inline TileSplat MakeTileSplat(const ProjectedSplat& s, uint32_t index) {
             float(s.conic_c),
             float(s.opacity),
             index};
+}
+
+/// Tile `tile`'s splats of `lists`, front to back, as BlendPixel reads them.
+inline std::vector<TileSplat> TileSplats(const std::vector<ProjectedSplat>& splats,
+                                         const TileLists& lists, int64_t tile) {
+    std::vector<TileSplat> local;
+    local.reserve(lists.offsets[tile + 1] - lists.offsets[tile]);
+    for (uint64_t k = lists.offsets[tile]; k < lists.offsets[tile + 1]; ++k) {
+        local.push_back(MakeTileSplat(splats[lists.splat_indices[k]], lists.splat_indices[k]));
+    }
+    return local;
 }
 
 /// The original's alpha of a splat at pixel (px, py), float32 in its operation order

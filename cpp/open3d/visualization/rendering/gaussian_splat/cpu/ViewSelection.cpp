@@ -79,11 +79,7 @@ std::vector<int64_t> SelectSplatsInView(const t::geometry::PointCloud& cloud,
                 const int y0 = std::max(ty * kTileSize, int(std::ceil(lo.y())));
                 const int y1 = std::min((ty + 1) * kTileSize - 1, int(std::floor(hi.y())));
                 if (x0 > x1 || y0 > y1) return;
-                std::vector<TileSplat> local;
-                for (uint64_t k = lists.offsets[tile]; k < lists.offsets[tile + 1]; ++k) {
-                    local.push_back(
-                        MakeTileSplat(splats[lists.splat_indices[k]], lists.splat_indices[k]));
-                }
+                const std::vector<TileSplat> local = TileSplats(splats, lists, tile);
                 for (int py = std::max(y0, 0); py <= std::min(y1, camera.height - 1); ++py) {
                     for (int px = std::max(x0, 0); px <= std::min(x1, camera.width - 1); ++px) {
                         if (!PolygonContains(polygon, Eigen::Vector2d(px, py))) continue;
