@@ -90,7 +90,7 @@ struct RadixSortParams {
     uvec4 sweep_histogram_grid;
 };
 
-// ---- One sweep per digit (RadixSort::Algorithm::kOneSweep, docs/vulkan.md) ----
+// ---- One sweep per digit (RadixSort::Algorithm::kOneSweep, docs/radix-sort.md) ----
 // One histogram dispatch counts the digits of every pass at once; then each pass is a
 // single scatter dispatch in which a block finds its output offsets by decoupled look-back:
 // it publishes its own digit counts (aggregate) in a status word per (block, digit), then

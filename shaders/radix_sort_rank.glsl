@@ -1,5 +1,5 @@
 // A block's stable ranking by one digit, shared by both scatters (radix_sort_scatter.comp,
-// radix_sort_sweep_scatter.comp; docs/vulkan.md "GPU radix sort").
+// radix_sort_sweep_scatter.comp; docs/radix-sort.md).
 // Each subgroup owns a contiguous run of the block (lanes x chunks pairs; lane l holds pairs
 // l, l + lanes, ... of it) and ranks its pairs step by step with ballots (the lanes holding
 // the same digit are the intersection of one ballot per digit bit), keeping a running count

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # The radix sort's two algorithms side by side on the GPU device machine, from binaries built
-# here (docs/vulkan.md "GPU radix sort"): the sort, geometry stage and frame suites with the
+# here (docs/radix-sort.md): the sort, geometry stage and frame suites with the
 # one-sweep sort, then gs-bench frames with OPEN3D_RADIX_SORT=multipass and =onesweep
 # alternating scene by scene, so that both see the same clocks.
 # Prepare here:

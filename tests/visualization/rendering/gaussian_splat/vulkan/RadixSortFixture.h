@@ -104,7 +104,7 @@ template <RadixSort::Algorithm kAlgorithm>
 class RadixSortFixture : public VulkanTest {
 protected:
     // The one-sweep sort runs on lavapipe with one thread: there workgroups run one after
-    // another, so no look-back ever waits (docs/vulkan.md "One sweep on CPU devices"). With
+    // another, so no look-back ever waits (docs/radix-sort.md "One sweep on CPU devices"). With
     // several threads a look-back may wait for a block whose thread the OS descheduled, and
     // lavapipe ends a loop after 65,535 iterations: the sort would then depend on the load
     // of the machine. lavapipe reads LP_NUM_THREADS when an instance is created; a GPU

@@ -2,7 +2,7 @@
 // caller allocates the scratch buffers from GetStorageRequirements and Record() only
 // records commands. The element count is read on the GPU from the producer's buffer.
 //
-// Algorithm (docs/vulkan.md): LSD, 8-bit digits, ceil(num_bits / 8) passes, blocks of
+// Algorithm (docs/radix-sort.md): LSD, 8-bit digits, ceil(num_bits / 8) passes, blocks of
 // 256..2048 elements (at most kRadixSortTargetBlocks of them while 2048-element blocks are not
 // needed) dispatched indirectly with the block count a setup shader or the producer writes.
 // Two ways to run the passes (Algorithm):
@@ -95,7 +95,7 @@ public:
 
     /// How the passes run (the class comment). kDefault: the multi-pass sort, unless the
     /// environment variable OPEN3D_RADIX_SORT=onesweep (or =multipass) says otherwise. The one
-    /// sweep is opt-in until it has run and been timed on a GPU (docs/vulkan.md "One sweep");
+    /// sweep is opt-in until it has run and been timed on a GPU (docs/radix-sort.md "One sweep");
     /// on CPU devices (lavapipe) it is for tests only: a look-back may wait for a workgroup whose
     /// thread the OS has descheduled, and lavapipe ends a loop after 65,535 iterations
     /// (docs/environment-notes.md).

@@ -1,6 +1,6 @@
 // RadixSort::RecordOneSweep: the one-sweep sort's recording (RadixSort.h; shaders
-// radix_sort_sweep_histogram.comp and radix_sort_sweep_scatter.comp, docs/vulkan.md "GPU
-// radix sort"). One histogram dispatch, then one scatter dispatch per pass, each pass's
+// radix_sort_sweep_histogram.comp and radix_sort_sweep_scatter.comp, docs/radix-sort.md
+// "One sweep"). One histogram dispatch, then one scatter dispatch per pass, each pass's
 // blocks chained by decoupled look-back instead of a histogram and a scan dispatch of their own.
 #include <algorithm>
 #include <cstddef>
