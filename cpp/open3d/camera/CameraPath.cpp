@@ -79,6 +79,13 @@ CameraPath::CameraPath(std::vector<CameraKeyframe> keyframes) : keyframes_(std::
                              i, k.camera.width, k.camera.height, first.width, first.height);
         }
     }
+    // Rotations, each on the hemisphere of the one before, once for every At.
+    for (size_t k = 0; k < keyframes_.size(); ++k) {
+        rotations_.push_back(CameraToWorld(keyframes_[k].camera));
+        if (k > 0 && rotations_[k].dot(rotations_[k - 1]) < 0.0) {
+            rotations_[k].coeffs() = -rotations_[k].coeffs();
+        }
+    }
 }
 
 CameraPath CameraPath::FromViews(const std::vector<CameraView>& views,
@@ -128,12 +135,8 @@ PinholeCamera CameraPath::At(double time) const {
     const Eigen::Vector3d p3 = i + 2 < n ? centre(i + 2) : 2.0 * p2 - p1;
     const Eigen::Vector3d position = CentripetalCatmullRom(p0, p1, p2, p3, u);
 
-    // Rotations, each on the hemisphere of the one before, and squad's inner quaternions.
-    std::vector<Eigen::Quaterniond> q(n);
-    for (size_t k = 0; k < n; ++k) {
-        q[k] = CameraToWorld(keyframes_[k].camera);
-        if (k > 0 && q[k].dot(q[k - 1]) < 0.0) q[k].coeffs() = -q[k].coeffs();
-    }
+    // The keyframes' rotations (made in the constructor) and squad's inner quaternions.
+    const std::vector<Eigen::Quaterniond>& q = rotations_;
     const auto inner = [&](size_t k) {
         if (k == 0 || k + 1 == n) return q[k];
         const Eigen::Quaterniond inv = q[k].conjugate();

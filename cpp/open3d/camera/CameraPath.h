@@ -5,6 +5,8 @@
 // within 1e-9 (relative) of a keyframe's gives that keyframe's camera exactly.
 #pragma once
 
+#include <Eigen/Geometry>
+
 #include <vector>
 
 #include "open3d/camera/CamerasJson.h"
@@ -40,6 +42,8 @@ public:
 
 private:
     std::vector<CameraKeyframe> keyframes_;
+    /// The keyframes' camera-to-world rotations, each on the hemisphere of the one before.
+    std::vector<Eigen::Quaterniond> rotations_;
 };
 
 }  // namespace camera
