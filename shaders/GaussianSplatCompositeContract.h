@@ -45,11 +45,15 @@ OPEN3D_SHADER_CONST float kCompositeMinTransmittance = 0.0001f;
 // Specialisation constant of gaussian_composite*.comp and gaussian_depth_merge.comp:
 // 1 = a scene depth texture is bound and tested; 0 = it is never read.
 OPEN3D_SHADER_CONST uint kSpecSceneDepth = 0u;
-// Specialisation constant of gaussian_composite*.comp: which depth images it writes, a sum
-// of the bits below (0 = colour only). Each bit drops per-blend arithmetic when clear.
+// Specialisation constant of gaussian_composite*.comp: which images beside the colour it
+// writes, a sum of the bits below (0 = colour only). Each bit drops per-blend arithmetic when
+// clear.
 OPEN3D_SHADER_CONST uint kSpecCompositeDepth = 1u;
 OPEN3D_SHADER_CONST uint kCompositeExpectedDepthBit = 1u;  // expected depth and alpha images
 OPEN3D_SHADER_CONST uint kCompositeMedianDepthBit = 2u;    // median depth image
+OPEN3D_SHADER_CONST uint kCompositeSplatIdBit = 4u;        // ID image of the dominant splat
+// The ID image's value where no splat blends (-1 read as int32).
+OPEN3D_SHADER_CONST uint kCompositeNoSplat = 0xFFFFFFFFu;
 // Specialisation constant of gaussian_composite.comp (RGBA32F): 1 = the colour goes to the
 // storage buffer at kCompositeColorBufferBinding (vec4 per pixel, row-major) instead of the
 // image, so a batch's views need no image-to-buffer copy (0.18 ms per 800x800 view on an
@@ -103,7 +107,8 @@ OPEN3D_SHADER_CONST uint kCompositeAlphaBinding = 6u;        // image2D r32f: 1 
 OPEN3D_SHADER_CONST uint kCompositeMedianDepthBinding = 7u;  // image2D r32f: median view z
 OPEN3D_SHADER_CONST uint kCompositeSceneDepthBinding = 8u;   // texture2D, reversed-Z
 OPEN3D_SHADER_CONST uint kCompositeColorBufferBinding = 9u;  // vec4[W * H] (kSpecColorBuffer)
-OPEN3D_SHADER_CONST uint kCompositeNumBindings = 10u;
+OPEN3D_SHADER_CONST uint kCompositeSplatIdBinding = 10u;     // uimage2D r32ui: dominant splat
+OPEN3D_SHADER_CONST uint kCompositeNumBindings = 11u;
 
 // Descriptor set 0 of the depth merge (push descriptors).
 OPEN3D_SHADER_CONST uint kDepthMergeSplatDepthBinding = 0u;  // image2D r32f: splat view z

@@ -37,6 +37,7 @@ layout(constant_id = kSpecCompositeDepth) const uint kDepthOutputs =
         kCompositeExpectedDepthBit | kCompositeMedianDepthBit;
 const bool kExpectedDepth = (kDepthOutputs & kCompositeExpectedDepthBit) != 0u;
 const bool kMedianDepth = (kDepthOutputs & kCompositeMedianDepthBit) != 0u;
+const bool kSplatId = (kDepthOutputs & kCompositeSplatIdBit) != 0u;
 // 1: the colour goes to color_buffer instead of out_color (RGBA32F batches, no image copy).
 layout(constant_id = kSpecColorBuffer) const uint kColorToBuffer = 0u;
 
@@ -61,11 +62,13 @@ layout(set = 0, binding = kCompositeSceneDepthBinding) uniform texture2D scene_d
 layout(std430, set = 0, binding = kCompositeColorBufferBinding) writeonly buffer ColorBufferBlock {
     vec4 color_buffer[];  // row-major W x H, the same floats the image would hold
 };
+layout(set = 0, binding = kCompositeSplatIdBinding, r32ui) writeonly uniform uimage2D out_splat_id;
 
 // The batch in shared memory: 48 B per splat, 12 KiB (lavapipe allows 32 KiB).
 shared vec4 s_center_depth_opacity[kCompositeBatchSize];
 shared vec4 s_conic[kCompositeBatchSize];
 shared vec4 s_color[kCompositeBatchSize];
+shared uint s_splat_index[kCompositeBatchSize];  // written only for the ID image (kSplatId)
 // Per pixel block, the batch slots whose splat may change the block (CompositeBlockMask), in
 // depth order: a block's invocations visit only those, 8 KiB.
 shared uint s_block_slots[kCompositeBlocks * kCompositeBatchSize];
@@ -94,6 +97,8 @@ struct PixelState {
     float weight;          // sum(alpha_i T_i): 1 - T without the cancellation of 1 - T
     float median_depth;
     bool median_found;
+    float best_weight;  // the dominant splat's alpha T so far: a strictly larger one replaces it
+    uint best_splat;    // kCompositeNoSplat until a splat blends
     bool done;  // T-stopped (or outside the image): no further splat changes the pixel
 };
 
@@ -138,6 +143,10 @@ void BlendAlpha(uint j, float alpha, inout PixelState p) {
             p.median_depth = z;
             p.median_found = true;
         }
+    }
+    if (kSplatId && weight > p.best_weight) {
+        p.best_weight = weight;
+        p.best_splat = s_splat_index[j];
     }
     p.transmittance = next_transmittance;
 }
@@ -222,6 +231,8 @@ uint CompositeTile(uint tile, uvec2 range, uint next_index, uvec2 upcoming, uint
     p.weight = 0.0;
     p.median_depth = 0.0;
     p.median_found = false;
+    p.best_weight = 0.0;
+    p.best_splat = kCompositeNoSplat;
     p.done = !inside;
     // s_done reset before the increments below. main() relies on this barrier too: every
     // invocation has read s_tile before it is written for the tile after the next.
@@ -241,6 +252,7 @@ uint CompositeTile(uint tile, uvec2 range, uint next_index, uvec2 upcoming, uint
         uint mask = 0u;
         if (entry < end) {
             GaussianProjectedSplat splat = LoadProjected(projected, next_index);
+            if (kSplatId) s_splat_index[slot] = next_index;
             if (entry + kCompositeBatchSize < end) {
                 next_index = entry_values[entry + kCompositeBatchSize];
             }
@@ -305,6 +317,7 @@ uint CompositeTile(uint tile, uvec2 range, uint next_index, uvec2 upcoming, uint
             imageStore(out_alpha, pixel, vec4(accumulated));
         }
         if (kMedianDepth) imageStore(out_median_depth, pixel, vec4(p.median_depth));
+        if (kSplatId) imageStore(out_splat_id, pixel, uvec4(p.best_splat));
     }
     return upcoming_index;
 }

@@ -74,6 +74,9 @@ void WritePng(const std::string& path, const t::geometry::Image& image) {
             // apply coverage a second time. Pass uint8 RGBA to write an alpha channel.
             t::io::WritePNG(path, image.SelectChannels(0, 3).ToUInt8());
             return;
+        case core::Dtype::Int32:
+            core::ThrowError(
+                "write_image: an int32 image (splat IDs) has no PNG form here; write .npy");
     }
 }
 

@@ -21,6 +21,8 @@ py::dtype NumpyDtype(core::Dtype dtype) {
             return py::dtype::of<uint8_t>();
         case core::Dtype::UInt16:
             return py::dtype::of<uint16_t>();
+        case core::Dtype::Int32:
+            return py::dtype::of<int32_t>();
     }
     return py::dtype::of<float>();
 }

@@ -294,6 +294,27 @@ void BindRendering(py::module_& m) {
             py::arg("z_in_view_space"), py::arg("kind") = "expected",
             "Open3D's positional form, render_to_depth_image(True): see the first form")
         .def(
+            "render_to_id_image",
+            [](SplatOffscreen& r) {
+                py::array ids = ArrayFromImage(r.RenderSplatId(), true);
+                return ids.attr("reshape")(r.Height(), r.Width());
+            },
+            "(H, W) int32: at each pixel the splat that contributes most to it (the largest "
+            "blend weight alpha T, the first of equal ones front to back), as its index in the "
+            "renderer's scene (its geometries in name order, one after another); -1 where no "
+            "splat is. locate_splat(id) gives the geometry and the index in it. The same on "
+            "the cpu and vulkan backends (docs/editing.md \"ID images\"); not with meshes=True")
+        .def(
+            "locate_splat",
+            [](SplatOffscreen& r, int64_t id) -> py::object {
+                const auto where = r.SplatRenderer().LocateSplat(id);
+                if (!where) return py::none();
+                return py::make_tuple(where->first, where->second);
+            },
+            py::arg("id"),
+            "(geometry name, index in that geometry) of an ID from render_to_id_image, as the "
+            "scene stood at the last render; None for -1")
+        .def(
             "render_batch",
             [](SplatOffscreen& r, const std::vector<camera::PinholeCamera>& cameras,
                const std::string& dtype, std::optional<py::array> out, std::optional<bool> alpha,

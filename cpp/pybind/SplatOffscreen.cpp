@@ -154,6 +154,27 @@ RenderOutput SplatOffscreen::Render(bool expected_depth, bool median_depth) {
     return out;
 }
 
+t::geometry::Image SplatOffscreen::RenderSplatId() {
+    if (filament_) {
+        core::ThrowError(
+            "render_to_id_image: splat-only renderers (meshes=False); a mesh has no splat ID");
+    }
+    if (renderer_->IsStreaming()) {
+        core::ThrowError("render_to_id_image: not while a stream runs (its IDs are pool slots)");
+    }
+    const camera::PinholeCamera camera = Camera();
+    RequireVisibleSplats();
+    RenderOutput out;
+    visualization::rendering::CompositeInputs inputs;
+    inputs.expected_depth = inputs.median_depth = false;
+    inputs.splat_id = true;
+    py::gil_scoped_release release;
+    renderer_->Prepare();
+    renderer_->RenderGeometryStage(kView, camera, config_);
+    renderer_->RenderCompositeStage(kView, out, inputs);
+    return std::move(out.splat_id);
+}
+
 t::geometry::Image SplatOffscreen::RenderWithMeshes(bool depth) {
     const camera::PinholeCamera camera = Camera();
     // The knobs go to the scene's splat settings (background stays the view's).

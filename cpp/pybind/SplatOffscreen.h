@@ -54,6 +54,10 @@ public:
 
     /// The splat backend's frame of the current camera (renderers without meshes).
     visualization::rendering::RenderOutput Render(bool expected_depth, bool median_depth);
+    /// The ID image (Int32 [H, W, 1], RenderOutput::splat_id) of the current camera: IDs of
+    /// the merged scene, GaussianSplatRenderer::LocateSplat names their clouds. Renderers
+    /// without meshes and without a stream only.
+    t::geometry::Image RenderSplatId();
     /// Filament's frame: UInt8 [H, W, 3], or the view z Float32 [H, W, 1] with `depth`.
     t::geometry::Image RenderWithMeshes(bool depth);
     /// Renders into `destination` (N x H x W x 4 elements of float32, or uint8 with `uint8`),

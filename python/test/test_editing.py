@@ -112,3 +112,34 @@ def test_pick_gives_the_dominant_splat_and_the_point_at_the_depth(playbot):
         assert view[2] == pytest.approx(pick["expected_depth"], rel=1e-12)
         assert camera.fx * view[0] / view[2] + camera.cx == pytest.approx(x, abs=1e-9)
     assert hits >= 3
+
+
+@pytest.mark.parametrize("backend", ["cpu", "vulkan"])
+def test_the_id_image_names_each_pixels_pick_and_its_geometry(playbot, backend):
+    pcd, views = playbot
+    camera = views[0].camera.resized(48, 40)
+    r = o3d.visualization.rendering.OffscreenRenderer(48, 40, backend)
+    # Two geometries: IDs run through them in name order ("a" first, then "b").
+    half = len(pcd) // 2
+    a, b = pcd.select_by_index(range(half)), pcd.select_by_index(range(half, len(pcd)))
+    r.scene.add_geometry("b", b)
+    r.scene.add_geometry("a", a)
+    r.setup_camera(camera)
+    ids = r.render_to_id_image()
+    assert ids.dtype == np.int32 and ids.shape == (40, 48)
+    alpha = r.render_to_image()[..., 3]
+    np.testing.assert_array_equal(ids >= 0, alpha > 0)
+    # The pick of the whole cloud, at pixels spread over the image: the same splat (the
+    # shared scenes' views agree on every pixel, docs/editing.md "ID images").
+    checked = 0
+    for y in range(0, 40, 7):
+        for x in range(0, 48, 7):
+            pick = pcd.pick(camera, x, y)
+            assert ids[y, x] == (pick["splat"] if pick["hit"] else -1), (x, y)
+            if ids[y, x] >= 0:
+                name, index = r.locate_splat(int(ids[y, x]))
+                assert (name, index) == (("a", pick["splat"]) if pick["splat"] < half
+                                         else ("b", pick["splat"] - half))
+                checked += 1
+    assert checked >= 10
+    assert r.locate_splat(-1) is None

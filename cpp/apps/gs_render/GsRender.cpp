@@ -16,6 +16,8 @@
 #include "../RunReportingErrors.h"
 #include "CameraPathRender.h"
 #include "FilamentRender.h"
+#include "GsRenderOptions.h"
+#include "RenderOutputs.h"
 #include "open3d/camera/CamerasJson.h"
 #include "open3d/camera/PinholeCamera.h"
 #include "open3d/core/Exception.h"
@@ -38,183 +40,18 @@
 namespace {
 
 using namespace open3d;
+using gs_render::CheckImageMemory;
+using gs_render::CheckOutputs;
+using gs_render::Options;
+using gs_render::PathOptions;
+using gs_render::WriteOutputs;
 namespace rendering = open3d::visualization::rendering;
-
-struct Options {
-    std::string input;
-    std::string cameras;
-    int view = 0;
-    int width = 0;
-    int height = 0;
-    std::string backend = "vulkan";
-    bool backend_given = false;
-    std::string output = "render.png";
-    std::string depth_output;
-    std::string depth_kind = "expected";
-    double depth_scale = 1000.0;
-    std::string float_output;
-    int sh_degree = 3;
-    bool antialias = false;
-    std::vector<double> background;
-    double near_plane = 0.2;
-    std::string depth_order = "reference";
-    std::vector<double> eye, center, up;
-    std::optional<double> fov;
-    double orbit_angle = 0.0;
-    bool filament = false;
-    bool sphere = false;
-    std::optional<double> sphere_radius;
-    int frames = 1;
-    uint64_t lod_budget = 0;  // 0: no level of detail
-    std::string lod;          // hierarchy file; default <input>.lod, else built here
-    std::string camera_path;  // --camera-path: render a path instead of one view
-    double fps = 30.0;
-    double seconds_per_keyframe = 2.0;
-};
 
 Eigen::Vector3d ToVec(const std::vector<double>& v) { return Eigen::Vector3d(v[0], v[1], v[2]); }
 
 using apps::kFinite;
 using apps::kPositive;
 using apps::kUnit;
-
-gs_render::CameraPathOptions PathOptions(const Options& opt) {
-    gs_render::CameraPathOptions path;
-    path.path_file = opt.camera_path;
-    path.fps = opt.fps;
-    path.seconds_per_keyframe = opt.seconds_per_keyframe;
-    path.width = opt.width;
-    path.height = opt.height;
-    path.output = opt.output;
-    return path;
-}
-
-// Every output is checked before the scene is read: a run that cannot write its result
-// fails at once instead of after loading and rendering, and the extension decides the
-// format (a .jpg depth output was written as PNG bytes).
-void CheckOutputs(const Options& opt) {
-    if (!opt.camera_path.empty()) {
-        const char* single = !opt.depth_output.empty()    ? "--depth-output"
-                             : !opt.float_output.empty()  ? "--float-output"
-                             : opt.filament || opt.sphere ? "--filament/--sphere"
-                             : opt.lod_budget > 0         ? "--lod-budget"
-                             : !opt.cameras.empty()       ? "--cameras"
-                             : !opt.eye.empty() || !opt.center.empty() || opt.fov
-                                 ? "--eye/--center/--fov"
-                                 : nullptr;
-        if (single != nullptr) {
-            core::ThrowError(
-                "{} is for a single view; --camera-path '{}' renders the path's "
-                "cameras into -o only",
-                single, opt.camera_path);
-        }
-        gs_render::CheckCameraPathOutput(PathOptions(opt));
-        t::io::CheckOutputIsNotAnInput(
-            "-o/--output", opt.output,
-            {{"--input", opt.input}, {"--camera-path", opt.camera_path}});
-        return;
-    }
-    struct Output {
-        const char* flag;
-        const std::string& path;
-        std::vector<std::string> extensions;
-        const char* formats;
-    };
-    const std::vector<Output> outputs = {
-        {"-o/--output", opt.output, {"png", "npy"}, ".png (8-bit RGB) or .npy (float RGB)"},
-        {"--depth-output",
-         opt.depth_output,
-         {"png", "npy"},
-         ".png (16-bit, view z * --depth-scale) or .npy (float view z)"},
-        {"--float-output", opt.float_output, {"npy"}, ".npy (premultiplied RGBA float32)"},
-    };
-    for (size_t i = 0; i < outputs.size(); ++i) {
-        const Output& o = outputs[i];
-        if (o.path.empty() && i > 0) continue;  // optional outputs not asked for
-        t::io::CheckOutputPath(o.flag, o.path);
-        t::io::CheckOutputIsNotAnInput(
-            o.flag, o.path,
-            {{"--input", opt.input}, {"--cameras", opt.cameras}, {"--lod", opt.lod}});
-        const std::string ext = t::io::LowerCaseExtension(o.path);
-        if (std::find(o.extensions.begin(), o.extensions.end(), ext) == o.extensions.end()) {
-            core::ThrowError("{} '{}': unknown extension '{}'; use {}", o.flag, o.path,
-                             ext.empty() ? "(none)" : "." + ext, o.formats);
-        }
-        for (size_t j = 0; j < i; ++j) {
-            if (!outputs[j].path.empty() && t::io::SameOutputPath(o.path, outputs[j].path)) {
-                core::ThrowError("{} and {} are the same file '{}'; give each its own path",
-                                 outputs[j].flag, o.flag, o.path);
-            }
-        }
-    }
-    if (!opt.float_output.empty() && (opt.filament || opt.sphere)) {
-        core::ThrowError(
-            "--float-output is not available with --filament/--sphere (the Filament path "
-            "returns 8-bit colour)");
-    }
-}
-
-// Writes every requested image to a temporary beside its output, then renames them all:
-// a failing write leaves neither a partial file nor some of the outputs without the rest.
-void WriteOutputs(const Options& opt, const t::geometry::Image& color,
-                  const t::geometry::Image* depth, const std::string& depth_what,
-                  const t::geometry::Image* float_color) {
-    t::io::OutputFileSet files;
-    files.Write(opt.output, [&](const std::string& path) { t::io::WriteImage(path, color); });
-    int64_t saturated = 0;
-    const bool depth_npy = t::io::LowerCaseExtension(opt.depth_output) == "npy";
-    if (depth != nullptr) {
-        files.Write(opt.depth_output, [&](const std::string& path) {
-            if (depth_npy) {
-                t::io::WriteNpy(path, *depth);
-            } else {
-                saturated = t::io::WritePNG16(path, *depth, opt.depth_scale);
-            }
-        });
-    }
-    if (float_color != nullptr) {
-        files.Write(opt.float_output,
-                    [&](const std::string& path) { t::io::WriteNpy(path, *float_color); });
-    }
-    files.Commit();
-    std::printf("wrote %s\n", opt.output.c_str());
-    if (depth != nullptr) {
-        std::printf("wrote %s (%s)\n", opt.depth_output.c_str(), depth_what.c_str());
-        if (saturated > 0) {
-            std::fprintf(stderr,
-                         "gs-render: warning: %lld of %lld depth pixels are farther than %g "
-                         "scene units (65535 / --depth-scale %g) and were saturated to 65535 in "
-                         "'%s'; lower --depth-scale or write .npy for exact depths\n",
-                         static_cast<long long>(saturated),
-                         static_cast<long long>(depth->NumPixels()), 65535.0 / opt.depth_scale,
-                         opt.depth_scale, opt.depth_output.c_str());
-        }
-    }
-    if (float_color != nullptr) std::printf("wrote %s (float RGBA)\n", opt.float_output.c_str());
-}
-
-// The render's images and every copy the outputs make, before anything is drawn: the
-// backends check their own images (colour RGBA32F and two float depths, 24 B/px), but the
-// 8-bit colour, the depth image and the float dump are more (a 30000x30000 view passed the
-// backend's check and was killed for memory writing them).
-void CheckImageMemory(const Options& opt, const camera::PinholeCamera& cam) {
-    uint64_t per_pixel = 4 * 4 + 4 + 4;  // the backend's images
-    per_pixel += 3;                      // 8-bit RGB for the PNG (or 12 B: float RGB .npy)
-    if (t::io::LowerCaseExtension(opt.output) == "npy") per_pixel += 9;
-    if (!opt.depth_output.empty()) per_pixel += 4;  // 16-bit PNG or float .npy
-    if (!opt.float_output.empty()) per_pixel += 16;
-    const uint64_t pixels = uint64_t(cam.width) * uint64_t(cam.height);
-    const uint64_t available = core::AvailableHostMemory();
-    const double scale = pixels * per_pixel > available
-                             ? std::sqrt(double(available) / double(pixels * per_pixel)) * 0.9
-                             : 1.0;
-    core::RequireHostMemory(
-        pixels * per_pixel,
-        fmt::format("gs-render: a {}x{} render and its outputs ({} bytes a pixel)", cam.width,
-                    cam.height, per_pixel),
-        fmt::format("{}x{} would fit", std::max(1, int(cam.width * scale)),
-                    std::max(1, int(cam.height * scale))));
-}
 
 // --view of --cameras, read before the scene (a bad index fails at once, not after seconds of
 // loading); nothing without --cameras.
@@ -403,7 +240,7 @@ int Run(const Options& opt) {
         const gs_render::FilamentImages images =
             gs_render::RenderWithFilament(cloud, cam, config, fo);
         WriteOutputs(opt, images.color, fo.depth ? &images.depth : nullptr,
-                     "merged splat and mesh depth", nullptr);
+                     "merged splat and mesh depth", nullptr, nullptr);
         std::printf("total time %.1f ms\n", core::MillisecondsSince(start));
         return 0;
     }
@@ -430,6 +267,7 @@ int Run(const Options& opt) {
     rendering::CompositeInputs inputs;  // the depth image to write, if any
     inputs.expected_depth = !opt.depth_output.empty() && opt.depth_kind != "median";
     inputs.median_depth = !opt.depth_output.empty() && opt.depth_kind == "median";
+    inputs.splat_id = !opt.id_output.empty();
     backend->RenderCompositeStage(out, inputs);
     const double render_ms = core::MillisecondsSince(render_start);
     const auto& s = out.stats;
@@ -453,7 +291,8 @@ int Run(const Options& opt) {
     }
     const auto& depth = opt.depth_kind == "median" ? out.depth_median : out.depth_expected;
     WriteOutputs(opt, out.color.SelectChannels(0, 3), opt.depth_output.empty() ? nullptr : &depth,
-                 opt.depth_kind + " depth", opt.float_output.empty() ? nullptr : &out.color);
+                 opt.depth_kind + " depth", opt.float_output.empty() ? nullptr : &out.color,
+                 opt.id_output.empty() ? nullptr : &out.splat_id);
     std::printf("total time %.1f ms\n", core::MillisecondsSince(start));
     return 0;
 }
@@ -505,6 +344,10 @@ int main(int argc, char** argv) {
         ->check(kPositive)
         ->capture_default_str();
     app.add_option("--float-output", opt.float_output, "Premultiplied RGBA float32 dump (.npy)");
+    app.add_option("--id-output", opt.id_output,
+                   "ID image (.npy, int32 H x W): the index in --input of the splat that "
+                   "contributes most to each pixel, -1 where none (docs/editing.md); not with "
+                   "--filament/--sphere or --lod-budget");
     app.add_option("--sh-degree", opt.sh_degree, "Highest SH degree evaluated")
         ->check(CLI::Range(0, 3))
         ->capture_default_str();

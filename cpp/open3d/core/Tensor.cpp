@@ -20,6 +20,8 @@ int64_t DtypeSize(Dtype dtype) {
             return 1;
         case Dtype::UInt16:
             return 2;
+        case Dtype::Int32:
+            return 4;
     }
     ThrowError("Tensor: unknown dtype {}", static_cast<int>(dtype));
 }
@@ -32,6 +34,8 @@ std::string DtypeName(Dtype dtype) {
             return "UInt8";
         case Dtype::UInt16:
             return "UInt16";
+        case Dtype::Int32:
+            return "Int32";
     }
     ThrowError("Tensor: unknown dtype {}", static_cast<int>(dtype));
 }

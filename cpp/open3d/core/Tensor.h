@@ -1,6 +1,6 @@
 // A small typed, contiguous, owning array for per-point attributes.
-// Only what the splat data model needs: float32, uint8 and uint16 (normalised depth), any
-// rank, row-major.
+// Only what the splat data model needs: float32, uint8, uint16 (normalised depth) and int32
+// (splat ID images), any rank, row-major.
 #pragma once
 
 #include <algorithm>
@@ -12,7 +12,7 @@
 namespace open3d {
 namespace core {
 
-enum class Dtype { Float32, UInt8, UInt16 };
+enum class Dtype { Float32, UInt8, UInt16, Int32 };
 
 /// Size of one element in bytes.
 int64_t DtypeSize(Dtype dtype);
@@ -31,6 +31,10 @@ constexpr Dtype DtypeOf<uint8_t>() {
 template <>
 constexpr Dtype DtypeOf<uint16_t>() {
     return Dtype::UInt16;
+}
+template <>
+constexpr Dtype DtypeOf<int32_t>() {
+    return Dtype::Int32;
 }
 
 using SizeVector = std::vector<int64_t>;

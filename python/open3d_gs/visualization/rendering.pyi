@@ -84,6 +84,9 @@ class OffscreenRenderer:
     def height(self) -> int:
         """Picture height in pixels"""
         ...
+    def locate_splat(self, id: int) -> object:
+        """(geometry name, index in that geometry) of an ID from render_to_id_image, as the scene stood at the last render; None for -1"""
+        ...
     @property
     def meshes(self) -> bool:
         """Whether Filament draws (meshes=True)"""
@@ -104,6 +107,9 @@ class OffscreenRenderer:
     @overload
     def render_to_depth_image(self, z_in_view_space: bool, kind: str = ...) -> numpy.ndarray:
         """Open3D's positional form, render_to_depth_image(True): see the first form"""
+        ...
+    def render_to_id_image(self) -> object:
+        """(H, W) int32: at each pixel the splat that contributes most to it (the largest blend weight alpha T, the first of equal ones front to back), as its index in the renderer's scene (its geometries in name order, one after another); -1 where no splat is. locate_splat(id) gives the geometry and the index in it. The same on the cpu and vulkan backends (docs/editing.md "ID images"); not with meshes=True"""
         ...
     def render_to_image(self, dtype: Optional[str] = ..., *, alpha: Optional[bool] = ...) -> numpy.ndarray:
         """The picture of the camera. float32 (the default without meshes): (H, W, 4) RGBA, rgb = C + T * background and a = 1 - T (premultiplied RGBA when the background is black, the default). uint8 (the default and only choice with meshes): (H, W, 3) RGB rounded to nearest, as Open3D's. alpha=True / False asks for RGBA / RGB instead (without meshes); render_batch follows the same rule"""

@@ -29,6 +29,8 @@ double ReadAsDouble(const core::Tensor& t, int64_t i) {
             return t.Data<uint8_t>()[i];
         case core::Dtype::UInt16:
             return t.Data<uint16_t>()[i];
+        case core::Dtype::Int32:
+            return t.Data<int32_t>()[i];
     }
     core::ThrowError("Image: unknown dtype {}", static_cast<int>(t.GetDtype()));
 }

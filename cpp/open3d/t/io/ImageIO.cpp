@@ -92,6 +92,8 @@ const char* NpyDescr(core::Dtype dtype) {
             return "|u1";
         case core::Dtype::UInt16:
             return "<u2";
+        case core::Dtype::Int32:
+            return "<i4";
     }
     core::ThrowError("npy: unknown dtype {}", static_cast<int>(dtype));
 }
@@ -250,7 +252,8 @@ geometry::Image ReadNpy(const std::string& filename) {
     std::string header(len, '\0');
     in.read(header.data(), static_cast<std::streamsize>(len));
     std::optional<core::Dtype> dtype;
-    for (const core::Dtype d : {core::Dtype::Float32, core::Dtype::UInt8, core::Dtype::UInt16}) {
+    for (const core::Dtype d :
+         {core::Dtype::Float32, core::Dtype::UInt8, core::Dtype::UInt16, core::Dtype::Int32}) {
         if (header.find(fmt::format("'{}'", NpyDescr(d))) != std::string::npos) dtype = d;
     }
     long long rows = 0, cols = 0, channels = 0;

@@ -36,6 +36,11 @@ struct RenderOutput {
     /// 0 where the accumulated alpha never reaches one half. Empty unless
     /// CompositeInputs::median_depth.
     t::geometry::Image depth_median;
+    /// Int32 [H, W, 1]: the splat with the largest blend weight alpha_i T_i at the pixel (the
+    /// first of equal ones, front to back) as its index in the cloud given to SetScene; -1
+    /// where no splat blends (docs/editing.md "ID images"). Empty unless
+    /// CompositeInputs::splat_id.
+    t::geometry::Image splat_id;
     RenderStats stats;
 };
 
@@ -53,6 +58,8 @@ struct CompositeInputs {
     /// blended splat: a colour-only composite took 8-10% less GPU time on an H100.
     bool expected_depth = true;
     bool median_depth = true;
+    /// The ID image of RenderOutput::splat_id: one comparison per blended splat on GPUs.
+    bool splat_id = false;
 };
 
 /// What RenderBatch produces for each view.

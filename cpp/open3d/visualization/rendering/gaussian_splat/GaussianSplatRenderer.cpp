@@ -199,6 +199,28 @@ std::vector<uint32_t> GaussianSplatRenderer::VisibilityMask() const {
     return mask;
 }
 
+std::optional<std::pair<std::string, int64_t>> GaussianSplatRenderer::LocateSplat(
+    int64_t id) const {
+    if (stream_) {
+        core::ThrowError(
+            "GaussianSplatRenderer: a streamed scene's IDs are pool slots, not splats");
+    }
+    if (merged_dirty_) {
+        core::ThrowError(
+            "GaussianSplatRenderer: the clouds changed since the last frame; render again to "
+            "get IDs of the scene as it is");
+    }
+    if (id < 0) return std::nullopt;
+    for (const auto& [name, cloud] : clouds_) {
+        // Hidden clouds are left out of the merged scene unless the mask hides them.
+        if (!merged_uses_mask_ && !cloud.visible) continue;
+        if (id >= cloud.first && id < cloud.first + NumSplats(cloud.cloud)) {
+            return std::pair{name, id - cloud.first};
+        }
+    }
+    return std::nullopt;
+}
+
 void GaussianSplatRenderer::Prepare() {
     if (stream_) {
         if (std::optional<SplatStreamStep> step = stream_->Take()) {

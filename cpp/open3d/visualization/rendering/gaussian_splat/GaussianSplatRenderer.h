@@ -17,6 +17,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "open3d/camera/PinholeCamera.h"
@@ -93,6 +94,12 @@ public:
 
     /// Uploads the merged scene or the visibility mask when they changed.
     void Prepare();
+
+    /// The cloud and the index in it of splat `id` of the merged scene (an ID image's value,
+    /// RenderOutput::splat_id), as of the last Prepare; nullopt for -1 or an ID past the
+    /// scene. Throws core::Open3DError while a stream runs (its IDs are pool slots) or when
+    /// the clouds changed since the last Prepare.
+    std::optional<std::pair<std::string, int64_t>> LocateSplat(int64_t id) const;
 
     /// Geometry stage of view `view_id` (any caller-chosen key): submitted, not waited for.
     void RenderGeometryStage(uint64_t view_id, const camera::PinholeCamera& camera,

@@ -1,5 +1,7 @@
 #include "open3d/visualization/rendering/gaussian_splat/PlaceholderBackend.h"
 
+#include <algorithm>
+
 #include "open3d/core/Exception.h"
 #include "open3d/core/Logging.h"
 
@@ -25,7 +27,8 @@ void PlaceholderBackend::RenderGeometryStage(const camera::PinholeCamera& camera
     config_ = config;
 }
 
-void PlaceholderBackend::RenderCompositeStage(RenderOutput& output, const CompositeInputs&) {
+void PlaceholderBackend::RenderCompositeStage(RenderOutput& output,
+                                              const CompositeInputs& inputs) {
     if (!camera_) core::ThrowError("RenderCompositeStage called before RenderGeometryStage");
     const int h = camera_->height, w = camera_->width;
     output.color = t::geometry::Image(h, w, 4, core::Dtype::Float32);
@@ -36,6 +39,12 @@ void PlaceholderBackend::RenderCompositeStage(RenderOutput& output, const Compos
     }
     output.depth_expected = t::geometry::Image(h, w, 1, core::Dtype::Float32);
     output.depth_median = t::geometry::Image(h, w, 1, core::Dtype::Float32);
+    // Nothing is drawn: no pixel shows a splat.
+    output.splat_id = t::geometry::Image();
+    if (inputs.splat_id) {
+        output.splat_id = t::geometry::Image(h, w, 1, core::Dtype::Int32);
+        std::fill_n(output.splat_id.Data<int32_t>(), output.splat_id.NumPixels(), -1);
+    }
     output.stats = RenderStats{};
     output.stats.num_splats = num_splats_;
 }

@@ -4,11 +4,13 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
+#include <random>
 #include <vector>
 
 #include "SplatTestScene.h"
 #include "open3d/core/Exception.h"
 #include "open3d/visualization/rendering/gaussian_splat/cpu/Composite.h"
+#include "open3d/visualization/rendering/gaussian_splat/cpu/CpuBackend.h"
 #include "open3d/visualization/rendering/gaussian_splat/cpu/Picking.h"
 #include "open3d/visualization/rendering/gaussian_splat/cpu/Projection.h"
 #include "open3d/visualization/rendering/gaussian_splat/cpu/TileLists.h"
@@ -79,6 +81,43 @@ TEST(Picking, ThePointLiesOnTheRayAtTheCompositesDepth) {
         EXPECT_NEAR(cam.fx * view.x() / view.z() + cam.cx, x, 1e-9);
         EXPECT_NEAR(cam.fy * view.y() / view.z() + cam.cy, y, 1e-9);
     }
+}
+
+TEST(Picking, TheIdImageHoldsEveryPixelsPick) {
+    // The composite's ID image (RenderOutput::splat_id) and PickPixel walk the same blend;
+    // 60 overlapping splats of random size, depth and opacity make most pixels a contest.
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    std::vector<TestSplat> splats(60);
+    for (TestSplat& s : splats) {
+        s.position = {u(rng) - 0.5, u(rng) - 0.5, 4.0 + 2.0 * u(rng)};
+        s.scale = {0.03 + 0.15 * u(rng), 0.03 + 0.15 * u(rng), 0.1};
+        s.opacity = 0.1 + 0.85 * u(rng);
+    }
+    const t::geometry::PointCloud cloud = MakeCloud(splats);
+    const camera::PinholeCamera cam = MakeTestCamera();
+    const RenderConfig config;
+    cpu::CpuBackend backend;
+    backend.SetScene(cloud);
+    visualization::rendering::CompositeInputs inputs;
+    inputs.splat_id = true;
+    const visualization::rendering::RenderOutput out = backend.Render(cam, config, inputs);
+    ASSERT_EQ(out.splat_id.GetDtype(), core::Dtype::Int32);
+    ASSERT_EQ(out.splat_id.GetRows(), cam.height);
+    int hits = 0;
+    for (int y = 0; y < cam.height; ++y) {
+        for (int x = 0; x < cam.width; ++x) {
+            const cpu::PickResult pick = cpu::PickPixel(cloud, cam, config, x, y);
+            ASSERT_EQ(out.splat_id.Data<int32_t>()[y * cam.width + x], pick.splat)
+                << "pixel " << x << ", " << y;
+            hits += pick.hit;
+        }
+    }
+    // Both outcomes occur: covered pixels and the background in the corners.
+    EXPECT_GT(hits, 1000);
+    EXPECT_LT(hits, cam.width * cam.height);
+    // Not asked for: no image.
+    EXPECT_TRUE(backend.Render(cam, config, {}).splat_id.IsEmpty());
 }
 
 TEST(Picking, AnEmptyPixelMissesAndOneOutsideIsRefused) {

@@ -31,8 +31,8 @@ void CompositeTiles(const std::vector<ProjectedSplat>& splats, const TileLists& 
         core::ThrowError("CompositeTiles: scene depth must be Float32 [{}, {}, 1]", height, width);
     }
     {
-        // The colour (RGBA32F) and the two depths (float32) of every pixel.
-        const uint64_t per_pixel = 4 * 4 + 4 + 4;
+        // The colour (RGBA32F), the two depths (float32) and the ID (int32) of every pixel.
+        const uint64_t per_pixel = 4 * 4 + 4 + 4 + (inputs.splat_id ? 4 : 0);
         const uint64_t need = per_pixel * uint64_t(width) * height;
         const uint64_t available = core::AvailableHostMemory();
         const double scale = need > available ? std::sqrt(double(available) / need) * 0.9 : 1.0;
@@ -43,9 +43,15 @@ void CompositeTiles(const std::vector<ProjectedSplat>& splats, const TileLists& 
     output.color = t::geometry::Image(height, width, 4, core::Dtype::Float32);
     output.depth_expected = t::geometry::Image(height, width, 1, core::Dtype::Float32);
     output.depth_median = t::geometry::Image(height, width, 1, core::Dtype::Float32);
-    float* color = output.color.Data<float>();                                // [H, W, 4]
-    float* depth_expected = output.depth_expected.Data<float>();              // [H, W, 1]
-    float* depth_median = output.depth_median.Data<float>();                  // [H, W, 1]
+    float* color = output.color.Data<float>();                    // [H, W, 4]
+    float* depth_expected = output.depth_expected.Data<float>();  // [H, W, 1]
+    float* depth_median = output.depth_median.Data<float>();      // [H, W, 1]
+    int32_t* splat_id = nullptr;                                  // [H, W, 1]
+    output.splat_id = t::geometry::Image();
+    if (inputs.splat_id) {
+        output.splat_id = t::geometry::Image(height, width, 1, core::Dtype::Int32);
+        splat_id = output.splat_id.Data<int32_t>();
+    }
     const float* scene = scene_depth ? scene_depth->Data<float>() : nullptr;  // [H, W, 1]
     const Eigen::Vector3d bg = config.background;
 
@@ -67,6 +73,8 @@ void CompositeTiles(const std::vector<ProjectedSplat>& splats, const TileLists& 
                     double weighted_depth = 0.0;
                     double median = 0.0;
                     bool median_found = false;
+                    double best_weight = 0.0;  // the dominant splat: strictly larger wins
+                    int32_t best = -1;
                     const double transmittance =
                         BlendPixel(local, px, py, limit_depth,
                                    [&](const TileSplat& s, double w, double transmittance_after) {
@@ -78,6 +86,10 @@ void CompositeTiles(const std::vector<ProjectedSplat>& splats, const TileLists& 
                                            median = s.depth;
                                            median_found = true;
                                        }
+                                       if (w > best_weight) {
+                                           best_weight = w;
+                                           best = static_cast<int32_t>(s.index);
+                                       }
                                    });
                     const double accumulated = 1.0 - transmittance;
                     for (int ch = 0; ch < 3; ++ch) {
@@ -87,6 +99,7 @@ void CompositeTiles(const std::vector<ProjectedSplat>& splats, const TileLists& 
                     depth_expected[pixel] =
                         accumulated > 0.0 ? static_cast<float>(weighted_depth / accumulated) : 0.f;
                     depth_median[pixel] = static_cast<float>(median);
+                    if (splat_id) splat_id[pixel] = best;
                 }
             }
         },

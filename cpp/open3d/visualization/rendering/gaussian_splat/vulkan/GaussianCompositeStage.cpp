@@ -23,6 +23,7 @@ namespace {
 using namespace shader;  // the contract's constants and structs
 
 static_assert(kCompositeTileSize == static_cast<uint32_t>(rendering::kTileSize));
+static_assert(kNoSplatId == kCompositeNoSplat);
 // The GPU compares against the same float32 thresholds the reference widens to double.
 static_assert(static_cast<double>(kCompositeMaxAlpha) == cpu::kMaxAlpha);
 static_assert(static_cast<double>(kCompositeMinAlpha) == cpu::kMinAlpha);
@@ -130,6 +131,8 @@ GaussianCompositeStage::GaussianCompositeStage(const VulkanContext& context) : c
     merge_layout_ = CreatePipelineLayout(context, merge_set_layout_.Get(),
                                          sizeof(GaussianDepthMergePushConstants));
     placeholder_depth_ = Image(context, 1, 1, VK_FORMAT_R32_SFLOAT, VK_IMAGE_USAGE_SAMPLED_BIT);
+    placeholder_splat_id_ =
+        Image(context, 1, 1, kSplatIdFormat, GetStorageRequirements().image_usage);
 }
 
 CompositeStageStorageRequirements GaussianCompositeStage::GetStorageRequirements() {
@@ -155,11 +158,13 @@ VkPipeline GaussianCompositeStage::GetCompositePipeline(CompositeColorFormat for
                                                         bool color_buffer) {
     const bool scene_depth = params.scene_depth != nullptr;
     const uint32_t depth_outputs = (params.expected_depth ? kCompositeExpectedDepthBit : 0u) |
-                                   (params.median_depth ? kCompositeMedianDepthBit : 0u);
-    static_assert(kCompositeExpectedDepthBit == 1u && kCompositeMedianDepthBit == 2u);
+                                   (params.median_depth ? kCompositeMedianDepthBit : 0u) |
+                                   (params.splat_id ? kCompositeSplatIdBit : 0u);
+    static_assert(kCompositeExpectedDepthBit == 1u && kCompositeMedianDepthBit == 2u &&
+                  kCompositeSplatIdBit == 4u);
     const uint32_t format_index = static_cast<uint32_t>(format);
-    UniquePipeline& pipeline = composite_[(color_buffer ? 24u : 0u) + format_index * 8u +
-                                          (scene_depth ? 4u : 0u) + depth_outputs];
+    UniquePipeline& pipeline = composite_[(color_buffer ? 48u : 0u) + format_index * 16u +
+                                          (scene_depth ? 8u : 0u) + depth_outputs];
     if (!pipeline) {
         std::span<const uint32_t> code = spirv::kGaussianComposite;
         const char* name = "gaussian_composite";
@@ -201,6 +206,18 @@ VkDescriptorImageInfo GaussianCompositeStage::SceneDepthDescriptor(
     return {VK_NULL_HANDLE, placeholder_depth_.GetView(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
 }
 
+VkDescriptorImageInfo GaussianCompositeStage::SplatIdDescriptor(VkCommandBuffer cmd,
+                                                                VkImageView splat_id) const {
+    if (splat_id != VK_NULL_HANDLE) return StorageImage(splat_id);
+    // As for the scene depth: never written without kCompositeSplatIdBit, but the binding is
+    // statically used. UNDEFINED -> GENERAL each time, after any earlier dispatch.
+    RecordImageBarrier(
+        cmd, placeholder_splat_id_.Get(), VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
+        VK_IMAGE_LAYOUT_GENERAL, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_NONE,
+        VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
+    return StorageImage(placeholder_splat_id_.GetView());
+}
+
 void GaussianCompositeStage::RecordComposite(VkCommandBuffer cmd,
                                              const CompositeStageInputs& inputs,
                                              const CompositeStageTargets& targets,
@@ -214,6 +231,7 @@ void GaussianCompositeStage::RecordComposite(VkCommandBuffer cmd,
     RequireView(targets.depth, "depth");
     RequireView(targets.alpha, "alpha");
     RequireView(targets.median_depth, "median_depth");
+    if (params.splat_id) RequireView(targets.splat_id, "splat_id");
     const VkDeviceSize alignment = context_.GetDeviceInfo().min_storage_buffer_offset_alignment;
     for (const BufferRange* range : {&inputs.entry_keys, &inputs.entry_values, &state}) {
         if (range->buffer == VK_NULL_HANDLE || range->offset % alignment != 0) {
@@ -308,12 +326,13 @@ void GaussianCompositeStage::RecordComposite(VkCommandBuffer cmd,
         {state.buffer, state.offset, state_bytes},
         color_buffer_info,
     }};
-    const std::array<VkDescriptorImageInfo, 5> images{{
+    const std::array<VkDescriptorImageInfo, 6> images{{
         StorageImage(targets.color),
         StorageImage(targets.depth),
         StorageImage(targets.alpha),
         StorageImage(targets.median_depth),
         SceneDepthDescriptor(cmd, params.scene_depth),
+        SplatIdDescriptor(cmd, params.splat_id ? targets.splat_id : VK_NULL_HANDLE),
     }};
     const std::array<VkWriteDescriptorSet, kCompositeNumBindings> writes{{
         BufferWrite(kCompositeEntryKeysBinding, &buffers[0]),
@@ -326,6 +345,7 @@ void GaussianCompositeStage::RecordComposite(VkCommandBuffer cmd,
         ImageWrite(kCompositeMedianDepthBinding, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, &images[3]),
         ImageWrite(kCompositeSceneDepthBinding, VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE, &images[4]),
         BufferWrite(kCompositeColorBufferBinding, &buffers[4]),
+        ImageWrite(kCompositeSplatIdBinding, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, &images[5]),
     }};
     // Both pipelines share the layout: descriptors and push constants are set once.
     context_.GetCmdPushDescriptorSet()(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, composite_layout_.Get(),

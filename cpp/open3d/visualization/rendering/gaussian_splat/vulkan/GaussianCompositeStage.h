@@ -36,6 +36,12 @@ enum class CompositeColorFormat {
 
 VkFormat ToVkFormat(CompositeColorFormat format);
 
+/// The ID image's format: the dominant splat's index, kCompositeNoSplat (-1 as int32) where
+/// no splat blends.
+inline constexpr VkFormat kSplatIdFormat = VK_FORMAT_R32_UINT;
+/// The ID image where no splat blends (== shader::kCompositeNoSplat).
+inline constexpr uint32_t kNoSplatId = 0xFFFFFFFFu;
+
 /// Formats and usages of what the caller allocates for composite stage.
 struct CompositeStageStorageRequirements {
     /// Usage of the composite's state buffer (its size: GaussianCompositeStage::StateBytes).
@@ -82,6 +88,10 @@ struct CompositeStageTargets {
     /// R32F view z of the splat that brings 1 - T to >= 0.5; 0 where it never gets there.
     /// Written only with CompositeParams::median_depth.
     VkImageView median_depth = VK_NULL_HANDLE;
+    /// R32_UINT (kSplatIdFormat) splat index of the largest alpha_i T_i at the pixel (the
+    /// first of equal ones), kCompositeNoSplat where nothing blends. Needed only with
+    /// CompositeParams::splat_id.
+    VkImageView splat_id = VK_NULL_HANDLE;
     /// Optional, RGBA32F only: the colour goes here instead of `color` (which must still be
     /// a valid view; it is left as it was): width x height vec4 row-major, the floats the
     /// image would hold. A storage buffer range at a minStorageBufferOffsetAlignment offset,
@@ -110,6 +120,8 @@ struct CompositeParams {
     /// one not asked for costs nothing per blended splat (the images it leaves keep old values).
     bool expected_depth = true;  ///< expected depth and alpha
     bool median_depth = true;
+    /// The ID image (CompositeStageTargets::splat_id), a specialisation like the depths.
+    bool splat_id = false;
     /// Workgroups of the grid (workgroup i does tile i, then steals tiles from a counter):
     /// 0 = min(tiles, kDefaultMaxWorkgroups) on GPUs, one per tile on CPU devices.
     uint32_t max_workgroups = 0;
@@ -186,10 +198,13 @@ private:
     UniqueDescriptorSetLayout merge_set_layout_;
     UniquePipelineLayout merge_layout_;
     UniquePipeline tile_ranges_;
-    // [colour buffer][format][scene depth][expected depth][median depth]
-    std::array<UniquePipeline, 48> composite_;  // buffer * 24 + format * 8 + depth * 4 + outputs
+    VkDescriptorImageInfo SplatIdDescriptor(VkCommandBuffer cmd, VkImageView splat_id) const;
+
+    // [colour buffer][format][scene depth][splat ID][expected depth][median depth]
+    std::array<UniquePipeline, 96> composite_;  // buffer * 48 + format * 16 + depth * 8 + outputs
     std::array<UniquePipeline, 2> merge_;       // [scene depth]
     Image placeholder_depth_;
+    Image placeholder_splat_id_;  // bound when no ID image is asked for
 };
 
 }  // namespace vulkan

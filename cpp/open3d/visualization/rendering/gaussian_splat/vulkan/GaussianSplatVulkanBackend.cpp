@@ -2,6 +2,7 @@
 #include "open3d/core/Timer.h"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstddef>
@@ -99,11 +100,11 @@ void GaussianSplatVulkanBackend::ReleaseResources() {
     cloud_.reset();
     visibility_mask_.clear();
     geometry_stage_resources_ = GeometryStageResources();
-    for (Buffer* buffer :
-         {&counters_readback_, &color_readback_, &depth_readback_, &median_readback_}) {
+    for (Buffer* buffer : {&counters_readback_, &color_readback_, &depth_readback_,
+                           &median_readback_, &splat_id_readback_}) {
         *buffer = Buffer();
     }
-    for (Image* image : {&depth_, &alpha_, &median_, &color_}) *image = Image();
+    for (Image* image : {&depth_, &alpha_, &median_, &color_, &splat_id_}) *image = Image();
     width_ = height_ = 0;
 }
 
@@ -267,8 +268,25 @@ public:
           output_(output),
           read_back_(inputs.read_back),
           expected_depth_(inputs.expected_depth),
-          median_depth_(inputs.median_depth) {
+          median_depth_(inputs.median_depth),
+          splat_id_(inputs.splat_id) {
         const uint32_t w = backend.color_.GetWidth(), h = backend.color_.GetHeight();
+        // Through a hierarchy the composite blends cut nodes, not the scene's splats.
+        if (splat_id_ && backend.geometry_stage_resources_.HasLod()) {
+            core::ThrowError(
+                "Vulkan backend: no ID image for a scene drawn through a level-of-detail "
+                "hierarchy (its pixels show merged nodes, not splats of the cloud)");
+        }
+        if (splat_id_ && (!backend.splat_id_ || backend.splat_id_.GetWidth() != w ||
+                          backend.splat_id_.GetHeight() != h)) {
+            backend.splat_id_ =
+                Image(*backend.context_, w, h, kSplatIdFormat,
+                      GaussianCompositeStage::GetStorageRequirements().image_usage |
+                          VK_IMAGE_USAGE_TRANSFER_SRC_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT);
+            backend.splat_id_readback_ =
+                Buffer(*backend.context_, VkDeviceSize(w) * h * 4, VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                       MemoryUsage::kHostReadback);
+        }
         if (inputs.scene_depth == nullptr || inputs.scene_depth->IsEmpty()) return;
         // Scene depth (view z) becomes Filament's reversed-Z texture d = near / z.
         const t::geometry::Image& z = *inputs.scene_depth;
@@ -296,6 +314,7 @@ public:
         params.scene_depth = scene_image_ ? &scene_ : nullptr;
         params.expected_depth = expected_depth_;
         params.median_depth = median_depth_;
+        params.splat_id = splat_id_;
     }
 
     void RecordBefore(const Frame& frame) override {
@@ -312,7 +331,8 @@ public:
         const std::pair<const Image*, const Buffer*> copies[] = {
             {&backend_.color_, &backend_.color_readback_},
             {expected_depth_ ? frame.depth : nullptr, &backend_.depth_readback_},
-            {median_depth_ ? frame.median : nullptr, &backend_.median_readback_}};
+            {median_depth_ ? frame.median : nullptr, &backend_.median_readback_},
+            {frame.splat_id, &backend_.splat_id_readback_}};
         for (const auto& [image, buffer] : copies) {
             if (image == nullptr) continue;
             ToTransferSrc(frame.cmd, *image, frame.write_stage, frame.write_access);
@@ -336,6 +356,13 @@ public:
         };
         output_.depth_expected = scalar(expected_depth_, backend_.depth_readback_);
         output_.depth_median = scalar(median_depth_, backend_.median_readback_);
+        // The R32_UINT image's bits are the int32 IDs (kCompositeNoSplat is -1).
+        output_.splat_id = t::geometry::Image();
+        if (splat_id_) {
+            output_.splat_id = t::geometry::Image(h, w, 1, core::Dtype::Int32);
+            std::memcpy(output_.splat_id.Data<int32_t>(), backend_.splat_id_readback_.GetMapped(),
+                        pixels * 4);
+        }
     }
 
 private:
@@ -344,6 +371,7 @@ private:
     const bool read_back_;
     const bool expected_depth_;
     const bool median_depth_;
+    const bool splat_id_;
     Image scene_image_;
     Buffer scene_upload_;
     SceneDepthTexture scene_;
@@ -421,10 +449,17 @@ RenderStats GaussianSplatVulkanBackend::RenderComposite(CompositeSink& sink) {
     frame.depth = &depth_;
     frame.alpha = &alpha_;
     frame.median = &median_;
+    frame.splat_id = params.splat_id ? &splat_id_ : nullptr;
+    if (params.splat_id && !splat_id_) {
+        core::ThrowError(
+            "Vulkan backend: this composite's sink asks for an ID image it has none of");
+    }
     frame.composite_stage = &composite_stage_;
     frame.timestamps = &composite_stage_timestamps_;
     // The last frame copied these (readback) or read them in a depth merge.
-    for (const Image* image : {&depth_, &alpha_, &median_}) {
+    const std::array<const Image*, 4> written{&depth_, &alpha_, &median_, frame.splat_id};
+    for (const Image* image : written) {
+        if (image == nullptr) continue;
         RecordImageBarrier(cmd, image->Get(), VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
                            VK_IMAGE_LAYOUT_GENERAL,
                            VK_PIPELINE_STAGE_2_COPY_BIT | VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
@@ -440,6 +475,11 @@ RenderStats GaussianSplatVulkanBackend::RenderComposite(CompositeSink& sink) {
         vkCmdClearColorImage(cmd, color.Get(), VK_IMAGE_LAYOUT_GENERAL, &background, 1, &all);
         for (const Image* image : {&depth_, &alpha_, &median_}) {
             vkCmdClearColorImage(cmd, image->Get(), VK_IMAGE_LAYOUT_GENERAL, &zero, 1, &all);
+        }
+        if (frame.splat_id) {
+            VkClearColorValue none{};
+            none.uint32[0] = kNoSplatId;
+            vkCmdClearColorImage(cmd, splat_id_.Get(), VK_IMAGE_LAYOUT_GENERAL, &none, 1, &all);
         }
         ++counters_.skipped_composites;
     } else {
@@ -461,6 +501,7 @@ RenderStats GaussianSplatVulkanBackend::RenderComposite(CompositeSink& sink) {
         targets.depth = depth_.GetView();
         targets.alpha = alpha_.GetView();
         targets.median_depth = median_.GetView();
+        targets.splat_id = frame.splat_id ? splat_id_.GetView() : VK_NULL_HANDLE;
         composite_stage_timestamps_.RecordBegin(cmd, TimedPass::kComposite);
         composite_stage_.RecordComposite(cmd, inputs, targets, composite_state_.Range(), params);
         composite_stage_timestamps_.RecordEnd(cmd, TimedPass::kComposite);

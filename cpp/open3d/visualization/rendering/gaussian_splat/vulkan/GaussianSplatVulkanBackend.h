@@ -58,6 +58,8 @@ public:
         const Image* depth = nullptr;
         const Image* alpha = nullptr;
         const Image* median = nullptr;
+        /// The R32_UINT ID image when the sink's params ask for it (AdjustParams), else null.
+        const Image* splat_id = nullptr;
         GaussianCompositeStage* composite_stage = nullptr;
         /// Composite stage's query pool, reset for this frame (time the depth merge with it).
         const GpuTimestamps* timestamps = nullptr;
@@ -288,6 +290,9 @@ private:
     Image depth_, alpha_, median_;
     Image color_;
     Buffer color_readback_, depth_readback_, median_readback_;
+    // The ID image and its readback, made on the first composite that asks for one.
+    Image splat_id_;
+    Buffer splat_id_readback_;
 
     // The last geometry stage: what it rendered, and its command buffer while in flight.
     struct GeometryState {

@@ -313,7 +313,8 @@ std::vector<RenderOutput> GaussianSplatVulkanBackend::WaitBatch(uint64_t ticket)
 RenderOutput GaussianSplatVulkanBackend::Render(const camera::PinholeCamera& camera,
                                                 const RenderConfig& config,
                                                 const CompositeInputs& inputs) {
-    if (inputs.scene_depth != nullptr && !inputs.scene_depth->IsEmpty()) {
+    // Scene depth and the ID image are composited on the stage path only.
+    if ((inputs.scene_depth != nullptr && !inputs.scene_depth->IsEmpty()) || inputs.splat_id) {
         return GaussianSplatBackend::Render(camera, config, inputs);
     }
     BatchOptions options;
