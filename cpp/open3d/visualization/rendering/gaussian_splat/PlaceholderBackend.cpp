@@ -27,8 +27,7 @@ void PlaceholderBackend::RenderGeometryStage(const camera::PinholeCamera& camera
     config_ = config;
 }
 
-void PlaceholderBackend::RenderCompositeStage(RenderOutput& output,
-                                              const CompositeInputs& inputs) {
+void PlaceholderBackend::RenderCompositeStage(RenderOutput& output, const CompositeInputs& inputs) {
     if (!camera_) core::ThrowError("RenderCompositeStage called before RenderGeometryStage");
     const int h = camera_->height, w = camera_->width;
     output.color = t::geometry::Image(h, w, 4, core::Dtype::Float32);
