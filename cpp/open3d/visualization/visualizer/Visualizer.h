@@ -15,6 +15,7 @@
 #include <algorithm>
 #include <cstdint>
 #include <functional>
+#include <map>
 #include <memory>
 #include <optional>
 #include <string>
@@ -85,6 +86,16 @@ struct RunOptions {
     /// a stream has settled. Scripts and tests wait for that event instead of a time
     /// (max_seconds then only bounds a hang). Ignored with `continuous`.
     bool until_idle = false;
+};
+
+/// A splat picked in the window (Visualizer::PickSplat).
+struct SplatPick {
+    std::string geometry;
+    int64_t index = -1;  ///< in that geometry
+    /// The world point on the pixel's ray at the view's expected depth there.
+    Eigen::Vector3d point = Eigen::Vector3d::Zero();
+    /// From the previous pick's point; -1 for the first pick.
+    double distance_to_previous = -1.0;
 };
 
 class Visualizer : public WindowEventHandler {
@@ -270,6 +281,33 @@ public:
     }
     const std::string& GetStatus() const { return status_; }
 
+    // Editing splat clouds (docs/viewer.md "Editing"). Mouse and keys: Ctrl + click picks,
+    // Ctrl + drag selects a rectangle (Ctrl + Shift + drag adds to the selection), Delete
+    // removes the selected splats, Ctrl + I inverts the selection, Ctrl + Z undoes a removal.
+    /// The splat that contributes most to window pixel (x, y) (the composite's ID image of
+    /// the current camera) and the point there; nullopt where no splat is. Kept in GetPicks.
+    std::optional<SplatPick> PickSplat(int x, int y);
+    /// Selects the splats of the visible clouds whose centre projects into the rectangle
+    /// and that the view shows there (cpu::SelectSplatsInView, each cloud on its own);
+    /// `add` keeps the earlier selection. Returns the number selected in all.
+    int64_t SelectSplats(double x0, double y0, double x1, double y1, bool add = false);
+    /// Every splat of the clouds that have a selection becomes selected but the selected
+    /// ones. Returns the number selected in all.
+    int64_t InvertSelection();
+    void ClearSelection();
+    /// Removes the selected splats from their clouds (UpdateGeometry; undoable). Returns
+    /// the number removed.
+    int64_t DeleteSelection();
+    /// Restores the clouds as they were before the last DeleteSelection; false when there
+    /// is nothing to undo.
+    bool UndoEdit();
+    /// Selected splat indices per cloud (ascending).
+    const std::map<std::string, std::vector<int64_t>>& GetSelection() const { return selection_; }
+    const std::vector<SplatPick>& GetPicks() const { return picks_; }
+    /// Writes splat cloud `name` as it stands (edits included) in any writable format
+    /// (t::io::WritePointCloud; the extension decides). Throws naming the file.
+    void SaveGeometry(const std::string& name, const std::string& path);
+
     // WindowEventHandler: GLFW's callbacks arrive here; tests may inject events.
     void OnMouseButton(int button, bool pressed, int mods) override;
     void OnCursorPos(double x, double y) override;
@@ -280,7 +318,7 @@ public:
     void OnDrop(const std::vector<std::string>& paths) override;
 
 private:
-    enum class Drag { kNone, kRotate, kPan, kPanel };
+    enum class Drag { kNone, kRotate, kPan, kPanel, kSelect, kSelectAdd };
 
     void Init(const VisualizerOptions& options);
     void ToggleGeometry(size_t index);
@@ -348,6 +386,18 @@ private:
     double last_present_s_ = -1.0;  // steady clock seconds of the last presented frame
     std::function<bool(int, int)> key_callback_;
     std::function<void()> panel_callback_;
+
+    // Editing (VisualizerEditing.cpp).
+    /// A splat-editing shortcut (Delete, Ctrl + I, Ctrl + Z); true when consumed.
+    bool OnEditKey(int key, int mods);
+    /// The end of a Ctrl + drag: a pick where the mouse barely moved, else a selection.
+    void EndSelectDrag(Drag drag);
+    void DrawEditingPanel();
+    std::map<std::string, std::vector<int64_t>> selection_;
+    std::vector<SplatPick> picks_;
+    std::vector<std::pair<std::string, t::geometry::PointCloud>> undo_;  // clouds before a removal
+    double press_x_ = 0.0, press_y_ = 0.0;  // where a Ctrl + drag started
+    std::string edit_error_;                // the last editing error, shown in the panel
 };
 
 /// A geometry for Draw: a splat cloud or a mesh, by name.

@@ -26,13 +26,20 @@ void Visualizer::OnMouseButton(int button, bool pressed, int mods) {
     PostRedraw();
     if (!pressed) {
         overlay_->OnMouseButton(button, false);
+        const Drag ended = drag_;
         drag_ = Drag::kNone;
+        if (ended == Drag::kSelect || ended == Drag::kSelectAdd) EndSelectDrag(ended);
         return;
     }
     if (drag_ != Drag::kNone) return;  // one drag at a time
     if (PanelContains(cursor_x_, cursor_y_) || (show_settings_ && overlay_->HasPopup())) {
         drag_ = Drag::kPanel;
         overlay_->OnMouseButton(button, true);
+    } else if (button == GLFW_MOUSE_BUTTON_LEFT && (mods & GLFW_MOD_CONTROL)) {
+        // Ctrl: a click picks, a drag selects (with shift: adds to the selection).
+        drag_ = (mods & GLFW_MOD_SHIFT) ? Drag::kSelectAdd : Drag::kSelect;
+        press_x_ = cursor_x_;
+        press_y_ = cursor_y_;
     } else if (button == GLFW_MOUSE_BUTTON_LEFT && !(mods & GLFW_MOD_SHIFT)) {
         drag_ = Drag::kRotate;
     } else {
@@ -73,6 +80,7 @@ void Visualizer::OnKey(int key, bool pressed, bool repeat, int mods) {
     PostRedraw();
     if (!pressed || overlay_->WantsTextInput()) return;
     if (!repeat && key_callback_ && key_callback_(key, mods)) return;
+    if (!repeat && OnEditKey(key, mods)) return;
     const double step = view_control_.GetHeight() / 36.0;  // 5 degrees of orbit
     const bool shift = (mods & GLFW_MOD_SHIFT) != 0;
     switch (key) {  // the camera keys count as motion (reduced frames on slow devices)

@@ -130,6 +130,7 @@ void Visualizer::BuildPanel() {
     if (header("Splats", roomy)) SplatSection(*this);
     if (header("Rendering", roomy)) RenderingSection(*this);
     if (header("Objects", true)) ObjectSection(*this);
+    if (header("Editing", true)) DrawEditingPanel();
     if (ImGui::Button("Reset camera (R)")) ResetCamera();
     ImGui::SameLine();
     if (ImGui::Button("Screenshot (P)")) RequestScreenshot();
@@ -148,6 +149,9 @@ void Visualizer::BuildPanel() {
             "Wheel, +/-: zoom\n"
             "Arrows: orbit (shift: pan)\n"
             "1-9: toggle object\n"
+            "Ctrl click: pick, Ctrl drag: select\n"
+            "(+Shift: add), Del: delete selected\n"
+            "Ctrl+I: invert, Ctrl+Z: undo\n"
             "R: reset camera, P: screenshot\n"
             "H: hide panel, Q/Esc: quit");
     }

@@ -199,6 +199,12 @@ std::vector<uint32_t> GaussianSplatRenderer::VisibilityMask() const {
     return mask;
 }
 
+const t::geometry::PointCloud& GaussianSplatRenderer::GetCloud(const std::string& name) const {
+    const auto it = clouds_.find(name);
+    if (it == clouds_.end()) core::ThrowError("GaussianSplatRenderer: no cloud named '{}'", name);
+    return it->second.cloud;
+}
+
 std::optional<std::pair<std::string, int64_t>> GaussianSplatRenderer::LocateSplat(
     int64_t id) const {
     if (stream_) {

@@ -59,6 +59,8 @@ public:
     /// Throws when the name is unknown.
     void ShowCloud(const std::string& name, bool show);
     bool HasCloud(const std::string& name) const { return clouds_.count(name) > 0; }
+    /// The cloud held under `name`; throws core::Open3DError when the name is unknown.
+    const t::geometry::PointCloud& GetCloud(const std::string& name) const;
     bool IsCloudVisible(const std::string& name) const;
     std::vector<std::string> GetCloudNames() const;
     /// Removes every cloud, ends a stream and frees the backend's scene and view buffers now.

@@ -1,0 +1,212 @@
+// Editing splat clouds in the viewer (docs/viewer.md "Editing"): picking a pixel through the
+// composite's ID image, rectangle selection, inverting, deleting with undo, and saving.
+#include <GLFW/glfw3.h>
+#include <imgui.h>
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <exception>
+#include <string>
+#include <vector>
+
+#include "open3d/core/Exception.h"
+#include "open3d/t/io/PointCloudIO.h"
+#include "open3d/visualization/rendering/gaussian_splat/GaussianSplatRenderer.h"
+#include "open3d/visualization/rendering/gaussian_splat/cpu/ViewSelection.h"
+#include "open3d/visualization/visualizer/Visualizer.h"
+
+namespace open3d {
+namespace visualization {
+
+namespace {
+
+// The renderer view the picks draw: its own key, so the window's view keeps its state.
+constexpr uint64_t kPickView = 0x7069636BULL;  // "pick"
+
+// Deep-enough undo for a session of edits without holding every version of a big scene.
+constexpr size_t kMaxUndo = 16;
+
+std::vector<int64_t> Complement(const std::vector<int64_t>& sorted, int64_t n) {
+    std::vector<int64_t> out;
+    out.reserve(static_cast<size_t>(n) - std::min(sorted.size(), static_cast<size_t>(n)));
+    size_t k = 0;
+    for (int64_t i = 0; i < n; ++i) {
+        if (k < sorted.size() && sorted[k] == i) {
+            ++k;
+        } else {
+            out.push_back(i);
+        }
+    }
+    return out;
+}
+
+}  // namespace
+
+std::optional<SplatPick> Visualizer::PickSplat(int x, int y) {
+    const camera::PinholeCamera camera = view_control_.GetCamera();
+    if (x < 0 || y < 0 || x >= camera.width || y >= camera.height) {
+        core::ThrowError("PickSplat: pixel ({}, {}) is outside the {}x{} view", x, y, camera.width,
+                         camera.height);
+    }
+    rendering::GaussianSplatRenderer& splats = scene_->GetScene().GetSplatRenderer();
+    if (!splats.HasVisibleSplats()) return std::nullopt;
+    rendering::RenderOutput out;
+    rendering::CompositeInputs inputs;
+    inputs.median_depth = false;
+    inputs.splat_id = true;
+    splats.Prepare();
+    splats.RenderGeometryStage(kPickView, camera, scene_->GetSplatConfig());
+    splats.RenderCompositeStage(kPickView, out, inputs);
+    splats.ReleaseView(kPickView);
+    const int64_t pixel = int64_t(y) * camera.width + x;
+    const auto where = splats.LocateSplat(out.splat_id.Data<int32_t>()[pixel]);
+    if (!where) return std::nullopt;
+    SplatPick pick;
+    pick.geometry = where->first;
+    pick.index = where->second;
+    // The ray through the pixel centre, scaled to view z = the expected depth, to the world.
+    const double z = out.depth_expected.Data<float>()[pixel];
+    const Eigen::Vector3d view((x - camera.cx) / camera.fx * z, (y - camera.cy) / camera.fy * z, z);
+    pick.point = camera.GetRotation().transpose() * (view - camera.GetTranslation());
+    if (!picks_.empty()) pick.distance_to_previous = (pick.point - picks_.back().point).norm();
+    picks_.push_back(pick);
+    PostRedraw();
+    return pick;
+}
+
+int64_t Visualizer::SelectSplats(double x0, double y0, double x1, double y1, bool add) {
+    if (!add) selection_.clear();
+    const camera::PinholeCamera camera = view_control_.GetCamera();
+    const std::vector<Eigen::Vector2d> rectangle = rendering::cpu::RectanglePolygon(x0, y0, x1, y1);
+    rendering::GaussianSplatRenderer& splats = scene_->GetScene().GetSplatRenderer();
+    for (const std::string& name : names_) {
+        if (!splats.HasCloud(name) || !splats.IsCloudVisible(name)) continue;
+        std::vector<int64_t> chosen = rendering::cpu::SelectSplatsInView(
+            splats.GetCloud(name), camera, scene_->GetSplatConfig(), rectangle);
+        if (chosen.empty()) continue;
+        std::vector<int64_t>& kept = selection_[name];
+        std::vector<int64_t> merged;
+        std::set_union(kept.begin(), kept.end(), chosen.begin(), chosen.end(),
+                       std::back_inserter(merged));
+        kept = std::move(merged);
+    }
+    PostRedraw();
+    int64_t total = 0;
+    for (const auto& [name, indices] : selection_) total += static_cast<int64_t>(indices.size());
+    return total;
+}
+
+int64_t Visualizer::InvertSelection() {
+    rendering::GaussianSplatRenderer& splats = scene_->GetScene().GetSplatRenderer();
+    int64_t total = 0;
+    for (auto& [name, indices] : selection_) {
+        indices = Complement(indices, splats.GetCloud(name).NumPoints());
+        total += static_cast<int64_t>(indices.size());
+    }
+    PostRedraw();
+    return total;
+}
+
+void Visualizer::ClearSelection() {
+    selection_.clear();
+    PostRedraw();
+}
+
+int64_t Visualizer::DeleteSelection() {
+    rendering::GaussianSplatRenderer& splats = scene_->GetScene().GetSplatRenderer();
+    int64_t removed = 0;
+    for (const auto& [name, indices] : selection_) {
+        if (indices.empty() || !splats.HasCloud(name)) continue;
+        const t::geometry::PointCloud before = splats.GetCloud(name);
+        const t::geometry::PointCloud after = before.RemoveByIndex(indices);
+        UpdateGeometry(name, after);
+        undo_.emplace_back(name, before);
+        if (undo_.size() > kMaxUndo) undo_.erase(undo_.begin());
+        removed += static_cast<int64_t>(indices.size());
+    }
+    selection_.clear();
+    picks_.clear();  // their indices named splats of the clouds before
+    return removed;
+}
+
+bool Visualizer::UndoEdit() {
+    if (undo_.empty()) return false;
+    const auto [name, cloud] = std::move(undo_.back());
+    undo_.pop_back();
+    if (scene_->GetScene().GetSplatRenderer().HasCloud(name)) UpdateGeometry(name, cloud);
+    selection_.clear();
+    picks_.clear();
+    return true;
+}
+
+void Visualizer::SaveGeometry(const std::string& name, const std::string& path) {
+    rendering::GaussianSplatRenderer& splats = scene_->GetScene().GetSplatRenderer();
+    if (!splats.HasCloud(name)) core::ThrowError("SaveGeometry: no splat cloud named '{}'", name);
+    t::io::WritePointCloud(path, splats.GetCloud(name));
+}
+
+bool Visualizer::OnEditKey(int key, int mods) {
+    const bool ctrl = (mods & GLFW_MOD_CONTROL) != 0;
+    try {
+        if (key == GLFW_KEY_DELETE && !selection_.empty()) {
+            DeleteSelection();
+        } else if (ctrl && key == GLFW_KEY_I) {
+            InvertSelection();
+        } else if (ctrl && key == GLFW_KEY_Z) {
+            UndoEdit();
+        } else {
+            return false;
+        }
+        edit_error_.clear();
+    } catch (const std::exception& e) {
+        edit_error_ = e.what();
+    }
+    return true;
+}
+
+void Visualizer::EndSelectDrag(Drag drag) {
+    // Pixels in the window's framebuffer: the cursor is in the same units here (no scaling
+    // of a high-density display under X11).
+    const double moved = std::hypot(cursor_x_ - press_x_, cursor_y_ - press_y_);
+    try {
+        if (moved < 3.0) {
+            const int x = static_cast<int>(std::lround(press_x_));
+            const int y = static_cast<int>(std::lround(press_y_));
+            if (x >= 0 && y >= 0 && x < fb_width_ && y < fb_height_) PickSplat(x, y);
+        } else {
+            SelectSplats(press_x_, press_y_, cursor_x_, cursor_y_, drag == Drag::kSelectAdd);
+        }
+        edit_error_.clear();
+    } catch (const std::exception& e) {
+        edit_error_ = e.what();
+    }
+    PostRedraw();
+}
+
+void Visualizer::DrawEditingPanel() {
+    int64_t selected = 0;
+    for (const auto& [name, indices] : selection_) selected += static_cast<int64_t>(indices.size());
+    if (!picks_.empty()) {
+        const SplatPick& p = picks_.back();
+        ImGui::Text("Picked %s #%lld", p.geometry.c_str(), static_cast<long long>(p.index));
+        ImGui::Text("  at (%.4g, %.4g, %.4g)", p.point.x(), p.point.y(), p.point.z());
+        if (p.distance_to_previous >= 0.0) {
+            ImGui::Text("  %.4g from the previous pick", p.distance_to_previous);
+        }
+    }
+    ImGui::Text("Selected %lld splats", static_cast<long long>(selected));
+    // The buttons run what the keys run, errors included.
+    if (selected > 0) {
+        if (ImGui::Button("Delete (Del)")) OnEditKey(GLFW_KEY_DELETE, 0);
+        ImGui::SameLine();
+        if (ImGui::Button("Invert (Ctrl+I)")) OnEditKey(GLFW_KEY_I, GLFW_MOD_CONTROL);
+        ImGui::SameLine();
+        if (ImGui::Button("Clear")) ClearSelection();
+    }
+    if (!undo_.empty() && ImGui::Button("Undo (Ctrl+Z)")) OnEditKey(GLFW_KEY_Z, GLFW_MOD_CONTROL);
+    if (!edit_error_.empty()) ImGui::TextWrapped("%s", edit_error_.c_str());
+}
+
+}  // namespace visualization
+}  // namespace open3d
