@@ -210,11 +210,14 @@ VkDescriptorImageInfo GaussianCompositeStage::SplatIdDescriptor(VkCommandBuffer 
                                                                 VkImageView splat_id) const {
     if (splat_id != VK_NULL_HANDLE) return StorageImage(splat_id);
     // As for the scene depth: never written without kCompositeSplatIdBit, but the binding is
-    // statically used. UNDEFINED -> GENERAL each time, after any earlier dispatch.
-    RecordImageBarrier(
-        cmd, placeholder_splat_id_.Get(), VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
-        VK_IMAGE_LAYOUT_GENERAL, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_NONE,
-        VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
+    // statically used, and the validation layer counts a write-only binding as written by
+    // every dispatch that binds it. UNDEFINED -> GENERAL each time, after those "writes" (an
+    // earlier composite of the same command buffer).
+    RecordImageBarrier(cmd, placeholder_splat_id_.Get(), VK_IMAGE_ASPECT_COLOR_BIT,
+                       VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_GENERAL,
+                       VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
+                       VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                       VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
     return StorageImage(placeholder_splat_id_.GetView());
 }
 
