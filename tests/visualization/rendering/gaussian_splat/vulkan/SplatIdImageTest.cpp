@@ -14,6 +14,7 @@
 #include "open3d/visualization/rendering/gaussian_splat/cpu/CpuBackend.h"
 #include "open3d/visualization/rendering/gaussian_splat/cpu/Picking.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/GaussianSplatVulkanBackend.h"
+#include "visualization/rendering/gaussian_splat/vulkan/SharedScenes.h"
 #include "visualization/rendering/gaussian_splat/vulkan/VulkanTestFixture.h"
 
 namespace open3d {
@@ -36,25 +37,16 @@ TEST_F(SplatIdImage, AgreesWithTheReferenceOnTheSharedScenes) {
     // each other (float32 blending against the reference's double), a documented tie. Measured
     // on lavapipe: all 21,726 covered pixels of the six views agree, so 0.1% (and 1% below
     // 0.5) is room for a GPU's exp2, not for a wrong index.
-    struct SceneCase {
-        const char* scene;
-        const char* cameras;
-    };
-    const SceneCase cases[] = {{"playbot/playbot_31k.ply", "playbot/cameras.json"},
-                               {"chair/chair.splat", "chair/cameras.json"},
-                               {"biker/biker_152k.ply", "biker/cameras.json"}};
     auto backend = MakeBackend();
-    for (const SceneCase& c : cases) {
+    for (const SharedSceneFiles& c : kSharedScenes) {
         if (!FileExists(DataPath(c.scene))) {
             OPEN3D_SKIP_OR_FAIL_WHEN_UNAVAILABLE(DataPath(c.scene) + " is absent");
         }
-        t::geometry::PointCloud cloud;
-        t::io::ReadPointCloud(DataPath(c.scene), cloud);
-        const auto views = camera::ReadCamerasJson(DataPath(c.cameras));
+        const auto [cloud, views] = ReadSharedScene(c);
         backend->SetScene(cloud);
         cpu::CpuBackend reference;
         reference.SetScene(cloud);
-        for (const auto& [view, w, h] : {std::tuple{0, 96, 96}, std::tuple{5, 100, 75}}) {
+        for (const auto& [view, w, h] : kSharedSceneViews) {
             SCOPED_TRACE(std::string(c.scene) + " view " + std::to_string(view));
             const camera::PinholeCamera cam = views.at(view).camera.Resized(w, h);
             const RenderOutput gpu = backend->Render(cam, {}, WithSplatId());
