@@ -140,13 +140,14 @@ const camera::PinholeCamera& SplatOffscreen::Camera() const {
     return camera_;
 }
 
-RenderOutput SplatOffscreen::Render(bool expected_depth, bool median_depth) {
+RenderOutput SplatOffscreen::Render(bool expected_depth, bool median_depth, bool splat_id) {
     const camera::PinholeCamera camera = Camera();
     RequireVisibleSplats();
     RenderOutput out;
     visualization::rendering::CompositeInputs inputs;
     inputs.expected_depth = expected_depth;
     inputs.median_depth = median_depth;
+    inputs.splat_id = splat_id;
     py::gil_scoped_release release;
     renderer_->Prepare();
     renderer_->RenderGeometryStage(kView, camera, config_);
@@ -162,17 +163,7 @@ t::geometry::Image SplatOffscreen::RenderSplatId() {
     if (renderer_->IsStreaming()) {
         core::ThrowError("render_to_id_image: not while a stream runs (its IDs are pool slots)");
     }
-    const camera::PinholeCamera camera = Camera();
-    RequireVisibleSplats();
-    RenderOutput out;
-    visualization::rendering::CompositeInputs inputs;
-    inputs.expected_depth = inputs.median_depth = false;
-    inputs.splat_id = true;
-    py::gil_scoped_release release;
-    renderer_->Prepare();
-    renderer_->RenderGeometryStage(kView, camera, config_);
-    renderer_->RenderCompositeStage(kView, out, inputs);
-    return std::move(out.splat_id);
+    return Render(false, false, true).splat_id;  // a member of the temporary: moved
 }
 
 t::geometry::Image SplatOffscreen::RenderWithMeshes(bool depth) {

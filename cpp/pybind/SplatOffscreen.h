@@ -53,7 +53,8 @@ public:
     const camera::PinholeCamera& Camera() const;
 
     /// The splat backend's frame of the current camera (renderers without meshes).
-    visualization::rendering::RenderOutput Render(bool expected_depth, bool median_depth);
+    visualization::rendering::RenderOutput Render(bool expected_depth, bool median_depth,
+                                                  bool splat_id = false);
     /// The ID image (Int32 [H, W, 1], RenderOutput::splat_id) of the current camera: IDs of
     /// the merged scene, GaussianSplatRenderer::LocateSplat names their clouds. Renderers
     /// without meshes and without a stream only.

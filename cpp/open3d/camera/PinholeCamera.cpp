@@ -12,6 +12,11 @@ Eigen::Vector3d PinholeCamera::GetCenter() const {
     return -GetRotation().transpose() * GetTranslation();
 }
 
+Eigen::Vector3d PinholeCamera::PixelToWorld(double x, double y, double z) const {
+    const Eigen::Vector3d view((x - cx) / fx * z, (y - cy) / fy * z, z);
+    return GetRotation().transpose() * (view - GetTranslation());
+}
+
 void PinholeCamera::Validate() const {
     if (width <= 0 || height <= 0) {
         core::ThrowError("PinholeCamera: image size must be positive, got {}x{}", width, height);

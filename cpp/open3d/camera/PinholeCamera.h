@@ -36,6 +36,9 @@ struct PinholeCamera {
     Eigen::Vector3d GetTranslation() const { return world_to_camera.topRightCorner<3, 1>(); }
     /// Camera centre in world space: -R^T t.
     Eigen::Vector3d GetCenter() const;
+    /// The world point on the ray through pixel (x, y) (pixel centres on integers) at view
+    /// depth z: R^T (((x - cx) / fx z, (y - cy) / fy z, z) - t). Picking's point.
+    Eigen::Vector3d PixelToWorld(double x, double y, double z) const;
     /// tan of half the horizontal / vertical field of view as 3DGS defines it: W / (2 fx).
     double GetTanHalfFovX() const { return width / (2.0 * fx); }
     double GetTanHalfFovY() const { return height / (2.0 * fy); }

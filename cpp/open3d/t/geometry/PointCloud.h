@@ -121,6 +121,10 @@ private:
     std::map<std::string, core::Tensor> attrs_;
 };
 
+/// The rows of [0, n) that are not among `indices` (any order, repeats ignored), ascending:
+/// SelectByIndex's inverted rows. Every index must lie in [0, n).
+std::vector<int64_t> ComplementIndices(const std::vector<int64_t>& indices, int64_t n);
+
 }  // namespace geometry
 }  // namespace t
 }  // namespace open3d

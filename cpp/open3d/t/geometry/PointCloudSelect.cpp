@@ -79,6 +79,12 @@ PointCloud CropBy(const PointCloud& cloud,
 
 }  // namespace
 
+std::vector<int64_t> ComplementIndices(const std::vector<int64_t>& indices, int64_t n) {
+    std::vector<bool> picked(size_t(n), false);
+    for (int64_t i : indices) picked[size_t(i)] = true;
+    return RowsWhere(picked, false);
+}
+
 PointCloud PointCloud::SelectByIndex(const std::vector<int64_t>& indices, bool invert) const {
     const int64_t n = NumPoints();
     for (int64_t i : indices) {
@@ -86,10 +92,7 @@ PointCloud PointCloud::SelectByIndex(const std::vector<int64_t>& indices, bool i
             core::ThrowError("SelectByIndex: index {} is out of range for {} points", i, n);
         }
     }
-    if (!invert) return CopyRows(*this, indices);
-    std::vector<bool> picked(size_t(n), false);
-    for (int64_t i : indices) picked[size_t(i)] = true;
-    return CopyRows(*this, RowsWhere(picked, false));
+    return CopyRows(*this, invert ? ComplementIndices(indices, n) : indices);
 }
 
 PointCloud PointCloud::SelectByMask(const std::vector<bool>& mask, bool invert) const {

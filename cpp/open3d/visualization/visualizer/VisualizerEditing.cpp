@@ -27,20 +27,6 @@ constexpr uint64_t kPickView = 0x7069636BULL;  // "pick"
 // Deep-enough undo for a session of edits without holding every version of a big scene.
 constexpr size_t kMaxUndo = 16;
 
-std::vector<int64_t> Complement(const std::vector<int64_t>& sorted, int64_t n) {
-    std::vector<int64_t> out;
-    out.reserve(static_cast<size_t>(n) - std::min(sorted.size(), static_cast<size_t>(n)));
-    size_t k = 0;
-    for (int64_t i = 0; i < n; ++i) {
-        if (k < sorted.size() && sorted[k] == i) {
-            ++k;
-        } else {
-            out.push_back(i);
-        }
-    }
-    return out;
-}
-
 }  // namespace
 
 std::optional<SplatPick> Visualizer::PickSplat(int x, int y) {
@@ -65,10 +51,8 @@ std::optional<SplatPick> Visualizer::PickSplat(int x, int y) {
     SplatPick pick;
     pick.geometry = where->first;
     pick.index = where->second;
-    // The ray through the pixel centre, scaled to view z = the expected depth, to the world.
-    const double z = out.depth_expected.Data<float>()[pixel];
-    const Eigen::Vector3d view((x - camera.cx) / camera.fx * z, (y - camera.cy) / camera.fy * z, z);
-    pick.point = camera.GetRotation().transpose() * (view - camera.GetTranslation());
+    // The ray through the pixel centre, at view z = the expected depth there.
+    pick.point = camera.PixelToWorld(x, y, out.depth_expected.Data<float>()[pixel]);
     if (!picks_.empty()) pick.distance_to_previous = (pick.point - picks_.back().point).norm();
     picks_.push_back(pick);
     PostRedraw();
@@ -101,7 +85,7 @@ int64_t Visualizer::InvertSelection() {
     rendering::GaussianSplatRenderer& splats = scene_->GetScene().GetSplatRenderer();
     int64_t total = 0;
     for (auto& [name, indices] : selection_) {
-        indices = Complement(indices, splats.GetCloud(name).NumPoints());
+        indices = t::geometry::ComplementIndices(indices, splats.GetCloud(name).NumPoints());
         total += static_cast<int64_t>(indices.size());
     }
     PostRedraw();

@@ -31,7 +31,7 @@ struct SharedScene {
     std::vector<camera::CameraView> views;
 };
 
-/// Reads a scene and its cameras (the caller checks FileExists first, to skip or fail).
+/// Reads a scene and its cameras (the caller checks OPEN3D_REQUIRE_DATA first, to skip or fail).
 inline SharedScene ReadSharedScene(const SharedSceneFiles& files) {
     SharedScene s;
     t::io::ReadPointCloud(DataPath(files.scene), s.cloud);

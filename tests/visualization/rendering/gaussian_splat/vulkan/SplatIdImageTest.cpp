@@ -39,9 +39,7 @@ TEST_F(SplatIdImage, AgreesWithTheReferenceOnTheSharedScenes) {
     // 0.5) is room for a GPU's exp2, not for a wrong index.
     auto backend = MakeBackend();
     for (const SharedSceneFiles& c : kSharedScenes) {
-        if (!FileExists(DataPath(c.scene))) {
-            OPEN3D_SKIP_OR_FAIL_WHEN_UNAVAILABLE(DataPath(c.scene) + " is absent");
-        }
+        OPEN3D_REQUIRE_DATA(c.scene);
         const auto [cloud, views] = ReadSharedScene(c);
         backend->SetScene(cloud);
         cpu::CpuBackend reference;

@@ -35,9 +35,7 @@ TEST_F(VulkanBackend, RealScenesMatchTheReference) {
     // near-tie in depth order flips two splats at a few pixels), p99.9 <= 1e-6.
     auto backend = MakeBackend();
     for (const SharedSceneFiles& c : kSharedScenes) {
-        if (!FileExists(DataPath(c.scene))) {
-            OPEN3D_SKIP_OR_FAIL_WHEN_UNAVAILABLE(DataPath(c.scene) + " is absent");
-        }
+        OPEN3D_REQUIRE_DATA(c.scene);
         const auto [cloud, views] = ReadSharedScene(c);
         backend->SetScene(cloud);
         for (const auto& [view, w, h] : kSharedSceneViews) {

@@ -42,12 +42,8 @@ PickResult PickPixel(const t::geometry::PointCloud& cloud, const camera::Pinhole
     pick.hit = pick.splat >= 0;
     if (!pick.hit) return pick;
     pick.expected_depth = weighted_depth / pick.alpha;
-    // The ray through the pixel's centre, scaled to view z = expected depth, to the world.
-    const Eigen::Vector3d view((x - camera.cx) / camera.fx * pick.expected_depth,
-                               (y - camera.cy) / camera.fy * pick.expected_depth,
-                               pick.expected_depth);
-    const Eigen::Matrix3d R = camera.GetRotation();
-    pick.point = R.transpose() * (view - camera.GetTranslation());
+    // The ray through the pixel's centre, at view z = the expected depth.
+    pick.point = camera.PixelToWorld(x, y, pick.expected_depth);
     return pick;
 }
 
