@@ -144,14 +144,9 @@ size_t RenderCameraPath(const CameraPathOptions& options, rendering::GaussianSpl
     const camera::CameraPath path = camera::CameraPath::FromViews(
         camera::ReadCamerasJson(options.path_file), options.seconds_per_keyframe);
     std::vector<camera::PinholeCamera> frames = path.Frames(options.fps);
-    const camera::PinholeCamera& first = frames.front();
-    int width = options.width, height = options.height;
-    if (width > 0 && height == 0)
-        height = std::max(1, int(std::lround(double(width) * first.height / first.width)));
-    if (height > 0 && width == 0)
-        width = std::max(1, int(std::lround(double(height) * first.width / first.height)));
-    if (width > 0) {
-        for (camera::PinholeCamera& c : frames) c = c.Resized(width, height);
+    // The keyframes share one size, so every frame gets the same one.
+    for (camera::PinholeCamera& c : frames) {
+        c = c.ResizedKeepingAspect(options.width, options.height);
     }
     const int w = frames.front().width, h = frames.front().height;
     const bool video = t::io::LowerCaseExtension(options.output) == "mp4";

@@ -100,21 +100,8 @@ camera::PinholeCamera ChooseCamera(const Options& opt,
         look_at = camera::OrbitLookAt(look_at, opt.orbit_angle);
         cam = camera::PinholeCamera::FromLookAt(look_at, cam.width, cam.height);
     }
-    if (opt.width > 0 || opt.height > 0) {
-        // One given size keeps the camera's aspect ratio.
-        const int w =
-            opt.width > 0
-                ? opt.width
-                : std::max(1, static_cast<int>(std::lround(static_cast<double>(opt.height) *
-                                                           cam.width / cam.height)));
-        const int h =
-            opt.height > 0
-                ? opt.height
-                : std::max(1, static_cast<int>(std::lround(static_cast<double>(opt.width) *
-                                                           cam.height / cam.width)));
-        cam = cam.Resized(w, h);
-    }
-    return cam;
+    // One given size keeps the camera's aspect ratio.
+    return cam.ResizedKeepingAspect(opt.width, opt.height);
 }
 
 // The hierarchy for --lod-budget: --lod, else <input>.lod beside the scene (what gs-convert

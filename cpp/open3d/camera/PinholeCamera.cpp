@@ -1,5 +1,6 @@
 #include "open3d/camera/PinholeCamera.h"
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -48,6 +49,19 @@ PinholeCamera PinholeCamera::FromIntrinsic(const Eigen::Matrix3d& intrinsic,
     camera.world_to_camera = extrinsic;
     camera.Validate();
     return camera;
+}
+
+PinholeCamera PinholeCamera::ResizedKeepingAspect(int new_width, int new_height) const {
+    if (new_width <= 0 && new_height <= 0) return *this;
+    const int w = new_width > 0
+                      ? new_width
+                      : std::max(1, static_cast<int>(std::lround(static_cast<double>(new_height) *
+                                                                 width / height)));
+    const int h = new_height > 0
+                      ? new_height
+                      : std::max(1, static_cast<int>(std::lround(static_cast<double>(new_width) *
+                                                                 height / width)));
+    return Resized(w, h);
 }
 
 PinholeCamera PinholeCamera::Resized(int new_width, int new_height) const {

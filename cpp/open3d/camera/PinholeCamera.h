@@ -57,6 +57,9 @@ struct PinholeCamera {
     /// principal point keeps its place relative to the image (pixel-centre aware:
     /// cx' = (cx + 0.5) * W' / W - 0.5), so a centred principal point stays centred.
     PinholeCamera Resized(int new_width, int new_height) const;
+    /// Resized where a size is given: 0 for one side takes it from the other with this
+    /// camera's aspect ratio (rounded, at least 1); both 0 leave the camera as it is.
+    PinholeCamera ResizedKeepingAspect(int new_width, int new_height) const;
 
     /// From a pinhole intrinsic matrix [[fx, 0, cx], [0, fy, cy], [0, 0, 1]] (only those four
     /// entries are read) and a 4x4 world-to-camera extrinsic, OpenCV axes; validated.
