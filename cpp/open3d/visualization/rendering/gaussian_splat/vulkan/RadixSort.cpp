@@ -269,11 +269,15 @@ void RadixSort::Record(VkCommandBuffer cmd, const BufferRange& keys, const Buffe
     }
 }
 
+uint32_t RadixSort::CountIndex(const BufferRange& count) const {
+    const VkDeviceSize alignment = context_->GetDeviceInfo().min_storage_buffer_offset_alignment;
+    return static_cast<uint32_t>((count.offset % alignment) / 4);
+}
+
 RadixSortPushConstants RadixSort::PushConstantsFor(const BufferRange& count, uint32_t max_count,
                                                    uint32_t num_bits, Output output) const {
-    const VkDeviceSize alignment = context_->GetDeviceInfo().min_storage_buffer_offset_alignment;
     RadixSortPushConstants push{};
-    push.count_index = static_cast<uint32_t>((count.offset % alignment) / 4);
+    push.count_index = CountIndex(count);
     push.max_count = max_count;
     push.target_blocks = GetTargetBlocks();
     push.num_passes = GetNumPasses(num_bits);
@@ -291,10 +295,6 @@ void RadixSort::RecordMultiPass(VkCommandBuffer cmd, const BufferRange& keys,
     const uint32_t num_passes = GetNumPasses(num_bits);
     // A range can only save passes after the first.
     const bool by_range = pass_count == PassCount::kFromKeyRange && num_passes > 1;
-    const VkDeviceSize alignment = context_->GetDeviceInfo().min_storage_buffer_offset_alignment;
-    const auto count_index = [&](const BufferRange& range) {
-        return static_cast<uint32_t>((range.offset % alignment) / 4);
-    };
     BufferRange count_in = count;  // what the setup dispatch reads
     RadixSortPushConstants push = PushConstantsFor(count, max_count, num_bits, output);
 
@@ -363,7 +363,7 @@ void RadixSort::RecordMultiPass(VkCommandBuffer cmd, const BufferRange& keys,
             // the copy of an odd pass count) sort only them. The range decides which of
             // the later passes run.
             if (drop) count_in = drop->kept_count;
-            push.count_index = count_index(count_in);
+            push.count_index = CountIndex(count_in);
             push.drop_max_keys = 0;
             setup();
         }

@@ -190,6 +190,9 @@ public:
                 Output output = Output::kKeysAndValues) const;
 
 private:
+    // The index of a count's uint within its binding, which starts at the aligned offset below
+    // it (BindBuffers): the push constant count_index.
+    uint32_t CountIndex(const BufferRange& count) const;
     // The push constants every dispatch of a sort starts from (the passes set shift,
     // digit_bits and drop_max_keys).
     shader::RadixSortPushConstants PushConstantsFor(const BufferRange& count, uint32_t max_count,
