@@ -393,6 +393,8 @@ private:
     /// The end of a Ctrl + drag: a pick where the mouse barely moved, else a selection.
     void EndSelectDrag(Drag drag);
     void DrawEditingPanel();
+    /// Selected splats over all clouds.
+    int64_t SelectedCount() const;
     std::map<std::string, std::vector<int64_t>> selection_;
     std::vector<SplatPick> picks_;
     std::vector<std::pair<std::string, t::geometry::PointCloud>> undo_;  // clouds before a removal

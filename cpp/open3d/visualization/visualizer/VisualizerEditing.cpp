@@ -76,19 +76,21 @@ int64_t Visualizer::SelectSplats(double x0, double y0, double x1, double y1, boo
         kept = std::move(merged);
     }
     PostRedraw();
-    int64_t total = 0;
-    for (const auto& [name, indices] : selection_) total += static_cast<int64_t>(indices.size());
-    return total;
+    return SelectedCount();
 }
 
 int64_t Visualizer::InvertSelection() {
     rendering::GaussianSplatRenderer& splats = scene_->GetScene().GetSplatRenderer();
-    int64_t total = 0;
     for (auto& [name, indices] : selection_) {
         indices = t::geometry::ComplementIndices(indices, splats.GetCloud(name).NumPoints());
-        total += static_cast<int64_t>(indices.size());
     }
     PostRedraw();
+    return SelectedCount();
+}
+
+int64_t Visualizer::SelectedCount() const {
+    int64_t total = 0;
+    for (const auto& [name, indices] : selection_) total += static_cast<int64_t>(indices.size());
     return total;
 }
 
@@ -169,8 +171,7 @@ void Visualizer::EndSelectDrag(Drag drag) {
 }
 
 void Visualizer::DrawEditingPanel() {
-    int64_t selected = 0;
-    for (const auto& [name, indices] : selection_) selected += static_cast<int64_t>(indices.size());
+    const int64_t selected = SelectedCount();
     if (!picks_.empty()) {
         const SplatPick& p = picks_.back();
         ImGui::Text("Picked %s #%lld", p.geometry.c_str(), static_cast<long long>(p.index));
