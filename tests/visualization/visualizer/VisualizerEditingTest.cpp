@@ -1,7 +1,8 @@
 // Editing in the viewer (docs/viewer.md "Editing"): a Ctrl + click picks the splat the CPU
 // reference picks at that pixel, a Ctrl + drag selects what cpu::SelectSplatsInView selects,
 // Delete (sent through the X server, as another client would) removes exactly those splats,
-// Ctrl + I inverts, Ctrl + Z restores the cloud bit for bit, and the edit saves to a file.
+// Ctrl + I inverts, Ctrl + Z restores the cloud bit for bit (every cloud one removal changed),
+// and the edit saves to a file.
 #include <GLFW/glfw3.h>
 #include <gtest/gtest.h>
 
@@ -115,6 +116,30 @@ TEST_F(VisualizerEditing, PickSelectDeleteInvertUndoAndSave) {
     EXPECT_TRUE(SameCloud(splats.GetCloud("scene"), cloud));
     EXPECT_FALSE(vis.UndoEdit());
     ASSERT_TRUE(vis.RenderFrame());
+}
+
+TEST_F(VisualizerEditing, OneUndoRestoresEveryCloudADeleteChanged) {
+    visualization::Visualizer& vis = MakeVisualizer(160, 120);
+    const t::geometry::PointCloud cloud = rendering::CreateDefaultGaussianSplatScene();
+    std::vector<int64_t> first_half;
+    for (int64_t i = 0; i < cloud.NumPoints() / 2; ++i) first_half.push_back(i);
+    const t::geometry::PointCloud a = cloud.SelectByIndex(first_half);
+    const t::geometry::PointCloud b = cloud.RemoveByIndex(first_half);
+    vis.AddGeometry("a", a);
+    vis.AddGeometry("b", b);
+    vis.ResetCamera();
+    ASSERT_TRUE(vis.RenderFrame());
+    // The whole window: both clouds have selected splats.
+    vis.SelectSplats(0, 0, vis.GetWidth() - 1, vis.GetHeight() - 1);
+    ASSERT_EQ(vis.GetSelection().size(), 2u);
+    EXPECT_GT(vis.DeleteSelection(), 0);
+    const rendering::GaussianSplatRenderer& splats = vis.GetScene().GetScene().GetSplatRenderer();
+    EXPECT_LT(splats.GetCloud("a").NumPoints(), a.NumPoints());
+    EXPECT_LT(splats.GetCloud("b").NumPoints(), b.NumPoints());
+    ASSERT_TRUE(vis.UndoEdit());
+    EXPECT_TRUE(SameCloud(splats.GetCloud("a"), a));
+    EXPECT_TRUE(SameCloud(splats.GetCloud("b"), b));
+    EXPECT_FALSE(vis.UndoEdit());
 }
 
 }  // namespace

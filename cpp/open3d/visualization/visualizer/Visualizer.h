@@ -397,7 +397,8 @@ private:
     int64_t SelectedCount() const;
     std::map<std::string, std::vector<int64_t>> selection_;
     std::vector<SplatPick> picks_;
-    std::vector<std::pair<std::string, t::geometry::PointCloud>> undo_;  // clouds before a removal
+    // Per DeleteSelection, every cloud it changed as it was before.
+    std::vector<std::vector<std::pair<std::string, t::geometry::PointCloud>>> undo_;
     double press_x_ = 0.0, press_y_ = 0.0;  // where a Ctrl + drag started
     std::string edit_error_;                // the last editing error, shown in the panel
 };

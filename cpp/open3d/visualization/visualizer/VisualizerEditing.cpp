@@ -102,14 +102,16 @@ void Visualizer::ClearSelection() {
 int64_t Visualizer::DeleteSelection() {
     rendering::GaussianSplatRenderer& splats = scene_->GetScene().GetSplatRenderer();
     int64_t removed = 0;
+    std::vector<std::pair<std::string, t::geometry::PointCloud>> before;
     for (const auto& [name, indices] : selection_) {
         if (indices.empty() || !splats.HasCloud(name)) continue;
-        const t::geometry::PointCloud before = splats.GetCloud(name);
-        const t::geometry::PointCloud after = before.RemoveByIndex(indices);
-        UpdateGeometry(name, after);
-        undo_.emplace_back(name, before);
-        if (undo_.size() > kMaxUndo) undo_.erase(undo_.begin());
+        before.emplace_back(name, splats.GetCloud(name));
+        UpdateGeometry(name, before.back().second.RemoveByIndex(indices));
         removed += static_cast<int64_t>(indices.size());
+    }
+    if (!before.empty()) {
+        undo_.push_back(std::move(before));
+        if (undo_.size() > kMaxUndo) undo_.erase(undo_.begin());
     }
     selection_.clear();
     picks_.clear();  // their indices named splats of the clouds before
@@ -118,9 +120,11 @@ int64_t Visualizer::DeleteSelection() {
 
 bool Visualizer::UndoEdit() {
     if (undo_.empty()) return false;
-    const auto [name, cloud] = std::move(undo_.back());
+    const auto clouds = std::move(undo_.back());
     undo_.pop_back();
-    if (scene_->GetScene().GetSplatRenderer().HasCloud(name)) UpdateGeometry(name, cloud);
+    for (const auto& [name, cloud] : clouds) {
+        if (scene_->GetScene().GetSplatRenderer().HasCloud(name)) UpdateGeometry(name, cloud);
+    }
     selection_.clear();
     picks_.clear();
     return true;
