@@ -188,5 +188,17 @@ TEST(PinholeCamera, FromIntrinsicReadsFocalLengthsAndPrincipalPoint) {
     EXPECT_THROW(camera::PinholeCamera::FromIntrinsic(K, extrinsic, 640, 480), core::Open3DError);
 }
 
+TEST(PinholeCamera, PixelToWorldLiesOnThePixelsRayAtTheDepth) {
+    camera::LookAtCamera look;
+    look.eye = Eigen::Vector3d(0.3, -2, 5);
+    look.center = Eigen::Vector3d(0, 0.5, 0);
+    const camera::PinholeCamera cam = camera::PinholeCamera::FromLookAt(look, 80, 60);
+    const Eigen::Vector3d p = cam.PixelToWorld(12.0, 40.0, 3.5);
+    const Eigen::Vector3d v = cam.GetRotation() * p + cam.GetTranslation();
+    EXPECT_NEAR(v.z(), 3.5, 1e-12);
+    EXPECT_NEAR(cam.fx * v.x() / v.z() + cam.cx, 12.0, 1e-9);
+    EXPECT_NEAR(cam.fy * v.y() / v.z() + cam.cy, 40.0, 1e-9);
+}
+
 }  // namespace tests
 }  // namespace open3d

@@ -1,8 +1,11 @@
 #include "open3d/camera/CamerasJson.h"
 
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
+#include <cstring>
 
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -116,6 +119,57 @@ std::vector<CameraView> ParseCamerasJson(const std::string& text, const std::str
         views.push_back(ParseEntry(root[i], fmt::format("{}: camera entry {}", source_name, i)));
     }
     return views;
+}
+
+std::string CamerasJsonText(const std::vector<CameraView>& views) {
+    Json root = Json::array();
+    for (size_t i = 0; i < views.size(); ++i) {
+        const CameraView& view = views[i];
+        const PinholeCamera& cam = view.camera;
+        cam.Validate();
+        if (cam.cx != (cam.width - 1) / 2.0 || cam.cy != (cam.height - 1) / 2.0) {
+            core::ThrowError(
+                "cameras.json entry {}: principal point ({}, {}) is not the image centre ({}, "
+                "{}), which is all the format can hold",
+                i, cam.cx, cam.cy, (cam.width - 1) / 2.0, (cam.height - 1) / 2.0);
+        }
+        const Eigen::Matrix3d camera_to_world = cam.GetRotation().transpose();
+        const Eigen::Vector3d position = cam.GetCenter();
+        Json entry;
+        entry["id"] = view.id;
+        entry["img_name"] = view.img_name;
+        entry["width"] = cam.width;
+        entry["height"] = cam.height;
+        entry["position"] = {position.x(), position.y(), position.z()};
+        entry["rotation"] = Json::array();
+        for (int r = 0; r < 3; ++r) {
+            entry["rotation"].push_back(
+                {camera_to_world(r, 0), camera_to_world(r, 1), camera_to_world(r, 2)});
+        }
+        entry["fx"] = cam.fx;
+        entry["fy"] = cam.fy;
+        if (view.time) entry["time"] = *view.time;
+        root.push_back(std::move(entry));
+    }
+    return root.dump(1) + "\n";
+}
+
+void WriteCamerasJson(const std::string& filename, const std::vector<CameraView>& views) {
+    const std::string text = CamerasJsonText(views);
+    const std::string temp = filename + ".partial";
+    {
+        std::ofstream out(temp, std::ios::binary | std::ios::trunc);
+        out << text;
+        out.close();
+        if (!out) {
+            std::remove(temp.c_str());
+            core::ThrowError("cannot write cameras file '{}'", filename);
+        }
+    }
+    if (std::rename(temp.c_str(), filename.c_str()) != 0) {
+        std::remove(temp.c_str());
+        core::ThrowError("cannot write cameras file '{}': {}", filename, std::strerror(errno));
+    }
 }
 
 std::vector<CameraView> ReadCamerasJson(const std::string& filename) {

@@ -30,5 +30,15 @@ std::vector<CameraView> ReadCamerasJson(const std::string& filename);
 /// Parses cameras.json text; `source_name` is used in error messages.
 std::vector<CameraView> ParseCamerasJson(const std::string& text, const std::string& source_name);
 
+/// cameras.json text of `views`: the fields ParseCamerasJson reads, "time" where set, numbers
+/// with enough digits to read back the same doubles. The format has no principal point (the
+/// reader puts it at the image centre, ((W - 1) / 2, (H - 1) / 2)): a camera whose principal
+/// point is elsewhere is refused, naming its entry.
+std::string CamerasJsonText(const std::vector<CameraView>& views);
+
+/// Writes CamerasJsonText(views) to `filename`: to a temporary beside it, then renamed, so
+/// a failed write leaves no partial file. Throws core::Open3DError naming the file.
+void WriteCamerasJson(const std::string& filename, const std::vector<CameraView>& views);
+
 }  // namespace camera
 }  // namespace open3d
