@@ -2,7 +2,8 @@
 // reference picks at that pixel, a Ctrl + drag selects what cpu::SelectSplatsInView selects,
 // Delete (sent through the X server, as another client would) removes exactly those splats,
 // Ctrl + I inverts, Ctrl + Z restores the cloud bit for bit (every cloud one removal changed),
-// and the edit saves to a file.
+// the edit saves to a file, a Ctrl + Alt drag selects a lasso's polygon, and K records
+// keyframes that save as a camera path.
 #include <GLFW/glfw3.h>
 #include <gtest/gtest.h>
 
@@ -14,6 +15,9 @@
 
 #include "TestUtility.h"
 #include "XKeySender.h"
+#include "open3d/camera/CameraPath.h"
+#include "open3d/camera/CamerasJson.h"
+#include "open3d/core/Exception.h"
 #include "open3d/t/io/PointCloudIO.h"
 #include "open3d/visualization/rendering/gaussian_splat/DefaultScene.h"
 #include "open3d/visualization/rendering/gaussian_splat/cpu/Picking.h"
@@ -140,6 +144,63 @@ TEST_F(VisualizerEditing, OneUndoRestoresEveryCloudADeleteChanged) {
     EXPECT_TRUE(SameCloud(splats.GetCloud("a"), a));
     EXPECT_TRUE(SameCloud(splats.GetCloud("b"), b));
     EXPECT_FALSE(vis.UndoEdit());
+}
+
+TEST_F(VisualizerEditing, ALassoSelectsWhatTheReferenceSelectsInItsPolygon) {
+    visualization::Visualizer& vis = MakeVisualizer(160, 120);
+    const t::geometry::PointCloud cloud = rendering::CreateDefaultGaussianSplatScene();
+    vis.AddGeometry("scene", cloud);
+    vis.ResetCamera();
+    ASSERT_TRUE(vis.RenderFrame());
+    // Ctrl + Alt + drag through a triangle: the press and every cursor position are its
+    // vertices.
+    const int mods = GLFW_MOD_CONTROL | GLFW_MOD_ALT;
+    vis.OnCursorPos(40, 30);
+    vis.OnMouseButton(GLFW_MOUSE_BUTTON_LEFT, true, mods);
+    vis.OnCursorPos(110, 40);
+    vis.OnCursorPos(70, 90);
+    vis.OnMouseButton(GLFW_MOUSE_BUTTON_LEFT, false, mods);
+    const std::vector<int64_t> want = rendering::cpu::SelectSplatsInView(
+        cloud, vis.GetCamera(), vis.GetSplatConfig(), {{40, 30}, {110, 40}, {70, 90}});
+    ASSERT_GT(want.size(), 10u);
+    ASSERT_EQ(vis.GetSelection().count("scene"), 1u);
+    EXPECT_EQ(vis.GetSelection().at("scene"), want);
+    // The triangle holds fewer than its bounding rectangle.
+    EXPECT_LT(want.size(),
+              rendering::cpu::SelectSplatsInView(cloud, vis.GetCamera(), vis.GetSplatConfig(),
+                                                 rendering::cpu::RectanglePolygon(40, 30, 110, 90))
+                  .size());
+}
+
+TEST_F(VisualizerEditing, KeyframesRecordTheCameraAndSaveAsACameraPath) {
+    visualization::Visualizer& vis = MakeVisualizer(160, 120);
+    vis.AddGeometry("scene", rendering::CreateDefaultGaussianSplatScene());
+    vis.ResetCamera();
+    PressKey(vis, GLFW_KEY_K);
+    const camera::PinholeCamera first = vis.GetCamera();
+    vis.GetViewControl().Rotate(40, 10);
+    PressKey(vis, GLFW_KEY_K);
+    const camera::PinholeCamera second = vis.GetCamera();
+    ASSERT_EQ(vis.GetKeyframes().size(), 2u);
+    EXPECT_EQ(*vis.GetKeyframes()[0].time, 0.0);
+    EXPECT_EQ(*vis.GetKeyframes()[1].time, 2.0);
+    const std::string path = (std::filesystem::path(TempDir()) / "viewer_keyframes.json").string();
+    vis.SaveKeyframes(path);
+    const std::vector<camera::CameraView> read = camera::ReadCamerasJson(path);
+    std::filesystem::remove(path);
+    ASSERT_EQ(read.size(), 2u);
+    // The path through them starts and ends at the recorded cameras (the file holds the
+    // centre: within ulps of its size).
+    const camera::CameraPath path_read = camera::CameraPath::FromViews(read, 1.0);
+    EXPECT_EQ(path_read.GetDuration(), 2.0);
+    for (const auto& [camera, time] : {std::pair{first, 0.0}, std::pair{second, 2.0}}) {
+        const camera::PinholeCamera at = path_read.At(time);
+        EXPECT_TRUE(at.GetRotation() == camera.GetRotation());
+        EXPECT_LE((at.GetCenter() - camera.GetCenter()).norm(), 1e-12 * camera.GetCenter().norm());
+        EXPECT_EQ(at.fy, camera.fy);
+    }
+    vis.ClearKeyframes();
+    EXPECT_THROW(vis.SaveKeyframes(path), core::Open3DError);
 }
 
 }  // namespace

@@ -22,6 +22,7 @@
 #include <variant>
 #include <vector>
 
+#include "open3d/camera/CamerasJson.h"
 #include "open3d/camera/PinholeCamera.h"
 #include "open3d/t/geometry/Image.h"
 #include "open3d/t/geometry/PointCloud.h"
@@ -282,8 +283,9 @@ public:
     const std::string& GetStatus() const { return status_; }
 
     // Editing splat clouds (docs/viewer.md "Editing"). Mouse and keys: Ctrl + click picks,
-    // Ctrl + drag selects a rectangle (Ctrl + Shift + drag adds to the selection), Delete
-    // removes the selected splats, Ctrl + I inverts the selection, Ctrl + Z undoes a removal.
+    // Ctrl + drag selects a rectangle, Ctrl + Alt + drag a lasso (with Shift either adds to
+    // the selection), Delete removes the selected splats, Ctrl + I inverts the selection,
+    // Ctrl + Z undoes a removal, K adds the camera as a keyframe of a camera path.
     /// The splat that contributes most to window pixel (x, y) (the composite's ID image of
     /// the current camera) and the point there; nullopt where no splat is. Kept in GetPicks.
     std::optional<SplatPick> PickSplat(int x, int y);
@@ -291,6 +293,8 @@ public:
     /// and that the view shows there (cpu::SelectSplatsInView, each cloud on its own);
     /// `add` keeps the earlier selection. Returns the number selected in all.
     int64_t SelectSplats(double x0, double y0, double x1, double y1, bool add = false);
+    /// The same for a polygon of window pixels (a lasso; at least 3 vertices).
+    int64_t SelectSplatsInPolygon(const std::vector<Eigen::Vector2d>& polygon, bool add = false);
     /// Every splat of the clouds that have a selection becomes selected but the selected
     /// ones. Returns the number selected in all.
     int64_t InvertSelection();
@@ -307,6 +311,19 @@ public:
     /// Writes splat cloud `name` as it stands (edits included) in any writable format
     /// (t::io::WritePointCloud; the extension decides). Throws naming the file.
     void SaveGeometry(const std::string& name, const std::string& path);
+    /// Appends the current camera to the camera path being recorded, 2 s after the last
+    /// keyframe (the first at 0 s); returns the number of keyframes.
+    size_t AddKeyframe();
+    /// The keyframes as cameras.json views with their times (gs-render --camera-path, Python
+    /// CameraPath.from_cameras_json).
+    const std::vector<camera::CameraView>& GetKeyframes() const { return keyframes_; }
+    void ClearKeyframes() {
+        keyframes_.clear();
+        PostRedraw();
+    }
+    /// Writes the keyframes as cameras.json (camera::WriteCamerasJson); throws when there are
+    /// none or the file cannot be written.
+    void SaveKeyframes(const std::string& path) const;
 
     // WindowEventHandler: GLFW's callbacks arrive here; tests may inject events.
     void OnMouseButton(int button, bool pressed, int mods) override;
@@ -400,7 +417,11 @@ private:
     // Per DeleteSelection, every cloud it changed as it was before.
     std::vector<std::vector<std::pair<std::string, t::geometry::PointCloud>>> undo_;
     double press_x_ = 0.0, press_y_ = 0.0;  // where a Ctrl + drag started
-    std::string edit_error_;                // the last editing error, shown in the panel
+    bool lasso_ = false;                    // the Ctrl + drag is a lasso (Alt held)
+    std::vector<Eigen::Vector2d> lasso_points_;
+    std::vector<camera::CameraView> keyframes_;
+    char edit_path_[1024] = {};  // the panel's file field for saving clouds and keyframes
+    std::string edit_status_;    // the last edit error or save, shown in the panel
 };
 
 /// A geometry for Draw: a splat cloud or a mesh, by name.

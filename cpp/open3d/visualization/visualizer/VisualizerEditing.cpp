@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <exception>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -60,14 +61,17 @@ std::optional<SplatPick> Visualizer::PickSplat(int x, int y) {
 }
 
 int64_t Visualizer::SelectSplats(double x0, double y0, double x1, double y1, bool add) {
+    return SelectSplatsInPolygon(rendering::cpu::RectanglePolygon(x0, y0, x1, y1), add);
+}
+
+int64_t Visualizer::SelectSplatsInPolygon(const std::vector<Eigen::Vector2d>& polygon, bool add) {
     if (!add) selection_.clear();
     const camera::PinholeCamera camera = view_control_.GetCamera();
-    const std::vector<Eigen::Vector2d> rectangle = rendering::cpu::RectanglePolygon(x0, y0, x1, y1);
     rendering::GaussianSplatRenderer& splats = scene_->GetScene().GetSplatRenderer();
     for (const std::string& name : names_) {
         if (!splats.HasCloud(name) || !splats.IsCloudVisible(name)) continue;
         std::vector<int64_t> chosen = rendering::cpu::SelectSplatsInView(
-            splats.GetCloud(name), camera, scene_->GetSplatConfig(), rectangle);
+            splats.GetCloud(name), camera, scene_->GetSplatConfig(), polygon);
         if (chosen.empty()) continue;
         std::vector<int64_t>& kept = selection_[name];
         std::vector<int64_t> merged;
@@ -136,6 +140,24 @@ void Visualizer::SaveGeometry(const std::string& name, const std::string& path) 
     t::io::WritePointCloud(path, splats.GetCloud(name));
 }
 
+size_t Visualizer::AddKeyframe() {
+    // A path's default spacing (docs/camera-paths.md): gs-render's --seconds-per-keyframe.
+    constexpr double kSecondsPerKeyframe = 2.0;
+    camera::CameraView view;
+    view.id = static_cast<int>(keyframes_.size());
+    view.img_name = fmt::format("keyframe_{:03d}", keyframes_.size());
+    view.camera = view_control_.GetCamera();
+    view.time = keyframes_.empty() ? 0.0 : *keyframes_.back().time + kSecondsPerKeyframe;
+    keyframes_.push_back(view);
+    PostRedraw();
+    return keyframes_.size();
+}
+
+void Visualizer::SaveKeyframes(const std::string& path) const {
+    if (keyframes_.empty()) core::ThrowError("SaveKeyframes: no keyframes (K adds the camera)");
+    camera::WriteCamerasJson(path, keyframes_);
+}
+
 bool Visualizer::OnEditKey(int key, int mods) {
     const bool ctrl = (mods & GLFW_MOD_CONTROL) != 0;
     try {
@@ -145,12 +167,14 @@ bool Visualizer::OnEditKey(int key, int mods) {
             InvertSelection();
         } else if (ctrl && key == GLFW_KEY_Z) {
             UndoEdit();
+        } else if (mods == 0 && key == GLFW_KEY_K) {
+            AddKeyframe();
         } else {
             return false;
         }
-        edit_error_.clear();
+        edit_status_.clear();
     } catch (const std::exception& e) {
-        edit_error_ = e.what();
+        edit_status_ = e.what();
     }
     return true;
 }
@@ -164,12 +188,14 @@ void Visualizer::EndSelectDrag(Drag drag) {
             const int x = static_cast<int>(std::lround(press_x_));
             const int y = static_cast<int>(std::lround(press_y_));
             if (x >= 0 && y >= 0 && x < fb_width_ && y < fb_height_) PickSplat(x, y);
+        } else if (lasso_ && lasso_points_.size() >= 3) {
+            SelectSplatsInPolygon(lasso_points_, drag == Drag::kSelectAdd);
         } else {
             SelectSplats(press_x_, press_y_, cursor_x_, cursor_y_, drag == Drag::kSelectAdd);
         }
-        edit_error_.clear();
+        edit_status_.clear();
     } catch (const std::exception& e) {
-        edit_error_ = e.what();
+        edit_status_ = e.what();
     }
     PostRedraw();
 }
@@ -194,7 +220,35 @@ void Visualizer::DrawEditingPanel() {
         if (ImGui::Button("Clear")) ClearSelection();
     }
     if (!undo_.empty() && ImGui::Button("Undo (Ctrl+Z)")) OnEditKey(GLFW_KEY_Z, GLFW_MOD_CONTROL);
-    if (!edit_error_.empty()) ImGui::TextWrapped("%s", edit_error_.c_str());
+    ImGui::Text("Camera path: %zu keyframes", keyframes_.size());
+    if (ImGui::Button("Add keyframe (K)")) OnEditKey(GLFW_KEY_K, 0);
+    if (!keyframes_.empty()) {
+        ImGui::SameLine();
+        if (ImGui::Button("Clear keyframes")) ClearKeyframes();
+    }
+    // One file field for what the buttons below write (the extension picks a cloud's format).
+    ImGui::SetNextItemWidth(ImGui::GetFontSize() * 16.0f);
+    ImGui::InputTextWithHint("##edit_path", "file to save to", edit_path_, sizeof(edit_path_));
+    const auto save = [&](const std::function<void(const std::string&)>& write) {
+        try {
+            if (edit_path_[0] == '\0') core::ThrowError("type a file name to save to first");
+            write(edit_path_);
+            edit_status_ = fmt::format("Saved {}", edit_path_);
+        } catch (const std::exception& e) {
+            edit_status_ = e.what();
+        }
+    };
+    if (!keyframes_.empty() && ImGui::Button("Save camera path")) {
+        save([&](const std::string& path) { SaveKeyframes(path); });
+    }
+    rendering::GaussianSplatRenderer& splats = scene_->GetScene().GetSplatRenderer();
+    for (const std::string& name : names_) {
+        if (!splats.HasCloud(name)) continue;
+        if (ImGui::Button(fmt::format("Save {}", name).c_str())) {
+            save([&](const std::string& path) { SaveGeometry(name, path); });
+        }
+    }
+    if (!edit_status_.empty()) ImGui::TextWrapped("%s", edit_status_.c_str());
 }
 
 }  // namespace visualization

@@ -40,6 +40,8 @@ void Visualizer::OnMouseButton(int button, bool pressed, int mods) {
         drag_ = (mods & GLFW_MOD_SHIFT) ? Drag::kSelectAdd : Drag::kSelect;
         press_x_ = cursor_x_;
         press_y_ = cursor_y_;
+        lasso_ = (mods & GLFW_MOD_ALT) != 0;
+        lasso_points_.assign(1, Eigen::Vector2d(cursor_x_, cursor_y_));
     } else if (button == GLFW_MOUSE_BUTTON_LEFT && !(mods & GLFW_MOD_SHIFT)) {
         drag_ = Drag::kRotate;
     } else {
@@ -57,6 +59,9 @@ void Visualizer::OnCursorPos(double x, double y) {
     if (drag_ == Drag::kRotate) view_control_.Rotate(dx, dy);
     if (drag_ == Drag::kPan) view_control_.Pan(dx, dy);
     if (drag_ == Drag::kRotate || drag_ == Drag::kPan) NoteCameraMotion();
+    if (lasso_ && (drag_ == Drag::kSelect || drag_ == Drag::kSelectAdd)) {
+        lasso_points_.emplace_back(x, y);
+    }
 }
 
 void Visualizer::OnScroll(double dx, double dy) {

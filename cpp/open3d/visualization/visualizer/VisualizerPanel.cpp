@@ -150,8 +150,9 @@ void Visualizer::BuildPanel() {
             "Arrows: orbit (shift: pan)\n"
             "1-9: toggle object\n"
             "Ctrl click: pick, Ctrl drag: select\n"
-            "(+Shift: add), Del: delete selected\n"
-            "Ctrl+I: invert, Ctrl+Z: undo\n"
+            "Ctrl+Alt drag: lasso (+Shift: add)\n"
+            "Del: delete selected, Ctrl+I: invert\n"
+            "Ctrl+Z: undo, K: camera keyframe\n"
             "R: reset camera, P: screenshot\n"
             "H: hide panel, Q/Esc: quit");
     }
