@@ -2,8 +2,9 @@
 // reference picks at that pixel, a Ctrl + drag selects what cpu::SelectSplatsInView selects,
 // Delete (sent through the X server, as another client would) removes exactly those splats,
 // Ctrl + I inverts, Ctrl + Z restores the cloud bit for bit (every cloud one removal changed),
-// the edit saves to a file, a Ctrl + Alt drag selects a lasso's polygon, and K records
-// keyframes that save as a camera path.
+// the edit saves to a file, a Ctrl + Alt drag selects a lasso's polygon, cropping to the
+// selection's box keeps what PointCloud::Crop keeps, and K records keyframes that save as a
+// camera path.
 #include <GLFW/glfw3.h>
 #include <gtest/gtest.h>
 
@@ -201,6 +202,36 @@ TEST_F(VisualizerEditing, KeyframesRecordTheCameraAndSaveAsACameraPath) {
     }
     vis.ClearKeyframes();
     EXPECT_THROW(vis.SaveKeyframes(path), core::Open3DError);
+}
+
+TEST_F(VisualizerEditing, CropToTheSelectionsBoxKeepsWhatPointCloudCropKeeps) {
+    visualization::Visualizer& vis = MakeVisualizer(160, 120);
+    const t::geometry::PointCloud cloud = rendering::CreateDefaultGaussianSplatScene();
+    vis.AddGeometry("scene", cloud);
+    vis.ResetCamera();
+    ASSERT_TRUE(vis.RenderFrame());
+    EXPECT_THROW(vis.GetSelectionBox(), core::Open3DError);
+    vis.SelectSplats(50, 40, 100, 80);
+    const std::vector<int64_t> selected = vis.GetSelection().at("scene");
+    // The box of the selected centres, computed here from the cloud.
+    const t::geometry::AxisAlignedBoundingBox want =
+        cloud.SelectByIndex(selected).GetAxisAlignedBoundingBox();
+    const t::geometry::OrientedBoundingBox box = vis.GetSelectionBox();
+    EXPECT_TRUE(box.GetCenter() == want.GetCenter());
+    EXPECT_TRUE(box.GetExtent() == want.GetExtent());
+    const t::geometry::PointCloud kept = cloud.Crop(box);
+    ASSERT_LT(kept.NumPoints(), cloud.NumPoints());
+    ASSERT_GE(kept.NumPoints(), int64_t(selected.size()));
+    EXPECT_EQ(vis.CropSplats(box), cloud.NumPoints() - kept.NumPoints());
+    const rendering::GaussianSplatRenderer& splats = vis.GetScene().GetScene().GetSplatRenderer();
+    EXPECT_TRUE(SameCloud(splats.GetCloud("scene"), kept));
+    EXPECT_TRUE(vis.GetSelection().empty());
+    ASSERT_TRUE(vis.RenderFrame());
+    ASSERT_TRUE(vis.UndoEdit());
+    EXPECT_TRUE(SameCloud(splats.GetCloud("scene"), cloud));
+    // Inverted: what lies outside.
+    vis.CropSplats(box, true);
+    EXPECT_TRUE(SameCloud(splats.GetCloud("scene"), cloud.Crop(box, true)));
 }
 
 }  // namespace

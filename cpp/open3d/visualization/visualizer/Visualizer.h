@@ -24,6 +24,7 @@
 
 #include "open3d/camera/CamerasJson.h"
 #include "open3d/camera/PinholeCamera.h"
+#include "open3d/t/geometry/BoundingBox.h"
 #include "open3d/t/geometry/Image.h"
 #include "open3d/t/geometry/PointCloud.h"
 #include "open3d/t/geometry/TriangleMesh.h"
@@ -302,8 +303,14 @@ public:
     /// Removes the selected splats from their clouds (UpdateGeometry; undoable). Returns
     /// the number removed.
     int64_t DeleteSelection();
-    /// Restores the clouds as they were before the last DeleteSelection; false when there
-    /// is nothing to undo.
+    /// Keeps, of every visible splat cloud, the splats whose centre lies in `box` (with
+    /// `invert`, outside it), undoable as one edit. Returns the number removed.
+    int64_t CropSplats(const t::geometry::OrientedBoundingBox& box, bool invert = false);
+    /// The axis-aligned box around the selected splats' centres, as an oriented box (the
+    /// panel's "Crop to the selection's box"); throws when nothing is selected.
+    t::geometry::OrientedBoundingBox GetSelectionBox() const;
+    /// Restores the clouds as they were before the last DeleteSelection or CropSplats;
+    /// false when there is nothing to undo.
     bool UndoEdit();
     /// Selected splat indices per cloud (ascending).
     const std::map<std::string, std::vector<int64_t>>& GetSelection() const { return selection_; }
@@ -412,6 +419,9 @@ private:
     void DrawEditingPanel();
     /// Selected splats over all clouds.
     int64_t SelectedCount() const;
+    /// After an edit replaced the clouds in `before` (as they were): one undo step; the
+    /// selection and picks end (their indices named the old clouds).
+    void CommitEdit(std::vector<std::pair<std::string, t::geometry::PointCloud>> before);
     std::map<std::string, std::vector<int64_t>> selection_;
     std::vector<SplatPick> picks_;
     // Per DeleteSelection, every cloud it changed as it was before.

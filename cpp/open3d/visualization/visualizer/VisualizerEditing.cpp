@@ -113,13 +113,50 @@ int64_t Visualizer::DeleteSelection() {
         UpdateGeometry(name, before.back().second.RemoveByIndex(indices));
         removed += static_cast<int64_t>(indices.size());
     }
+    CommitEdit(std::move(before));
+    return removed;
+}
+
+int64_t Visualizer::CropSplats(const t::geometry::OrientedBoundingBox& box, bool invert) {
+    rendering::GaussianSplatRenderer& splats = scene_->GetScene().GetSplatRenderer();
+    int64_t removed = 0;
+    std::vector<std::pair<std::string, t::geometry::PointCloud>> before;
+    for (const std::string& name : names_) {
+        if (!splats.HasCloud(name) || !splats.IsCloudVisible(name)) continue;
+        const t::geometry::PointCloud& cloud = splats.GetCloud(name);
+        t::geometry::PointCloud cropped = cloud.Crop(box, invert);
+        if (cropped.NumPoints() == cloud.NumPoints()) continue;  // nothing left out
+        removed += cloud.NumPoints() - cropped.NumPoints();
+        before.emplace_back(name, cloud);
+        UpdateGeometry(name, cropped);
+    }
+    CommitEdit(std::move(before));
+    return removed;
+}
+
+t::geometry::OrientedBoundingBox Visualizer::GetSelectionBox() const {
+    const rendering::GaussianSplatRenderer& splats = scene_->GetScene().GetSplatRenderer();
+    std::optional<t::geometry::AxisAlignedBoundingBox> box;  // the union of each cloud's box
+    for (const auto& [name, indices] : selection_) {
+        if (indices.empty()) continue;
+        const t::geometry::AxisAlignedBoundingBox part =
+            splats.GetCloud(name).SelectByIndex(indices).GetAxisAlignedBoundingBox();
+        box = box ? t::geometry::AxisAlignedBoundingBox(
+                        box->GetMinBound().cwiseMin(part.GetMinBound()),
+                        box->GetMaxBound().cwiseMax(part.GetMaxBound()))
+                  : part;
+    }
+    if (!box) core::ThrowError("GetSelectionBox: nothing is selected");
+    return t::geometry::OrientedBoundingBox::FromAxisAligned(*box);
+}
+
+void Visualizer::CommitEdit(std::vector<std::pair<std::string, t::geometry::PointCloud>> before) {
     if (!before.empty()) {
         undo_.push_back(std::move(before));
         if (undo_.size() > kMaxUndo) undo_.erase(undo_.begin());
     }
     selection_.clear();
-    picks_.clear();  // their indices named splats of the clouds before
-    return removed;
+    picks_.clear();
 }
 
 bool Visualizer::UndoEdit() {
@@ -218,6 +255,14 @@ void Visualizer::DrawEditingPanel() {
         if (ImGui::Button("Invert (Ctrl+I)")) OnEditKey(GLFW_KEY_I, GLFW_MOD_CONTROL);
         ImGui::SameLine();
         if (ImGui::Button("Clear")) ClearSelection();
+        if (ImGui::Button("Crop to the selection's box")) {
+            try {
+                CropSplats(GetSelectionBox());
+                edit_status_.clear();
+            } catch (const std::exception& e) {
+                edit_status_ = e.what();
+            }
+        }
     }
     if (!undo_.empty() && ImGui::Button("Undo (Ctrl+Z)")) OnEditKey(GLFW_KEY_Z, GLFW_MOD_CONTROL);
     ImGui::Text("Camera path: %zu keyframes", keyframes_.size());
