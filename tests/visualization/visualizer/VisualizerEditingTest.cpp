@@ -3,11 +3,12 @@
 // Delete (sent through the X server, as another client would) removes exactly those splats,
 // Ctrl + I inverts, Ctrl + Z restores the cloud bit for bit (every cloud one removal changed),
 // the edit saves to a file, a Ctrl + Alt drag selects a lasso's polygon, cropping to the
-// selection's box keeps what PointCloud::Crop keeps, and K records keyframes that save as a
-// camera path.
+// selection's box keeps what PointCloud::Crop keeps, K records keyframes that save as a
+// camera path, and the selection shows as red points.
 #include <GLFW/glfw3.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <chrono>
 #include <filesystem>
 #include <string>
@@ -232,6 +233,26 @@ TEST_F(VisualizerEditing, CropToTheSelectionsBoxKeepsWhatPointCloudCropKeeps) {
     // Inverted: what lies outside.
     vis.CropSplats(box, true);
     EXPECT_TRUE(SameCloud(splats.GetCloud("scene"), cloud.Crop(box, true)));
+}
+
+TEST_F(VisualizerEditing, TheSelectionIsDrawnAsRedPointsUntilItEnds) {
+    visualization::Visualizer& vis = MakeVisualizer(160, 120);
+    vis.AddGeometry("scene", rendering::CreateDefaultGaussianSplatScene());
+    vis.ResetCamera();
+    const int64_t before = CountRed(vis.CaptureScreenImage());
+    vis.SelectSplats(50, 40, 110, 80);
+    ASSERT_FALSE(vis.GetSelection().empty());
+    // Hundreds of selected centres, each a 3-pixel red square where nothing hides it.
+    EXPECT_GT(CountRed(vis.CaptureScreenImage()), before + 50);
+    EXPECT_FALSE(
+        std::count(vis.GetGeometryNames().begin(), vis.GetGeometryNames().end(), "__selection__"));
+    vis.ClearSelection();
+    EXPECT_EQ(CountRed(vis.CaptureScreenImage()), before);
+    // The overlay's name is the viewer's, and only window objects can be removed.
+    EXPECT_THROW(vis.AddGeometry("__selection__", rendering::CreateDefaultGaussianSplatScene()),
+                 core::Open3DError);
+    EXPECT_FALSE(vis.RemoveGeometry("__selection__"));
+    EXPECT_FALSE(vis.RemoveGeometry("never added"));
 }
 
 }  // namespace

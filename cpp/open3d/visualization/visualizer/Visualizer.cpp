@@ -84,6 +84,7 @@ void Visualizer::NoteNewSplats(const t::geometry::PointCloud& cloud) {
 }
 
 void Visualizer::AddGeometry(const std::string& name, const t::geometry::PointCloud& cloud) {
+    RequireObjectName(name);
     scene_->AddGeometry(name, cloud);
     NoteNewSplats(cloud);
     names_.push_back(name);
@@ -92,6 +93,7 @@ void Visualizer::AddGeometry(const std::string& name, const t::geometry::PointCl
 
 void Visualizer::AddGeometry(const std::string& name, const t::geometry::PointCloud& cloud,
                              const rendering::MaterialRecord& material) {
+    RequireObjectName(name);
     scene_->AddGeometry(name, cloud, material);
     NoteNewSplats(cloud);
     names_.push_back(name);
@@ -100,6 +102,7 @@ void Visualizer::AddGeometry(const std::string& name, const t::geometry::PointCl
 
 void Visualizer::AddGeometry(const std::string& name, const t::geometry::TriangleMesh& mesh,
                              const rendering::MaterialRecord& material) {
+    RequireObjectName(name);
     scene_->AddGeometry(name, mesh, material);
     names_.push_back(name);
     PostRedraw();
@@ -141,8 +144,10 @@ std::optional<rendering::SplatStreamProgress> Visualizer::GetStreamProgress() co
 }
 
 bool Visualizer::RemoveGeometry(const std::string& name) {
-    if (!scene_->RemoveGeometry(name)) return false;
-    names_.erase(std::find(names_.begin(), names_.end(), name));
+    const auto it = std::find(names_.begin(), names_.end(), name);
+    if (it == names_.end() || !scene_->RemoveGeometry(name)) return false;
+    names_.erase(it);
+    if (selection_.erase(name) > 0) UpdateSelectionOverlay();
     PostRedraw();
     return true;
 }

@@ -422,6 +422,13 @@ private:
     /// After an edit replaced the clouds in `before` (as they were): one undo step; the
     /// selection and picks end (their indices named the old clouds).
     void CommitEdit(std::vector<std::pair<std::string, t::geometry::PointCloud>> before);
+    /// Draws the selection: red points at the selected centres, a scene geometry named
+    /// kSelectionOverlay that is not one of the window's objects (none when nothing is
+    /// selected).
+    void UpdateSelectionOverlay();
+    /// Throws for the name the selection overlay takes.
+    static void RequireObjectName(const std::string& name);
+    static constexpr const char* kSelectionOverlay = "__selection__";
     std::map<std::string, std::vector<int64_t>> selection_;
     std::vector<SplatPick> picks_;
     // Per DeleteSelection, every cloud it changed as it was before.

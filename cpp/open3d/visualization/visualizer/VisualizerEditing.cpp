@@ -13,6 +13,7 @@
 
 #include "open3d/core/Exception.h"
 #include "open3d/t/io/PointCloudIO.h"
+#include "open3d/visualization/rendering/filament/MaterialRecord.h"
 #include "open3d/visualization/rendering/gaussian_splat/GaussianSplatRenderer.h"
 #include "open3d/visualization/rendering/gaussian_splat/cpu/ViewSelection.h"
 #include "open3d/visualization/visualizer/Visualizer.h"
@@ -79,7 +80,7 @@ int64_t Visualizer::SelectSplatsInPolygon(const std::vector<Eigen::Vector2d>& po
                        std::back_inserter(merged));
         kept = std::move(merged);
     }
-    PostRedraw();
+    UpdateSelectionOverlay();
     return SelectedCount();
 }
 
@@ -88,7 +89,7 @@ int64_t Visualizer::InvertSelection() {
     for (auto& [name, indices] : selection_) {
         indices = t::geometry::ComplementIndices(indices, splats.GetCloud(name).NumPoints());
     }
-    PostRedraw();
+    UpdateSelectionOverlay();
     return SelectedCount();
 }
 
@@ -100,7 +101,34 @@ int64_t Visualizer::SelectedCount() const {
 
 void Visualizer::ClearSelection() {
     selection_.clear();
+    UpdateSelectionOverlay();
+}
+
+void Visualizer::UpdateSelectionOverlay() {
+    scene_->RemoveGeometry(kSelectionOverlay);
     PostRedraw();
+    rendering::GaussianSplatRenderer& splats = scene_->GetScene().GetSplatRenderer();
+    std::vector<float> centres;
+    for (const auto& [name, indices] : selection_) {
+        if (!splats.HasCloud(name)) continue;
+        const float* p = splats.GetCloud(name).GetPointPositions().Data<float>();
+        for (int64_t i : indices) centres.insert(centres.end(), p + 3 * i, p + 3 * i + 3);
+    }
+    if (centres.empty()) return;
+    rendering::MaterialRecord red;
+    red.shader = rendering::kShaderDefaultUnlit;
+    red.base_color = Eigen::Vector4f(1.0f, 0.0f, 0.0f, 1.0f);
+    red.point_size = 3.0f;
+    const int64_t n = static_cast<int64_t>(centres.size() / 3);
+    scene_->AddGeometry(kSelectionOverlay,
+                        t::geometry::PointCloud(core::Tensor::FromVector(centres, {n, 3})), red);
+}
+
+void Visualizer::RequireObjectName(const std::string& name) {
+    if (name == kSelectionOverlay) {
+        core::ThrowError("'{}' is the name the viewer's selection overlay takes; choose another",
+                         name);
+    }
 }
 
 int64_t Visualizer::DeleteSelection() {
@@ -157,6 +185,7 @@ void Visualizer::CommitEdit(std::vector<std::pair<std::string, t::geometry::Poin
     }
     selection_.clear();
     picks_.clear();
+    UpdateSelectionOverlay();
 }
 
 bool Visualizer::UndoEdit() {
@@ -168,6 +197,7 @@ bool Visualizer::UndoEdit() {
     }
     selection_.clear();
     picks_.clear();
+    UpdateSelectionOverlay();
     return true;
 }
 
