@@ -222,7 +222,8 @@ void BindCamera(py::module_& m) {
                 return camera::CameraPath::FromViews(camera::ReadCamerasJson(InputPath(filename)),
                                                      seconds_per_keyframe);
             },
-            py::arg("filename"), py::arg("seconds_per_keyframe") = 2.0,
+            py::arg("filename"),
+            py::arg("seconds_per_keyframe") = camera::kDefaultSecondsPerKeyframe,
             "A cameras.json's views as keyframes: at their 'time' fields, or "
             "seconds_per_keyframe apart")
         .def_property_readonly("duration", &camera::CameraPath::GetDuration, "Seconds")

@@ -6,6 +6,7 @@
 #include <cstddef>
 #include <string>
 
+#include "open3d/camera/CameraPath.h"
 #include "open3d/visualization/rendering/gaussian_splat/GaussianSplatBackend.h"
 
 namespace gs_render {
@@ -13,8 +14,8 @@ namespace gs_render {
 struct CameraPathOptions {
     std::string path_file;  ///< cameras.json entries, "time" optional
     double fps = 30.0;
-    double seconds_per_keyframe = 2.0;  ///< where the entries carry no "time"
-    int width = 0;                      ///< 0: the keyframes' size (one of the two: aspect kept)
+    double seconds_per_keyframe = open3d::camera::kDefaultSecondsPerKeyframe;  ///< where no "time"
+    int width = 0;  ///< 0: the keyframes' size (one of the two: aspect kept)
     int height = 0;
     /// .png: frames at <stem>_00000.png, <stem>_00001.png, ... beside it; .mp4: one video.
     std::string output;

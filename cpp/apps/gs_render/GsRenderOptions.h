@@ -7,6 +7,8 @@
 #include <string>
 #include <vector>
 
+#include "open3d/camera/CameraPath.h"
+
 namespace gs_render {
 
 struct Options {
@@ -39,7 +41,7 @@ struct Options {
     std::string lod;          // hierarchy file; default <input>.lod, else built here
     std::string camera_path;  // --camera-path: render a path instead of one view
     double fps = 30.0;
-    double seconds_per_keyframe = 2.0;
+    double seconds_per_keyframe = open3d::camera::kDefaultSecondsPerKeyframe;
 };
 
 }  // namespace gs_render

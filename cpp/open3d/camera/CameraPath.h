@@ -20,6 +20,10 @@ struct CameraKeyframe {
     PinholeCamera camera;
 };
 
+/// Keyframes' spacing where their file gives no times, and the viewer's (gs-render's
+/// --seconds-per-keyframe default, Python's CameraPath.from_cameras_json).
+inline constexpr double kDefaultSecondsPerKeyframe = 2.0;
+
 class CameraPath {
 public:
     /// At least one keyframe, times finite and strictly increasing, every camera valid and of

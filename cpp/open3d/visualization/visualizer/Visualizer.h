@@ -422,6 +422,8 @@ private:
     /// After an edit replaced the clouds in `before` (as they were): one undo step; the
     /// selection and picks end (their indices named the old clouds).
     void CommitEdit(std::vector<std::pair<std::string, t::geometry::PointCloud>> before);
+    /// After the clouds changed: their selection and picks named the splats before.
+    void EndSelectionAndPicks();
     /// Draws the selection: red points at the selected centres, a scene geometry named
     /// kSelectionOverlay that is not one of the window's objects (none when nothing is
     /// selected).

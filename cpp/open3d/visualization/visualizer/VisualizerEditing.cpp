@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "open3d/camera/CameraPath.h"
 #include "open3d/core/Exception.h"
 #include "open3d/t/io/PointCloudIO.h"
 #include "open3d/visualization/rendering/filament/MaterialRecord.h"
@@ -183,6 +184,10 @@ void Visualizer::CommitEdit(std::vector<std::pair<std::string, t::geometry::Poin
         undo_.push_back(std::move(before));
         if (undo_.size() > kMaxUndo) undo_.erase(undo_.begin());
     }
+    EndSelectionAndPicks();
+}
+
+void Visualizer::EndSelectionAndPicks() {
     selection_.clear();
     picks_.clear();
     UpdateSelectionOverlay();
@@ -195,9 +200,7 @@ bool Visualizer::UndoEdit() {
     for (const auto& [name, cloud] : clouds) {
         if (scene_->GetScene().GetSplatRenderer().HasCloud(name)) UpdateGeometry(name, cloud);
     }
-    selection_.clear();
-    picks_.clear();
-    UpdateSelectionOverlay();
+    EndSelectionAndPicks();
     return true;
 }
 
@@ -208,13 +211,12 @@ void Visualizer::SaveGeometry(const std::string& name, const std::string& path) 
 }
 
 size_t Visualizer::AddKeyframe() {
-    // A path's default spacing (docs/camera-paths.md): gs-render's --seconds-per-keyframe.
-    constexpr double kSecondsPerKeyframe = 2.0;
     camera::CameraView view;
     view.id = static_cast<int>(keyframes_.size());
     view.img_name = fmt::format("keyframe_{:03d}", keyframes_.size());
     view.camera = view_control_.GetCamera();
-    view.time = keyframes_.empty() ? 0.0 : *keyframes_.back().time + kSecondsPerKeyframe;
+    view.time =
+        keyframes_.empty() ? 0.0 : *keyframes_.back().time + camera::kDefaultSecondsPerKeyframe;
     keyframes_.push_back(view);
     PostRedraw();
     return keyframes_.size();
