@@ -169,3 +169,19 @@ def test_an_interpreter_without_numpy_is_told_what_to_run():
     assert done.returncode != 0
     assert "open3d_gs needs numpy" in done.stderr and "build/bin/gs-python" in done.stderr
     assert "initialization failed" not in done.stderr
+
+
+def test_scenes_load_when_numpy_was_imported_first(data):
+    # On the GPU machine (numpy 2 wheels) an import of numpy before open3d_gs made the
+    # iostream parse of the cgroup's memory.max report 0 bytes free, refusing every scene
+    # (docs/environment-notes.md); the host memory check reads with C stdio since.
+    import subprocess
+    import sys
+
+    path = data("playbot/playbot_31k.ply")
+    code = ("import sys\nimport numpy\nimport open3d_gs as o3d\n"
+            "print(len(o3d.t.io.read_point_cloud(sys.argv[1])))\n")
+    run = subprocess.run([sys.executable, "-c", code, str(path)], capture_output=True, text=True,
+                         timeout=300)
+    assert run.returncode == 0, run.stderr
+    assert run.stdout.strip() == "31000"

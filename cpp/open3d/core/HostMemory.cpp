@@ -3,11 +3,13 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
-#include <fstream>
 #include <limits>
 #include <string>
+#include <vector>
 
 #include "open3d/core/Exception.h"
 
@@ -18,24 +20,66 @@ namespace {
 
 constexpr uint64_t kUnknown = std::numeric_limits<uint64_t>::max();
 
+// These reads use C stdio, not iostreams: in a Python process that had loaded NumPy 2's wheels
+// before this module, std::ifstream extraction here read "max" from memory.max as something
+// else, which became a limit of 0 bytes and refused every load (docs/environment-notes.md).
+
+// The first line of a small file, without its newline; false when it cannot be read.
+bool ReadFirstLine(const std::string& path, std::string& line) {
+    FILE* file = std::fopen(path.c_str(), "r");
+    if (file == nullptr) return false;
+    char buffer[4096];
+    const bool ok = std::fgets(buffer, sizeof(buffer), file) != nullptr;
+    std::fclose(file);
+    if (!ok) return false;
+    line = buffer;
+    while (!line.empty() && (line.back() == '\n' || line.back() == '\r')) line.pop_back();
+    return true;
+}
+
+// A whole line that is a decimal count; false for anything else ("max", empty, garbage).
+bool ParseCount(const std::string& text, uint64_t& value) {
+    if (text.empty() || text[0] < '0' || text[0] > '9') return false;
+    char* end = nullptr;
+    errno = 0;
+    const unsigned long long parsed = std::strtoull(text.c_str(), &end, 10);
+    if (errno != 0 || end == nullptr || *end != '\0') return false;
+    value = parsed;
+    return true;
+}
+
 // "MemAvailable:   23456789 kB" -> bytes.
 uint64_t ReadMemAvailable() {
-    std::ifstream in("/proc/meminfo");
-    std::string key;
-    uint64_t kb = 0;
-    std::string unit;
-    while (in >> key >> kb >> unit) {
-        if (key == "MemAvailable:") return kb * 1024;
+    FILE* file = std::fopen("/proc/meminfo", "r");
+    if (file == nullptr) return kUnknown;
+    char line[256];
+    uint64_t bytes = kUnknown;
+    while (std::fgets(line, sizeof(line), file) != nullptr) {
+        unsigned long long kb = 0;
+        if (std::sscanf(line, "MemAvailable: %llu kB", &kb) == 1) {
+            bytes = uint64_t(kb) * 1024;
+            break;
+        }
     }
-    return kUnknown;
+    std::fclose(file);
+    return bytes;
 }
 
 // The room the process's memory cgroup leaves: cgroup v2 memory.max - memory.current, or
-// v1 memory.limit_in_bytes - memory.usage_in_bytes ("max" or a huge v1 value: no limit).
+// v1 memory.limit_in_bytes - memory.usage_in_bytes ("max" or a huge v1 value: no limit). A
+// file that does not hold a count says nothing (no limit from it), never a limit of 0.
 uint64_t ReadCgroupRoom() {
-    std::ifstream cgroup("/proc/self/cgroup");
-    std::string line;
-    while (std::getline(cgroup, line)) {
+    FILE* cgroup = std::fopen("/proc/self/cgroup", "r");
+    if (cgroup == nullptr) return kUnknown;
+    std::vector<std::string> lines;
+    char buffer[4096];
+    while (std::fgets(buffer, sizeof(buffer), cgroup) != nullptr) {
+        std::string line = buffer;
+        while (!line.empty() && line.back() == '\n') line.pop_back();
+        lines.push_back(line);
+    }
+    std::fclose(cgroup);
+    for (const std::string& line : lines) {
         std::string limit_path, usage_path;
         if (line.rfind("0::", 0) == 0) {
             const std::string dir = "/sys/fs/cgroup" + line.substr(3);
@@ -48,11 +92,12 @@ uint64_t ReadCgroupRoom() {
         } else {
             continue;
         }
-        std::ifstream limit_file(limit_path), usage_file(usage_path);
-        std::string limit_text;
-        uint64_t usage = 0;
-        if (!(limit_file >> limit_text) || limit_text == "max" || !(usage_file >> usage)) continue;
-        const uint64_t limit = std::strtoull(limit_text.c_str(), nullptr, 10);
+        std::string limit_text, usage_text;
+        uint64_t limit = 0, usage = 0;
+        if (!ReadFirstLine(limit_path, limit_text) || !ParseCount(limit_text, limit) ||
+            !ReadFirstLine(usage_path, usage_text) || !ParseCount(usage_text, usage)) {
+            continue;
+        }
         if (limit >= (uint64_t(1) << 60)) continue;  // v1 writes "no limit" as ~2^63
         return limit > usage ? limit - usage : 0;
     }
