@@ -275,7 +275,7 @@ def _pick(queue, member, pool, cache_scenes):
 
 def render_jobs(client, jobs, *, batch=8, retries=3, backend="vulkan", resources="auto",
                 return_arrays=False, progress=None, worker_hook=None, cache_scenes=2,
-                calls_per_worker=2, worker_wait=600.0, timeout=None, poll=0.02, protect=()):
+                calls_per_worker=4, worker_wait=600.0, timeout=None, poll=0.005, protect=()):
     """Renders `jobs` (Job records) on the workers of `client`; returns a Report.
 
     batch: views per render_batch call; retries: how often a batch lost with its worker (or

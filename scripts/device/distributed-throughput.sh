@@ -85,6 +85,9 @@ prepare() {
   # Debian's dask and distributed are pure Python (tornado's one extension is abi3).
   local dist=/usr/lib/python3/dist-packages packages=(dask distributed tornado partd locket zict tblib) p
   for p in "${packages[@]}"; do packages+=("$(cd "$dist" && echo "$p"-*.egg-info)"); done
+  # zict's heapdict, a module of one file, and sortedcontainers: the device image lacked
+  # heapdict (ModuleNotFoundError from zict on the first run there).
+  packages+=(heapdict.py HeapDict-1.0.1.egg-info sortedcontainers sortedcontainers-2.4.0.egg-info)
   tar -C "$dist" --exclude=tests --exclude=__pycache__ -czf "$pymod/pydeps.tar.gz" "${packages[@]}"
   echo "prepare: .pymod holds $(du -sh "$pymod" | cut -f1); carry .gl .devlibs .pymod and the scene files:"
   echo "  [\".gl\", \".devlibs\", \".pymod\", \"shared/data/playbot/playbot_125k.ply\", \"shared/data/playbot/cameras.json\"]"
@@ -163,6 +166,9 @@ measure() {
   export LD_LIBRARY_PATH="$work/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
   export PYTHONPATH="$work/python:$work/pydeps${PYTHONPATH:+:$PYTHONPATH}"
   export PYTHONUNBUFFERED=1
+  # Dask 2022.12's GPU monitor calls .decode() on what the device's newer pynvml returns as
+  # str, and the scheduler fails to start; the benchmark does not need the monitor.
+  export DASK_DISTRIBUTED__DIAGNOSTICS__NVML=False
   local carried=("$work"/lib/*)
   [ -e "${carried[0]}" ] || carried=(none)
   echo "measure: carried libraries in use (this machine lacks them): ${carried[*]##*/}"
