@@ -93,11 +93,11 @@ public:
     /// that write the parameters themselves pass it.
     uint32_t GetMaxGroupsX() const;
 
-    /// How the passes run (the class comment). kDefault: the multi-pass sort, unless the
-    /// environment variable OPEN3D_RADIX_SORT=onesweep (or =multipass) says otherwise. The one
-    /// sweep is opt-in until it has run and been timed on a GPU (docs/radix-sort.md "One sweep");
-    /// on CPU devices (lavapipe) it is for tests only: a look-back may wait for a workgroup whose
-    /// thread the OS has descheduled, and lavapipe ends a loop after 65,535 iterations
+    /// How the passes run (the class comment). kDefault: the one sweep on GPUs, the multi-pass
+    /// sort on CPU devices, unless the environment variable OPEN3D_RADIX_SORT=onesweep (or
+    /// =multipass) says otherwise (docs/radix-sort.md). On CPU devices (lavapipe) the one sweep
+    /// is for tests only: a look-back may wait for a workgroup whose thread the OS has
+    /// descheduled, and lavapipe ends a loop after 65,535 iterations
     /// (docs/environment-notes.md).
     enum class Algorithm { kDefault, kMultiPass, kOneSweep };
 
