@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <filesystem>
 #include <string>
 #include <thread>
@@ -68,6 +69,23 @@ TEST_F(VisualizerEditing, PickSelectDeleteInvertUndoAndSave) {
     // covers its rounding (the reference's depth is double).
     EXPECT_LE((vis.GetPicks()[0].point - ref.point).norm(), 1e-5 * ref.point.norm() + 1e-6);
     EXPECT_LT(vis.GetPicks()[0].distance_to_previous, 0.0);
+    // The panel's attributes, from the cloud's row: centre, sigmoid of the stored opacity,
+    // scale, rotation and 0.5 + C0 f_dc.
+    {
+        namespace gs = t::geometry::gs_attr;
+        const visualization::SplatPick& p = vis.GetPicks()[0];
+        const auto at = [&](const char* name, int64_t width, int k) {
+            return double(cloud.GetPointAttr(name).Data<float>()[p.index * width + k]);
+        };
+        for (int k = 0; k < 3; ++k) {
+            EXPECT_EQ(p.center[k], at(gs::kPositions, 3, k));
+            EXPECT_EQ(p.scale[k], at(gs::kScale, 3, k));
+            EXPECT_DOUBLE_EQ(p.color[k], 0.5 + 0.28209479177387814 * at(gs::kFDc, 3, k));
+        }
+        EXPECT_EQ(p.rotation[0], at(gs::kRot, 4, 0));
+        EXPECT_DOUBLE_EQ(p.opacity, 1.0 / (1.0 + std::exp(-at(gs::kOpacity, 1, 0))));
+        EXPECT_GT(p.opacity, 0.0);
+    }
     Click(vis, px + 10, py + 5, GLFW_MOD_CONTROL);
     ASSERT_EQ(vis.GetPicks().size(), 2u);
     EXPECT_NEAR(vis.GetPicks()[1].distance_to_previous,

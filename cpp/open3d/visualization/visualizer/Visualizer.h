@@ -98,6 +98,14 @@ struct SplatPick {
     Eigen::Vector3d point = Eigen::Vector3d::Zero();
     /// From the previous pick's point; -1 for the first pick.
     double distance_to_previous = -1.0;
+    /// The splat's attributes as the renderer reads them: its centre, opacity after the
+    /// sigmoid, scale (the axes' standard deviations), rotation (w, x, y, z) and degree-0
+    /// colour 0.5 + C0 f_dc.
+    Eigen::Vector3d center = Eigen::Vector3d::Zero();
+    double opacity = 0.0;
+    Eigen::Vector3d scale = Eigen::Vector3d::Zero();
+    Eigen::Vector4d rotation = Eigen::Vector4d::Zero();
+    Eigen::Vector3d color = Eigen::Vector3d::Zero();
 };
 
 class Visualizer : public WindowEventHandler {

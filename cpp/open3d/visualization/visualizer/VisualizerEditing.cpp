@@ -13,6 +13,7 @@
 
 #include "open3d/camera/CameraPath.h"
 #include "open3d/core/Exception.h"
+#include "open3d/t/geometry/SphericalHarmonics.h"
 #include "open3d/t/io/PointCloudIO.h"
 #include "open3d/visualization/rendering/filament/MaterialRecord.h"
 #include "open3d/visualization/rendering/gaussian_splat/GaussianSplatRenderer.h"
@@ -56,6 +57,21 @@ std::optional<SplatPick> Visualizer::PickSplat(int x, int y) {
     pick.index = where->second;
     // The ray through the pixel centre, at view z = the expected depth there.
     pick.point = camera.PixelToWorld(x, y, out.depth_expected.Data<float>()[pixel]);
+    namespace gs = t::geometry::gs_attr;
+    const t::geometry::PointCloud& cloud = splats.GetCloud(pick.geometry);
+    const int64_t i = pick.index;
+    const auto row = [&](const char* name, int64_t width) {
+        return cloud.GetPointAttr(name).Data<float>() + i * width;
+    };
+    const float* c = row(gs::kPositions, 3);
+    const float* s = row(gs::kScale, 3);
+    const float* q = row(gs::kRot, 4);
+    const float* dc = row(gs::kFDc, 3);
+    pick.center = Eigen::Vector3d(c[0], c[1], c[2]);
+    pick.opacity = 1.0 / (1.0 + std::exp(-double(*row(gs::kOpacity, 1))));
+    pick.scale = Eigen::Vector3d(s[0], s[1], s[2]);
+    pick.rotation = Eigen::Vector4d(q[0], q[1], q[2], q[3]);
+    for (int k = 0; k < 3; ++k) pick.color[k] = 0.5 + t::geometry::kSH_C0 * dc[k];
     if (!picks_.empty()) pick.distance_to_previous = (pick.point - picks_.back().point).norm();
     picks_.push_back(pick);
     PostRedraw();
@@ -278,6 +294,9 @@ void Visualizer::DrawEditingPanel() {
         if (p.distance_to_previous >= 0.0) {
             ImGui::Text("  %.4g from the previous pick", p.distance_to_previous);
         }
+        ImGui::Text("  opacity %.3f, colour (%.3f, %.3f, %.3f)", p.opacity, p.color.x(),
+                    p.color.y(), p.color.z());
+        ImGui::Text("  scale (%.3g, %.3g, %.3g)", p.scale.x(), p.scale.y(), p.scale.z());
     }
     ImGui::Text("Selected %lld splats", static_cast<long long>(selected));
     // The buttons run what the keys run, errors included.
