@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Issue 53's camera-path timing on the GPU device machine (docs/camera-paths.md): a 10 s path
-# through playbot_125k's 24 views at 30 fps (300 frames) at 1920x1080, rendered in batches by
+# through playbot_125k's 24 views at 30 fps (301 frames) at 1920x1080, rendered in batches by
 # gs-render --camera-path, wall time of the whole command.
 # Prepare here:
 #   mkdir -p .devbin && cp build/bin/{gs-bench,gs-render,tests_gaussian_splat_vulkan} .devbin/ && strip .devbin/*
