@@ -31,7 +31,19 @@ namespace open3d {
 namespace tests {
 namespace {
 
-using VisualizerEditing = VisualizerTest;
+class VisualizerEditing : public VisualizerTest {
+protected:
+    // A 160 x 120 window showing the default scene as "scene", the camera fitted, one frame
+    // drawn.
+    visualization::Visualizer& ShowScene() {
+        visualization::Visualizer& vis = MakeVisualizer(160, 120);
+        vis.AddGeometry("scene", cloud_);
+        vis.ResetCamera();
+        EXPECT_TRUE(vis.RenderFrame());
+        return vis;
+    }
+    const t::geometry::PointCloud cloud_ = rendering::CreateDefaultGaussianSplatScene();
+};
 
 bool SameCloud(const t::geometry::PointCloud& a, const t::geometry::PointCloud& b) {
     if (a.NumPoints() != b.NumPoints()) return false;
@@ -49,11 +61,8 @@ void Click(visualization::Visualizer& vis, double x, double y, int mods) {
 }
 
 TEST_F(VisualizerEditing, PickSelectDeleteInvertUndoAndSave) {
-    visualization::Visualizer& vis = MakeVisualizer(160, 120);
-    const t::geometry::PointCloud cloud = rendering::CreateDefaultGaussianSplatScene();
-    vis.AddGeometry("scene", cloud);
-    vis.ResetCamera();
-    ASSERT_TRUE(vis.RenderFrame());
+    visualization::Visualizer& vis = ShowScene();
+    const t::geometry::PointCloud& cloud = cloud_;
     const camera::PinholeCamera cam = vis.GetCamera();
     const rendering::RenderConfig& config = vis.GetSplatConfig();
 
@@ -167,11 +176,8 @@ TEST_F(VisualizerEditing, OneUndoRestoresEveryCloudADeleteChanged) {
 }
 
 TEST_F(VisualizerEditing, ALassoSelectsWhatTheReferenceSelectsInItsPolygon) {
-    visualization::Visualizer& vis = MakeVisualizer(160, 120);
-    const t::geometry::PointCloud cloud = rendering::CreateDefaultGaussianSplatScene();
-    vis.AddGeometry("scene", cloud);
-    vis.ResetCamera();
-    ASSERT_TRUE(vis.RenderFrame());
+    visualization::Visualizer& vis = ShowScene();
+    const t::geometry::PointCloud& cloud = cloud_;
     // Ctrl + Alt + drag through a triangle: the press and every cursor position are its
     // vertices.
     const int mods = GLFW_MOD_CONTROL | GLFW_MOD_ALT;
@@ -193,9 +199,7 @@ TEST_F(VisualizerEditing, ALassoSelectsWhatTheReferenceSelectsInItsPolygon) {
 }
 
 TEST_F(VisualizerEditing, KeyframesRecordTheCameraAndSaveAsACameraPath) {
-    visualization::Visualizer& vis = MakeVisualizer(160, 120);
-    vis.AddGeometry("scene", rendering::CreateDefaultGaussianSplatScene());
-    vis.ResetCamera();
+    visualization::Visualizer& vis = ShowScene();
     PressKey(vis, GLFW_KEY_K);
     const camera::PinholeCamera first = vis.GetCamera();
     vis.GetViewControl().Rotate(40, 10);
@@ -224,11 +228,8 @@ TEST_F(VisualizerEditing, KeyframesRecordTheCameraAndSaveAsACameraPath) {
 }
 
 TEST_F(VisualizerEditing, CropToTheSelectionsBoxKeepsWhatPointCloudCropKeeps) {
-    visualization::Visualizer& vis = MakeVisualizer(160, 120);
-    const t::geometry::PointCloud cloud = rendering::CreateDefaultGaussianSplatScene();
-    vis.AddGeometry("scene", cloud);
-    vis.ResetCamera();
-    ASSERT_TRUE(vis.RenderFrame());
+    visualization::Visualizer& vis = ShowScene();
+    const t::geometry::PointCloud& cloud = cloud_;
     EXPECT_THROW(vis.GetSelectionBox(), core::Open3DError);
     vis.SelectSplats(50, 40, 100, 80);
     const std::vector<int64_t> selected = vis.GetSelection().at("scene");
@@ -254,9 +255,7 @@ TEST_F(VisualizerEditing, CropToTheSelectionsBoxKeepsWhatPointCloudCropKeeps) {
 }
 
 TEST_F(VisualizerEditing, TheSelectionIsDrawnAsRedPointsUntilItEnds) {
-    visualization::Visualizer& vis = MakeVisualizer(160, 120);
-    vis.AddGeometry("scene", rendering::CreateDefaultGaussianSplatScene());
-    vis.ResetCamera();
+    visualization::Visualizer& vis = ShowScene();
     const int64_t before = CountRed(vis.CaptureScreenImage());
     vis.SelectSplats(50, 40, 110, 80);
     ASSERT_FALSE(vis.GetSelection().empty());
