@@ -14,10 +14,14 @@ find_package(ZLIB REQUIRED)
 find_package(PkgConfig REQUIRED)
 pkg_check_modules(ZSTD REQUIRED IMPORTED_TARGET libzstd)
 pkg_check_modules(WEBP REQUIRED IMPORTED_TARGET libwebp)
+# H.264 videos (t/io/H264VideoWriter.h): libx264 0.164 (libx264-dev); the tests decode what it
+# wrote with Cisco's openh264 2.3 (libopenh264-dev), a decoder independent of the encoder.
+pkg_check_modules(X264 REQUIRED IMPORTED_TARGET x264)
 
 # Eigen's headers are included as SYSTEM through its imported target already.
 if(OPEN3D_BUILD_TESTS)
   find_package(GTest REQUIRED)
+  pkg_check_modules(OPENH264 REQUIRED IMPORTED_TARGET openh264)
 endif()
 if(OPEN3D_BUILD_BENCHMARKS)
   find_package(benchmark REQUIRED)

@@ -10,6 +10,8 @@ packages=(
   clang-14 clang-format-14 libclang-rt-14-dev libfuzzer-14-dev
   libvulkan-dev mesa-vulkan-drivers vulkan-tools vulkan-validationlayers
   glslang-tools glslang-dev spirv-cross libspirv-cross-c-shared-dev
+  libx264-dev  # H.264 videos (gs-render --camera-path -o x.mp4)
+  libopenh264-dev  # the video tests decode with it
   libfilament-dev libfilament-tools libglfw3-dev libimgui-dev
   libxrandr-dev  # glfw3native.h (the GLX context handed to Filament) includes Xrandr.h
   xvfb xauth libgl1-mesa-dri libgl-dev xdotool

@@ -5,6 +5,8 @@
 
 #include <pybind11/pybind11.h>
 
+#include "open3d/t/geometry/Image.h"
+
 namespace open3d {
 namespace pybind {
 
@@ -14,6 +16,11 @@ void BindMesh(pybind11::module_& t_geometry);
 void BindMaterial(pybind11::module_& rendering);
 void BindIo(pybind11::module_& t_io);
 void BindImageIo(pybind11::module_& io);
+void BindVideo(pybind11::module_& io);
+
+/// A numpy image (H, W) or (H, W, C), C 1..4, as an Image of the array's dtype (float32, uint8
+/// or uint16 after ArrayForTensor's conversions); errors name write_image.
+t::geometry::Image ImageFromArray(const pybind11::object& value);
 void BindCamera(pybind11::module_& camera);
 void BindScene(pybind11::module_& rendering);
 void BindRendering(pybind11::module_& rendering);

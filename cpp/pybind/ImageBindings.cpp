@@ -28,8 +28,8 @@ std::string Extension(const std::filesystem::path& path) {
     return ext;
 }
 
-// A numpy image (H, W) or (H, W, C), C 1..4, as an Image of the array's dtype (float32,
-// uint8 or uint16 after ArrayForTensor's conversions).
+}  // namespace
+
 t::geometry::Image ImageFromArray(const py::object& value) {
     py::array array = py::module_::import("numpy").attr("asarray")(value);
     const char kind = array.dtype().kind();
@@ -48,6 +48,8 @@ t::geometry::Image ImageFromArray(const py::object& value) {
     // NaN is a value a float image may hold (a depth hole); PNG rounding clamps it.
     return t::geometry::Image(TensorFromArray(array, "write_image: image", true));
 }
+
+namespace {
 
 void WritePng(const std::string& path, const t::geometry::Image& image) {
     const int64_t channels = image.GetChannels();

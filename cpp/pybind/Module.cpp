@@ -77,7 +77,8 @@ class Open3DFileNotFoundError(FileNotFoundError, Open3DError):
         "io", "read_point_cloud, write_point_cloud, write_splat_pages, read_image, write_image");
     py::module_ io = m.def_submodule(
         "io",
-        "Open3D's o3d.io names: read_image, write_image, read_point_cloud, write_point_cloud");
+        "Open3D's o3d.io names: read_image, write_image, read_point_cloud, write_point_cloud; "
+        "VideoWriter");
     py::module_ camera = m.def_submodule("camera", "PinholeCamera, read_cameras_json");
     py::module_ visualization = m.def_submodule("visualization", "draw");
     py::module_ rendering =
@@ -89,6 +90,7 @@ class Open3DFileNotFoundError(FileNotFoundError, Open3DError):
     open3d::pybind::BindIo(t_io);
     open3d::pybind::BindImageIo(t_io);
     open3d::pybind::BindImageIo(io);
+    open3d::pybind::BindVideo(io);
     // o3d.io.read_point_cloud is how Open3D code reads clouds: the same functions (they give
     // t.geometry.PointCloud, the one cloud class here).
     io.attr("read_point_cloud") = t_io.attr("read_point_cloud");

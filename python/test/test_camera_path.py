@@ -41,3 +41,28 @@ def test_bad_keyframes_are_refused(playbot):
         o3d.camera.CameraPath([0.0, 0.0], [views[0].camera, views[1].camera])
     with pytest.raises(o3d.Open3DError, match="2 times for 1 cameras"):
         o3d.camera.CameraPath([0.0, 1.0], [views[0].camera])
+
+
+def test_a_path_renders_into_a_video(playbot, tmp_path):
+    """A batch of a path's frames into an MP4 through io.VideoWriter: the file appears only when
+    the writer closes, holds one sample per frame (its stsz box), and a raising block leaves
+    nothing. What the samples decode to is tests_io's H264VideoWriterTest."""
+    pcd, views = playbot
+    path = o3d.camera.CameraPath([0.0, 1.0], [views[0].camera, views[3].camera])
+    frames = [c.resized(34, 30) for c in path.frames(fps=6)]
+    r = o3d.visualization.rendering.OffscreenRenderer(34, 30, "cpu")
+    r.scene.add_geometry("scene", pcd)
+    out = tmp_path / "path.mp4"
+    with o3d.io.VideoWriter(out, 34, 30, fps=6) as video:
+        for image in r.render_batch(frames):
+            video.write(image)
+        assert not out.exists()
+    data = out.read_bytes()
+    stsz = data.index(b"stsz")
+    assert int.from_bytes(data[stsz + 12:stsz + 16], "big") == len(frames)
+    with pytest.raises(o3d.Open3DError, match="frame 0 is 10x30 with 3 channels"):
+        with o3d.io.VideoWriter(tmp_path / "bad.mp4", 34, 30) as video:
+            video.write(np.zeros((30, 10, 3), np.uint8))
+    with pytest.raises(o3d.Open3DError, match="--crf 0: the constant rate factor is 1"):
+        o3d.io.VideoWriter(tmp_path / "bad.mp4", 34, 30, crf=0)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["path.mp4"]

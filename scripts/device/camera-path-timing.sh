@@ -8,10 +8,9 @@
 # The call carries .gl, .devlibs, .devbin, shared/data/playbot/playbot_125k.ply and
 # shared/data/playbot/cameras.json:
 #   bash scripts/device/camera-path-timing.sh OUT_DIR
-# An MP4 needs an ffmpeg program there (the device image is not known to hold one; the script
-# looks on PATH and in Python's imageio_ffmpeg). Without one it times the same run into the
-# tests' stand-in ffmpeg, which reads and counts the frames (render + 8-bit readback + pipe,
-# no encoding); what.txt says which was measured.
+# The MP4 is encoded by libx264 inside gs-render (t/io/H264VideoWriter.h): prepare.sh copies
+# libx264.so.164 into .devlibs with the binaries' other libraries, so nothing else is needed.
+# A fourth run writes a PNG sequence of the same frames (render + float readback + PNG zlib).
 set -uo pipefail
 out=${1:?usage: bash scripts/device/camera-path-timing.sh OUT_DIR}
 mkdir -p "$out"
@@ -20,24 +19,14 @@ ldconfig
 export VK_DRIVER_FILES=${VK_DRIVER_FILES:-/usr/local/nvidia/share/vulkan/icd.d/nvidia_icd.json}
 nvidia-smi --query-gpu=name,driver_version,clocks.sm,clocks.max.sm --format=csv | tee "$out/gpu.txt"
 
-ffmpeg=$(command -v ffmpeg || python3 -c 'import imageio_ffmpeg; print(imageio_ffmpeg.get_ffmpeg_exe())' 2>/dev/null || true)
-if [[ -n $ffmpeg && -x $ffmpeg ]]; then
-  bin=$(mktemp -d /tmp/ffmpeg-XXXX)
-  ln -s "$ffmpeg" "$bin/ffmpeg"
-  what="MP4 through $ffmpeg"
-else
-  # The tests' stand-in: reads every frame, writes their byte count as the "video".
-  bin=$PWD/tests/apps/gs_render/fake_ffmpeg
-  what="no ffmpeg on the device: frames piped into a stand-in that reads and counts them (no encoding)"
-fi
-echo "camera-path-timing: $what" | tee "$out/what.txt"
+nproc | sed 's/^/cpu cores: /' | tee -a "$out/gpu.txt"
 
 d=shared/data/playbot
 # 24 keyframes over 10 s: 10 / 23 s apart.
 run() {  # NAME OUTPUT
   local start end
   start=$(date +%s.%N)
-  PATH="$bin:$PATH" LD_LIBRARY_PATH=$PWD/.devlibs timeout 60 .devbin/gs-render \
+  LD_LIBRARY_PATH=$PWD/.devlibs timeout 120 .devbin/gs-render \
     -i $d/playbot_125k.ply --camera-path $d/cameras.json --seconds-per-keyframe 0.434782608695652 \
     --fps 30 --width 1920 --height 1080 -o "$2" >"$out/$1.log" 2>&1
   local rc=$?
@@ -49,4 +38,7 @@ run warm "$out/warm.mp4"  # first run: driver shader caches, page cache
 run timed "$out/path.mp4"
 run timed_again "$out/path2.mp4"
 ls -la "$out"/*.mp4 2>/dev/null | tee -a "$out/times.txt"
-rm -f "$out"/*.mp4  # the videos are not needed back; their sizes are in times.txt
+rm -f "$out/warm.mp4" "$out/path2.mp4"  # path.mp4 comes back to be looked at
+mkdir -p /tmp/frames
+run png_sequence /tmp/frames/f.png
+ls /tmp/frames | wc -l | sed 's/^/png frames: /' | tee -a "$out/times.txt"

@@ -1,6 +1,6 @@
 // gs-render --camera-path: a camera path (camera/CameraPath.h) rendered frame by frame through
-// the backend's batched path into a PNG sequence or, through the ffmpeg program, an H.264 MP4
-// (docs/camera-paths.md).
+// the backend's batched path into a PNG sequence or an H.264 MP4 (t/io/H264VideoWriter.h;
+// docs/camera-paths.md).
 #pragma once
 
 #include <cstddef>
@@ -19,11 +19,13 @@ struct CameraPathOptions {
     int height = 0;
     /// .png: frames at <stem>_00000.png, <stem>_00001.png, ... beside it; .mp4: one video.
     std::string output;
-    int batch = 8;  ///< views a RenderBatch call renders
+    int batch = 8;                    ///< views a RenderBatch call renders
+    float crf = 23.0f;                ///< .mp4: x264's constant rate factor, 1 (best) .. 51
+    std::string preset = "veryfast";  ///< .mp4: x264's speed preset
 };
 
 /// Refuses an output before any work: an extension other than .png and .mp4, a missing folder,
-/// an .mp4 without an `ffmpeg` program on PATH.
+/// for .mp4 an unknown x264 preset or a rate factor outside [1, 51].
 void CheckCameraPathOutput(const CameraPathOptions& options);
 
 /// Reads the path, renders every frame (RenderBatch of `options.batch` views at a time) and

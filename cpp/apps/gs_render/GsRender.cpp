@@ -397,8 +397,8 @@ int main(int argc, char** argv) {
                    "Render a camera path instead of one view: a cameras.json whose entries are "
                    "the keyframes (at their 'time' fields in seconds, else "
                    "--seconds-per-keyframe apart), every frame into -o: .png gives "
-                   "<name>_00000.png, ... beside it, .mp4 an H.264 video through the ffmpeg "
-                   "program (docs/camera-paths.md)")
+                   "<name>_00000.png, ... beside it, .mp4 an H.264 video (libx264; "
+                   "docs/camera-paths.md)")
         ->check(CLI::ExistingFile);
     app.add_option("--fps", opt.fps, "--camera-path: frames per second")
         ->check(kPositive)
@@ -406,6 +406,15 @@ int main(int argc, char** argv) {
     app.add_option("--seconds-per-keyframe", opt.seconds_per_keyframe,
                    "--camera-path: keyframe spacing where the entries have no 'time'")
         ->check(kPositive)
+        ->capture_default_str();
+    app.add_option("--crf", opt.crf,
+                   "--camera-path into .mp4: x264's constant rate factor, 1 (best, largest) to "
+                   "51 (worst); 18 looks lossless to most eyes")
+        ->capture_default_str();
+    app.add_option("--preset", opt.preset,
+                   "--camera-path into .mp4: x264's speed preset (ultrafast, superfast, "
+                   "veryfast, faster, fast, medium, slow, slower, veryslow): slower ones make "
+                   "smaller files of the same quality")
         ->capture_default_str();
     try {
         app.parse(argc, argv);

@@ -42,6 +42,8 @@ struct Options {
     std::string camera_path;  // --camera-path: render a path instead of one view
     double fps = 30.0;
     double seconds_per_keyframe = open3d::camera::kDefaultSecondsPerKeyframe;
+    float crf = 23.0f;                // --camera-path -o x.mp4: x264's constant rate factor
+    std::string preset = "veryfast";  // and its speed preset
 };
 
 }  // namespace gs_render

@@ -24,6 +24,8 @@ gs_render::CameraPathOptions PathOptions(const Options& opt) {
     path.width = opt.width;
     path.height = opt.height;
     path.output = opt.output;
+    path.crf = opt.crf;
+    path.preset = opt.preset;
     return path;
 }
 
