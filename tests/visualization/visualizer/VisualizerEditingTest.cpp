@@ -3,8 +3,9 @@
 // Delete (sent through the X server, as another client would) removes exactly those splats,
 // Ctrl + I inverts, Ctrl + Z restores the cloud bit for bit (every cloud one removal changed),
 // the edit saves to a file, a Ctrl + Alt drag selects a lasso's polygon, cropping to the
-// selection's box keeps what PointCloud::Crop keeps, K records keyframes that save as a
-// camera path, and the selection shows as red points.
+// selection's box keeps what PointCloud::Crop keeps, so does the crop box (drawn as yellow
+// edges while it is edited), K records keyframes that save as a camera path, and the selection
+// shows as red points.
 #include <GLFW/glfw3.h>
 #include <gtest/gtest.h>
 
@@ -270,6 +271,66 @@ TEST_F(VisualizerEditing, TheSelectionIsDrawnAsRedPointsUntilItEnds) {
                  core::Open3DError);
     EXPECT_FALSE(vis.RemoveGeometry("__selection__"));
     EXPECT_FALSE(vis.RemoveGeometry("never added"));
+}
+
+// Pixels of the crop box's yellow (r and g high, b low; the default scene has a few).
+int64_t CountYellow(const t::geometry::Image& rgb) {
+    const uint8_t* p = rgb.Data<uint8_t>();
+    int64_t n = 0;
+    for (int64_t i = 0; i < rgb.NumPixels(); ++i) {
+        const uint8_t* c = p + i * rgb.GetChannels();
+        n += c[0] > 200 && c[1] > 160 && c[2] < 80;
+    }
+    return n;
+}
+
+TEST_F(VisualizerEditing, TheCropBoxIsDrawnAndKeepsWhatPointCloudCropKeeps) {
+    visualization::Visualizer& vis = ShowScene();
+    const t::geometry::PointCloud& cloud = cloud_;
+    EXPECT_THROW(vis.ApplyCropBox(), core::Open3DError);
+    // Without a selection the box starts at the shown clouds' bounds.
+    const t::geometry::AxisAlignedBoundingBox bounds = cloud.GetAxisAlignedBoundingBox();
+    EXPECT_TRUE(vis.DefaultCropBox().GetMinBound() == bounds.GetMinBound());
+    EXPECT_TRUE(vis.DefaultCropBox().GetMaxBound() == bounds.GetMaxBound());
+    const int64_t before = CountYellow(vis.CaptureScreenImage());
+    // The middle half of the scene along each axis.
+    const Eigen::Vector3d lo = bounds.GetMinBound() + 0.25 * bounds.GetExtent();
+    const Eigen::Vector3d hi = bounds.GetMinBound() + 0.75 * bounds.GetExtent();
+    const t::geometry::AxisAlignedBoundingBox box(lo, hi);
+    vis.SetCropBox(box);
+    // 12 edges of 97 points, most of them in view: hundreds of yellow pixels.
+    EXPECT_GT(CountYellow(vis.CaptureScreenImage()), before + 100);
+    EXPECT_FALSE(
+        std::count(vis.GetGeometryNames().begin(), vis.GetGeometryNames().end(), "__crop_box__"));
+    EXPECT_THROW(vis.AddGeometry("__crop_box__", cloud), core::Open3DError);
+    const t::geometry::OrientedBoundingBox oriented =
+        t::geometry::OrientedBoundingBox::FromAxisAligned(box);
+    const t::geometry::PointCloud kept = cloud.Crop(oriented);
+    ASSERT_GT(kept.NumPoints(), 0);
+    ASSERT_LT(kept.NumPoints(), cloud.NumPoints());
+    EXPECT_EQ(vis.ApplyCropBox(), cloud.NumPoints() - kept.NumPoints());
+    const rendering::GaussianSplatRenderer& splats = vis.GetScene().GetScene().GetSplatRenderer();
+    EXPECT_TRUE(SameCloud(splats.GetCloud("scene"), kept));
+    EXPECT_FALSE(vis.GetCropBox().has_value());
+    // The box ended with the crop: drawing it again adds its edges, cancelling takes them away.
+    const int64_t cropped = CountYellow(vis.CaptureScreenImage());
+    vis.SetCropBox(box);
+    EXPECT_GT(CountYellow(vis.CaptureScreenImage()), cropped + 100);
+    vis.SetCropBox(std::nullopt);
+    EXPECT_EQ(CountYellow(vis.CaptureScreenImage()), cropped);
+    ASSERT_TRUE(vis.UndoEdit());
+    EXPECT_TRUE(SameCloud(splats.GetCloud("scene"), cloud));
+    // "Remove inside": what lies outside stays.
+    vis.SetCropBox(box);
+    vis.ApplyCropBox(true);
+    EXPECT_TRUE(SameCloud(splats.GetCloud("scene"), cloud.Crop(oriented, true)));
+    ASSERT_TRUE(vis.UndoEdit());
+    // With a selection the box starts at the selection's box.
+    vis.SelectSplats(50, 40, 100, 80);
+    const t::geometry::AxisAlignedBoundingBox selected =
+        cloud.SelectByIndex(vis.GetSelection().at("scene")).GetAxisAlignedBoundingBox();
+    EXPECT_TRUE(vis.DefaultCropBox().GetMinBound().isApprox(selected.GetMinBound(), 1e-12));
+    EXPECT_TRUE(vis.DefaultCropBox().GetMaxBound().isApprox(selected.GetMaxBound(), 1e-12));
 }
 
 }  // namespace

@@ -317,6 +317,18 @@ public:
     /// The axis-aligned box around the selected splats' centres, as an oriented box (the
     /// panel's "Crop to the selection's box"); throws when nothing is selected.
     t::geometry::OrientedBoundingBox GetSelectionBox() const;
+    /// The crop box being edited, drawn in the window as its 12 edges (yellow points) and
+    /// adjusted in the panel ("Crop box": its corners dragged with the mouse); nullopt ends it.
+    void SetCropBox(const std::optional<t::geometry::AxisAlignedBoundingBox>& box);
+    const std::optional<t::geometry::AxisAlignedBoundingBox>& GetCropBox() const {
+        return crop_box_;
+    }
+    /// The box the panel's "Crop box" starts from: the selection's (GetSelectionBox), else the
+    /// visible splat clouds' bounds; throws when no splat cloud is shown.
+    t::geometry::AxisAlignedBoundingBox DefaultCropBox() const;
+    /// CropSplats with the crop box (`invert`: removes what lies inside), then ends the box.
+    /// Throws when there is none. Returns the number removed.
+    int64_t ApplyCropBox(bool invert = false);
     /// Restores the clouds as they were before the last DeleteSelection or CropSplats;
     /// false when there is nothing to undo.
     bool UndoEdit();
@@ -436,9 +448,16 @@ private:
     /// kSelectionOverlay that is not one of the window's objects (none when nothing is
     /// selected).
     void UpdateSelectionOverlay();
-    /// Throws for the name the selection overlay takes.
+    /// Draws the crop box's edges as points (kCropBoxOverlay), or removes them without a box.
+    void UpdateCropBoxOverlay();
+    /// The panel's crop-box section: corners, the count inside, keep / remove / cancel.
+    void DrawCropBoxPanel();
+    /// Throws for the names the selection and crop-box overlays take.
     static void RequireObjectName(const std::string& name);
     static constexpr const char* kSelectionOverlay = "__selection__";
+    static constexpr const char* kCropBoxOverlay = "__crop_box__";
+    std::optional<t::geometry::AxisAlignedBoundingBox> crop_box_;
+    int64_t crop_box_inside_ = 0;  // splats of the visible clouds inside, counted on each change
     std::map<std::string, std::vector<int64_t>> selection_;
     std::vector<SplatPick> picks_;
     // Per DeleteSelection, every cloud it changed as it was before.

@@ -142,9 +142,8 @@ void Visualizer::UpdateSelectionOverlay() {
 }
 
 void Visualizer::RequireObjectName(const std::string& name) {
-    if (name == kSelectionOverlay) {
-        core::ThrowError("'{}' is the name the viewer's selection overlay takes; choose another",
-                         name);
+    if (name == kSelectionOverlay || name == kCropBoxOverlay) {
+        core::ThrowError("'{}' is a name the viewer's editing overlays take; choose another", name);
     }
 }
 
@@ -207,6 +206,7 @@ void Visualizer::EndSelectionAndPicks() {
     selection_.clear();
     picks_.clear();
     UpdateSelectionOverlay();
+    if (crop_box_) SetCropBox(crop_box_);  // counts the splats inside the changed clouds again
 }
 
 bool Visualizer::UndoEdit() {
@@ -315,6 +315,7 @@ void Visualizer::DrawEditingPanel() {
             }
         }
     }
+    DrawCropBoxPanel();
     if (!undo_.empty() && ImGui::Button("Undo (Ctrl+Z)")) OnEditKey(GLFW_KEY_Z, GLFW_MOD_CONTROL);
     ImGui::Text("Camera path: %zu keyframes", keyframes_.size());
     if (ImGui::Button("Add keyframe (K)")) OnEditKey(GLFW_KEY_K, 0);
