@@ -190,10 +190,11 @@ int Run(const Options& opt) {
             opt.reference_max_splats > 0 && job.cloud.NumPoints() <= opt.reference_max_splats;
         t::geometry::SplatHierarchy hierarchy;
         double hierarchy_ms = 0.0;
-        if (!budgets.empty() || !opt.stream.empty()) {
+        const bool lod = !budgets.empty() || opt.lod_target_ms > 0.0;
+        if (lod || !opt.stream.empty()) {
             // The level-of-detail rows upload every node: refused before the build, which
             // takes minutes at 1e8 splats, when even the leaves cannot fit.
-            if (vulkan != nullptr && !budgets.empty()) {
+            if (vulkan != nullptr && lod) {
                 vulkan->CheckHierarchyFits(job.cloud.NumPoints(),
                                            job.cloud.GetGaussianSplatArrays().sh_degree);
             }
@@ -305,7 +306,7 @@ int Run(const Options& opt) {
                 }
                 rows.push_back(row);
             }
-            if (!budgets.empty()) {
+            if (lod) {
                 AddLodRows(opt, budgets, job, hierarchy, hierarchy_ms, *backend, cams,
                            fmt::format("{}x{}", w, h), rows);
             }
@@ -526,6 +527,17 @@ int main(int argc, char** argv) {
                    "exact render at S x S times the pixels, box-filtered to the row's size "
                    "(what the view's splats look like with less aliasing; docs/lod.md)")
         ->check(CLI::Range(2, 8));
+    app.add_option("--lod-target-ms", opt.lod_target_ms,
+                   "Vulkan: also render a path through the views (--lod-target-frames frames "
+                   "from each to the next, after 30 at the first) with "
+                   "RenderConfig::lod_target_ms, the cut's budget chosen each frame from the "
+                   "last frames' GPU times, and print how the frames' GPU times meet the "
+                   "target (docs/lod.md)")
+        ->check(CLI::PositiveNumber);
+    app.add_option("--lod-target-frames", opt.lod_target_frames,
+                   "--lod-target-ms: frames from each view to the next")
+        ->check(CLI::Range(1, 1000))
+        ->capture_default_str();
     app.add_option("--lod-cut-search", opt.lod_cut_search,
                    "Vulkan: how the GPU finds the cut, a comma list for one row each: auto, "
                    "every-node (size every inner node), from-root (walk down from the root "

@@ -39,6 +39,8 @@ struct Options {
     std::string lod_budgets;              // --lod-budgets, empty: no level-of-detail rows
     std::string lod_cut_search = "auto";  // --lod-cut-search: comma list
     int lod_supersample = 0;              // --lod-supersample, 0: no filtered reference
+    double lod_target_ms = 0.0;           // --lod-target-ms, 0: no path with a frame-time target
+    int lod_target_frames = 10;           // --lod-target-frames: per view of that path
     uint64_t max_tile_entries = 0;        // --max-tile-entries, 0: RenderConfig's default
     std::string stream;                   // --stream, empty: no streaming run
     std::string gpu_budget = "2G";

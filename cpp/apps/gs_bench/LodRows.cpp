@@ -16,6 +16,7 @@
 #include <vector>
 #include "BenchScenes.h"
 #include "LodBudgets.h"
+#include "LodTarget.h"
 #include "StreamBench.h"
 #include "Throughput.h"
 #include "open3d/camera/CamerasJson.h"
@@ -173,6 +174,15 @@ void AddLodRows(const Options& opt, const std::vector<int64_t>& budgets, const S
         }
         row.gpu_total_ms = row.project_ms + row.sort_ms + row.composite_ms;
         rows.push_back(row);
+    }
+    if (opt.lod_target_ms > 0.0) {
+        if (vulkan == nullptr)
+            core::ThrowError("--lod-target-ms: the backend times frames on the GPU: use vulkan");
+        rendering::RenderConfig target = TimedConfig(opt);
+        target.lod_target_ms = opt.lod_target_ms;
+        const LodTargetResult result =
+            RunLodTargetPath(*lod_backend, cams, target, opt.lod_target_frames, 30);
+        PrintLodTargetResult(job.name.c_str(), cams.at(0).width, cams.at(0).height, result);
     }
 }
 

@@ -90,6 +90,12 @@ struct RenderConfig {
     /// SetSceneHierarchy): the most nodes the view's cut may keep; 0 (the default) keeps
     /// every leaf, the exact scene. Ignored for plain scenes.
     uint64_t lod_budget = 0;
+    /// A hierarchy's frame time to hold, in milliseconds of GPU time (GPU backends; 0, the
+    /// default, off): each frame's budget is chosen from the last frames' GPU times
+    /// (LodBudgetController.h), at most lod_budget nodes where that is set. The cut, and so the
+    /// image, then depends on how fast the device is. Ignored for plain scenes and by the CPU
+    /// reference.
+    double lod_target_ms = 0.0;
     /// How the cut is found; see LodCutSearch (the cut is the same).
     LodCutSearch lod_cut_search = LodCutSearch::kAuto;
     /// GPU backends skip the geometry stage when the scene, the camera and this config are
@@ -99,12 +105,15 @@ struct RenderConfig {
 
     /// Throws core::Open3DError for a near plane that is not a positive finite number (a
     /// negative one would keep splats behind the camera, mirrored, and NaN would cull
-    /// every splat). Every backend calls it before the geometry stage.
+    /// every splat), or a lod_target_ms that is negative or not finite. Every backend calls it
+    /// before the geometry stage.
     void Validate() const;
 };
 
 /// Whether two configs give the same geometry stage: every field but the background (a
-/// composite parameter) and reuse_geometry.
+/// composite parameter) and reuse_geometry. With lod_target_ms, backends compare the configs
+/// with the budget it chose in lod_budget, and a new target runs the geometry stage once: a
+/// reused stage measures no time to steer by.
 bool SameGeometryConfig(const RenderConfig& a, const RenderConfig& b);
 
 /// Bits of RenderStats::error_flags (the same bits the GPU backends read back).

@@ -98,6 +98,7 @@ public:
                    const PackedLodNodes& lod);
     void ClearLod();
     bool HasLod() const { return static_cast<bool>(lod_nodes); }
+    uint32_t LodLeaves() const { return lod_leaves_; }
     std::optional<uint32_t> LodInner() const {
         return HasLod() ? std::optional<uint32_t>(lod_inner_) : std::nullopt;
     }

@@ -161,10 +161,11 @@ bool GaussianSplatVulkanBackend::WaitGeometryStage(double timeout_ms) {
 }
 
 void GaussianSplatVulkanBackend::RenderGeometryStage(const camera::PinholeCamera& camera,
-                                                     const RenderConfig& config) {
+                                                     const RenderConfig& requested) {
     if (!cloud_) core::ThrowError("Vulkan backend: RenderGeometryStage before SetScene");
     camera.Validate();
-    config.Validate();
+    requested.Validate();
+    const RenderConfig config = WithLodTarget(requested);
     const auto start = std::chrono::steady_clock::now();
     const SplatPrecision precision = SplatPrecisionFor(config.compact_storage);
     if (precision != geometry_stage_resources_.Layout().precision) {
@@ -560,7 +561,24 @@ RenderStats GaussianSplatVulkanBackend::RenderComposite(CompositeSink& sink) {
     s.host_submit_ms += submit_ms;
     s.host_wait_ms = geometry_wait_ms + wait_ms;
     s.host_readback_ms = core::MillisecondsSince(readback_start);
+    if (!geometry_.reused) {
+        ObserveLodFrame(geometry_.config, s.gpu_project_ms + s.gpu_sort_ms + s.gpu_composite_ms);
+    }
     return s;
+}
+
+RenderConfig GaussianSplatVulkanBackend::WithLodTarget(const RenderConfig& config) {
+    if (!(config.lod_target_ms > 0.0) || !geometry_stage_resources_.HasLod()) return config;
+    RenderConfig frame = config;
+    frame.lod_budget = lod_controller_.NextBudget(
+        config.lod_target_ms, geometry_stage_resources_.LodLeaves(), config.lod_budget);
+    return frame;
+}
+
+void GaussianSplatVulkanBackend::ObserveLodFrame(const RenderConfig& frame_config, double gpu_ms) {
+    if (frame_config.lod_target_ms > 0.0 && geometry_stage_resources_.HasLod()) {
+        lod_controller_.Observe(frame_config.lod_budget, gpu_ms);
+    }
 }
 
 }  // namespace vulkan

@@ -19,6 +19,7 @@
 #include "open3d/camera/PinholeCamera.h"
 #include "open3d/visualization/rendering/gaussian_splat/GaussianSplatBackend.h"
 #include "open3d/visualization/rendering/gaussian_splat/GaussianSplatDataPacking.h"
+#include "open3d/visualization/rendering/gaussian_splat/LodBudgetController.h"
 #include "open3d/visualization/rendering/gaussian_splat/SplatStreamer.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/Buffer.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/Commands.h"
@@ -254,6 +255,12 @@ private:
     /// Logs each error flag the first time a frame reports it.
     void WarnNewFlags(uint32_t flags);
 
+    /// RenderConfig::lod_target_ms: `config` with the budget lod_controller_ chooses for this
+    /// frame where the scene is a hierarchy and a target is set, else `config` as it is.
+    RenderConfig WithLodTarget(const RenderConfig& config);
+    /// A frame rendered with `frame_config` (WithLodTarget's) took `gpu_ms` of GPU time.
+    void ObserveLodFrame(const RenderConfig& frame_config, double gpu_ms);
+
     void UploadScene(SplatPrecision precision);
     /// WriteSceneSplats of several ranges, checked first, written in one submission.
     void WriteSceneSplatRanges(
@@ -274,6 +281,7 @@ private:
     GpuTimestamps geometry_stage_timestamps_;
     GpuTimestamps composite_stage_timestamps_;
     Counters counters_;
+    LodBudgetController lod_controller_;
 
     // The scene: kept on the CPU to re-pack when the storage precision changes.
     std::optional<t::geometry::PointCloud> cloud_;

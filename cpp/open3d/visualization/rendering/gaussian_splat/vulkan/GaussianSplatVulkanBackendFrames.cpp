@@ -94,13 +94,14 @@ void GaussianSplatVulkanBackend::SubmitSlot(FrameSlot& slot) {
 }
 
 uint64_t GaussianSplatVulkanBackend::SubmitBatch(const std::vector<camera::PinholeCamera>& cameras,
-                                                 const RenderConfig& config,
+                                                 const RenderConfig& requested,
                                                  const BatchOptions& options) {
     if (!cloud_) core::ThrowError("Vulkan backend: SubmitBatch before SetScene");
     if (cameras.empty()) core::ThrowError("Vulkan backend: SubmitBatch of no camera");
     CheckBatchCameras(cameras);
     for (const camera::PinholeCamera& camera : cameras) camera.Validate();
-    config.Validate();
+    requested.Validate();
+    const RenderConfig config = WithLodTarget(requested);
     const uint32_t w = static_cast<uint32_t>(cameras[0].width);
     const uint32_t h = static_cast<uint32_t>(cameras[0].height);
     const uint32_t max_views = MaxViewsPerSubmission(w, h, options);
@@ -275,6 +276,7 @@ std::vector<RenderOutput> GaussianSplatVulkanBackend::WaitBatch(uint64_t ticket)
     WarnNewFlags(flags);
     const std::vector<double> job_ms = slot.job_timestamps.ReadMilliseconds();
     stats.gpu_ms = job_ms[0];
+    ObserveLodFrame(slot.config, stats.gpu_ms / views);
     if (views == 1) {
         const std::vector<double> ms = slot.pass_timestamps.ReadMilliseconds();
         const auto at = [&](TimedPass pass) {

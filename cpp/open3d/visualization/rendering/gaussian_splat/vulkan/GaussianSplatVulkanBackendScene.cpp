@@ -28,6 +28,7 @@ void GaussianSplatVulkanBackend::SetScene(const t::geometry::PointCloud& cloud) 
     pool_scene_ = false;
     visibility_mask_.clear();
     RetireLod();
+    lod_controller_.Reset();
     UploadScene(SplatPrecision::kExact);
 }
 
@@ -52,6 +53,7 @@ void GaussianSplatVulkanBackend::SetSceneHierarchy(const t::geometry::PointCloud
     pool_scene_ = false;
     visibility_mask_.clear();
     RetireLod();
+    lod_controller_.Reset();
     UploadScene(SplatPrecision::kExact);
     geometry_stage_resources_.UploadLod(*context_, pool_, lod);
 }
@@ -74,6 +76,7 @@ void GaussianSplatVulkanBackend::SetScenePool(int64_t capacity, int sh_degree,
     if (geometry_.in_flight) Wait(*context_, geometry_stage_fence_.Get());
     geometry_ = GeometryState{};
     RetireLod();
+    lod_controller_.Reset();
     RetireSceneBuffers(false);
     ++scene_serial_;
     geometry_stage_resources_.AllocateScene(*context_, pool_, like, capacity);
