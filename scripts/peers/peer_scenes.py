@@ -1,8 +1,9 @@
 #!/usr/bin/env python3
 """The scenes and views the peers are timed on: view 0 of each scene as gs-bench renders it.
 
-For time_peers.py. Scene names (render_original.SCENES plus playbot_125k), gridK scenes and
-PATH[:CAMERAS] specs are loaded with render_original's readers, so every peer gets the splats
+For time_peers.py. Scene names (render_original.SCENES plus playbot_125k), gridK scenes,
+PATH[:CAMERAS] specs and any of those but a grid with #N (its first N splats, gs-bench
+--first N: the frame's fixed cost, issue 47's one-splat and 1,000-splat rows) are loaded with render_original's readers, so every peer gets the splats
 our C++ readers decode. The view is gs-bench's (cpp/apps/gs_bench/BenchScenes.cpp):
 ScaleViewTo for cameras.json scenes (bench_view_entry), and for --grid K the scene of
 MakeGridScene (make_grid) and the camera of MakeGridCamera (grid_camera_entry), reproduced
@@ -17,7 +18,7 @@ from parity_imports import ro
 
 # Scene names beside render_original's: name -> (scene, cameras) under SHARED/data.
 SCENES = {"playbot_125k": ("playbot/playbot_125k.ply", "playbot/cameras.json"), **ro.SCENES}
-DEFAULT_SCENES = "playbot_125k,chair,biker_152k,grid7"
+DEFAULT_SCENES = "playbot_125k,chair,biker_152k,grid7,playbot_125k#1,playbot_125k#1000"
 DEFAULT_GRID_TILE = "playbot_125k"
 
 
@@ -88,14 +89,16 @@ def grid_camera_entry(tile, view0, k, spacing, width, height):
 class Scene:
     """One benchmark scene: its splats and view 0 at any size, as gs-bench renders it."""
 
-    def __init__(self, label, bench_name, path, cameras_path, gaussians, entry_at, grid=None):
+    def __init__(self, label, bench_name, path, cameras_path, gaussians, entry_at, grid=None,
+                 first=None):
         self.label = label  # short name for tables
-        self.bench_name = bench_name  # gs-bench's name for it (file name, or gridKxK)
+        self.bench_name = bench_name  # gs-bench's name for it (file name, gridKxK, [first N])
         self.path = Path(path)
         self.cameras_path = Path(cameras_path)
         self.gaussians = gaussians
         self.entry_at = entry_at  # (width, height) -> cameras.json entry of view 0
         self.grid = grid  # K for a grid scene
+        self.first = first  # N for the first N splats of the file (gs-bench --first N)
 
 
 def parse_scene_specs(text):
@@ -140,11 +143,29 @@ def load_scenes(specs, shared, grid_tile):
                     grid_camera_entry(tile, view0, k, s, w, h),
                 grid=k))
         else:
+            spec, _, first = spec.partition("#")
+            if first and (not first.isdigit() or int(first) < 1):
+                raise ValueError(f"scene '{spec}#{first}': #N takes a splat count >= 1")
             label, path, cameras_path, gaussians, cameras = tile_of(spec)
             view0 = cameras[0]
-            scenes.append(Scene(label, path.name, path, cameras_path, gaussians,
-                                lambda w, h, view0=view0: bench_view_entry(view0, w, h)))
+            bench_name = path.name
+            if first:
+                n = int(first)
+                gaussians = first_splats(gaussians, n)
+                label = f"{label} first {n:,}"
+                bench_name = f"{path.name}[first {n}]"  # gs-bench's job name (GsBench.cpp)
+            scenes.append(Scene(label, bench_name, path, cameras_path, gaussians,
+                                lambda w, h, view0=view0: bench_view_entry(view0, w, h),
+                                first=int(first) if first else None))
     return scenes
+
+
+def first_splats(g, n):
+    """The first n splats: bench::FirstSplats, which refuses n past the scene's count."""
+    if n > len(g.means):
+        raise ValueError(f"#{n}: the scene has {len(g.means)} splats")
+    return ro.Gaussians(means=g.means[:n], shs=g.shs[:n], opacities=g.opacities[:n],
+                        scales=g.scales[:n], rotations=g.rotations[:n], sh_degree=g.sh_degree)
 
 
 def parse_resolutions(text):

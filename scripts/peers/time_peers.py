@@ -120,13 +120,17 @@ def run_gs_bench(args, scenes, resolutions, out_dir):
     for w, h in resolutions:
         common += ["--resolution", f"{w}x{h}"]
     runs = []
-    files = [s for s in scenes if s.grid is None]
+    files = [s for s in scenes if s.grid is None and s.first is None]
     if files:
         cmd = [str(args.gs_bench)]
         for s in files:
             cmd += ["-i", str(s.path), "--cameras", str(s.cameras_path)]
         runs.append(("gs-bench", cmd + common))
     for s in scenes:
+        if s.first is not None:
+            runs.append((f"gs-bench-first{s.first}",
+                         [str(args.gs_bench), "-i", str(s.path), "--cameras", str(s.cameras_path),
+                          "--first", str(s.first)] + common))
         if s.grid is not None:
             runs.append((f"gs-bench-grid{s.grid}",
                          [str(args.gs_bench), "-i", str(s.path), "--cameras", str(s.cameras_path),
@@ -387,7 +391,9 @@ def main(argv=None):
                         f"{record['gpu_ms_median']:.3f} ms (min {record['gpu_ms_min']:.3f}, "
                         f"wall {record['wall_ms_median']:.3f})"
                         + (f", PSNR {fmt_psnr(record)} dB" if "psnr_db" in record else "")))
-                if args.gs_render and reference is not None and scene.grid is None:
+                # gs-render reads whole files: no PSNR of ours for a grid or a file's first splats.
+                if (args.gs_render and reference is not None and scene.grid is None
+                        and scene.first is None):
                     record = {"scene": scene.label, "gs_bench_scene": scene.bench_name,
                               "resolution": resolution, "peer": "ours", "splats": len(g.means)}
                     try:
