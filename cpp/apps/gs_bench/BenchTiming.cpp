@@ -22,6 +22,7 @@
 #include "open3d/camera/CamerasJson.h"
 #include "open3d/core/Exception.h"
 #include "open3d/core/ParallelFor.h"
+#include "open3d/core/Percentile.h"
 #include "open3d/core/Timer.h"
 #include "open3d/t/geometry/ImageMetrics.h"
 #include "open3d/t/geometry/SplatHierarchy.h"
@@ -36,8 +37,7 @@ namespace open3d {
 namespace bench {
 
 double Median(std::vector<double> v) {
-    std::sort(v.begin(), v.end());
-    return v.empty() ? 0.0 : v[v.size() / 2];
+    return v.empty() ? 0.0 : core::Percentile(std::move(v), 0.5);
 }
 
 // Medians of the host_* fields of `frames`.

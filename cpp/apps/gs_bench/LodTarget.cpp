@@ -7,21 +7,11 @@
 
 #include "open3d/camera/CameraPath.h"
 #include "open3d/core/Exception.h"
+#include "open3d/core/Percentile.h"
 #include "open3d/core/Timer.h"
 
 namespace open3d {
 namespace bench {
-
-namespace {
-
-double Quantile(std::vector<double> values, double q) {
-    std::sort(values.begin(), values.end());
-    const size_t i =
-        std::min(values.size() - 1, static_cast<size_t>(q * (values.size() - 1) + 0.5));
-    return values[i];
-}
-
-}  // namespace
 
 LodTargetResult RunLodTargetPath(visualization::rendering::GaussianSplatBackend& backend,
                                  const std::vector<camera::PinholeCamera>& cameras,
@@ -45,16 +35,16 @@ LodTargetResult RunLodTargetPath(visualization::rendering::GaussianSplatBackend&
     r.wall_ms_per_frame = core::MillisecondsSince(start) / double(path.size());
     r.target_ms = config.lod_target_ms;
     r.frames = static_cast<int>(path.size());
-    r.median_ms = Quantile(ms, 0.5);
-    r.p5_ms = Quantile(ms, 0.05);
-    r.p95_ms = Quantile(ms, 0.95);
+    r.median_ms = core::Percentile(ms, 0.5);
+    r.p5_ms = core::Percentile(ms, 0.05);
+    r.p95_ms = core::Percentile(ms, 0.95);
     r.within_10_percent =
         double(std::count_if(ms.begin(), ms.end(),
                              [&](double t) { return std::abs(t / r.target_ms - 1.0) <= 0.1; })) /
         double(ms.size());
-    r.min_budget = Quantile(budgets, 0.0);
-    r.median_budget = Quantile(budgets, 0.5);
-    r.max_budget = Quantile(budgets, 1.0);
+    r.min_budget = core::Percentile(budgets, 0.0);
+    r.median_budget = core::Percentile(budgets, 0.5);
+    r.max_budget = core::Percentile(budgets, 1.0);
     return r;
 }
 

@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "open3d/core/Percentile.h"
+
 namespace open3d {
 namespace visualization {
 
@@ -23,13 +25,6 @@ rendering::FrameTimes Mix(const rendering::FrameTimes& old_value,
     out.readback_ms = mix(old_value.readback_ms, new_value.readback_ms);
     out.total_ms = mix(old_value.total_ms, new_value.total_ms);
     return out;
-}
-
-double Percentile(std::vector<double> values, double q) {
-    std::sort(values.begin(), values.end());
-    const size_t i =
-        std::min(values.size() - 1, static_cast<size_t>(q * (values.size() - 1) + 0.5));
-    return values[i];
 }
 
 }  // namespace
@@ -59,8 +54,8 @@ FrameTimeSummary FrameStatistics::Summarize(int64_t warmup) const {
     double sum = 0.0;
     for (double v : frames) sum += v;
     summary.mean_ms = sum / summary.frames;
-    summary.median_ms = Percentile(frames, 0.5);
-    summary.p90_ms = Percentile(frames, 0.9);
+    summary.median_ms = core::Percentile(frames, 0.5);
+    summary.p90_ms = core::Percentile(frames, 0.9);
     rendering::FrameTimes& m = summary.mean_parts;
     for (int64_t i = first; i < n; ++i) {
         m.geometry_stage_ms += parts_[i].geometry_stage_ms / summary.frames;

@@ -448,6 +448,10 @@ private:
     /// kSelectionOverlay that is not one of the window's objects (none when nothing is
     /// selected).
     void UpdateSelectionOverlay();
+    /// Adds unlit points of `color` to the scene as `name` (an overlay, not a window object);
+    /// nothing for no points.
+    void ShowOverlayPoints(const char* name, const std::vector<float>& points,
+                           const Eigen::Vector4f& color, float point_size);
     /// Draws the crop box's edges as points (kCropBoxOverlay), or removes them without a box.
     void UpdateCropBoxOverlay();
     /// The panel's crop-box section: corners, the count inside, keep / remove / cancel.

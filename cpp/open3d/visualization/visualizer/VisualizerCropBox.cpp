@@ -9,7 +9,6 @@
 #include <vector>
 
 #include "open3d/core/Exception.h"
-#include "open3d/visualization/rendering/filament/MaterialRecord.h"
 #include "open3d/visualization/rendering/gaussian_splat/GaussianSplatRenderer.h"
 #include "open3d/visualization/visualizer/Visualizer.h"
 
@@ -99,13 +98,7 @@ void Visualizer::UpdateCropBoxOverlay() {
             }
         }
     }
-    rendering::MaterialRecord yellow;
-    yellow.shader = rendering::kShaderDefaultUnlit;
-    yellow.base_color = Eigen::Vector4f(1.0f, 0.85f, 0.0f, 1.0f);
-    yellow.point_size = 2.0f;
-    const int64_t n = static_cast<int64_t>(points.size() / 3);
-    scene_->AddGeometry(kCropBoxOverlay,
-                        t::geometry::PointCloud(core::Tensor::FromVector(points, {n, 3})), yellow);
+    ShowOverlayPoints(kCropBoxOverlay, points, Eigen::Vector4f(1.0f, 0.85f, 0.0f, 1.0f), 2.0f);
 }
 
 void Visualizer::DrawCropBoxPanel() {

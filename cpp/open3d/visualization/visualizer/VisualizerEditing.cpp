@@ -131,14 +131,19 @@ void Visualizer::UpdateSelectionOverlay() {
         const float* p = splats.GetCloud(name).GetPointPositions().Data<float>();
         for (int64_t i : indices) centres.insert(centres.end(), p + 3 * i, p + 3 * i + 3);
     }
-    if (centres.empty()) return;
-    rendering::MaterialRecord red;
-    red.shader = rendering::kShaderDefaultUnlit;
-    red.base_color = Eigen::Vector4f(1.0f, 0.0f, 0.0f, 1.0f);
-    red.point_size = 3.0f;
-    const int64_t n = static_cast<int64_t>(centres.size() / 3);
-    scene_->AddGeometry(kSelectionOverlay,
-                        t::geometry::PointCloud(core::Tensor::FromVector(centres, {n, 3})), red);
+    ShowOverlayPoints(kSelectionOverlay, centres, Eigen::Vector4f(1.0f, 0.0f, 0.0f, 1.0f), 3.0f);
+}
+
+void Visualizer::ShowOverlayPoints(const char* name, const std::vector<float>& points,
+                                   const Eigen::Vector4f& color, float point_size) {
+    if (points.empty()) return;
+    rendering::MaterialRecord material;
+    material.shader = rendering::kShaderDefaultUnlit;
+    material.base_color = color;
+    material.point_size = point_size;
+    const int64_t n = static_cast<int64_t>(points.size() / 3);
+    scene_->AddGeometry(name, t::geometry::PointCloud(core::Tensor::FromVector(points, {n, 3})),
+                        material);
 }
 
 void Visualizer::RequireObjectName(const std::string& name) {
