@@ -1,10 +1,18 @@
 #include "CameraPathRender.h"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
+#include <condition_variable>
 #include <cstdio>
+#include <deque>
+#include <exception>
+#include <functional>
 #include <memory>
+#include <mutex>
+#include <thread>
+#include <utility>
 #include <vector>
 
 #include "open3d/camera/CameraPath.h"
@@ -29,6 +37,74 @@ std::string FramePath(const std::string& output, size_t index) {
     std::snprintf(number, sizeof(number), "_%05zu.png", index);
     return stem + number;
 }
+
+// Writes rendered batches on a thread of its own, so the device renders the next batch while
+// this one is encoded or compressed: at most two batches wait. An error on the writer's
+// thread is thrown again by the next Push or by Finish; the destructor drops what still waits
+// (an error on the rendering side) and stops the thread.
+class BatchWriter {
+public:
+    using Write = std::function<void(size_t first_frame, std::vector<rendering::RenderOutput>&)>;
+    explicit BatchWriter(Write write) : write_(std::move(write)), thread_([this] { Run(); }) {}
+    ~BatchWriter() {
+        {
+            std::lock_guard<std::mutex> lock(mutex_);
+            queue_.clear();
+            closed_ = true;
+        }
+        changed_.notify_all();
+        thread_.join();
+    }
+    void Push(size_t first_frame, std::vector<rendering::RenderOutput> outputs) {
+        std::unique_lock<std::mutex> lock(mutex_);
+        changed_.wait(lock, [&] { return queue_.size() < 2 || error_; });
+        if (error_) std::rethrow_exception(error_);
+        queue_.emplace_back(first_frame, std::move(outputs));
+        changed_.notify_all();
+    }
+    /// Waits until every pushed batch is written.
+    void Finish() {
+        std::unique_lock<std::mutex> lock(mutex_);
+        changed_.wait(lock, [&] { return (queue_.empty() && !busy_) || error_; });
+        if (error_) std::rethrow_exception(error_);
+    }
+    size_t Written() const { return written_; }
+
+private:
+    void Run() {
+        std::unique_lock<std::mutex> lock(mutex_);
+        while (true) {
+            changed_.wait(lock, [&] { return !queue_.empty() || closed_; });
+            if (queue_.empty()) return;  // closed
+            auto [first, outputs] = std::move(queue_.front());
+            queue_.pop_front();
+            busy_ = true;
+            lock.unlock();
+            try {
+                write_(first, outputs);
+                written_ += outputs.size();
+            } catch (...) {
+                lock.lock();
+                error_ = std::current_exception();
+                busy_ = false;
+                changed_.notify_all();
+                return;
+            }
+            lock.lock();
+            busy_ = false;
+            changed_.notify_all();
+        }
+    }
+
+    Write write_;
+    std::mutex mutex_;
+    std::condition_variable changed_;
+    std::deque<std::pair<size_t, std::vector<rendering::RenderOutput>>> queue_;
+    bool busy_ = false, closed_ = false;
+    std::exception_ptr error_;
+    std::atomic<size_t> written_{0};
+    std::thread thread_;  // last: started once the members above exist
+};
 
 }  // namespace
 
@@ -73,8 +149,31 @@ size_t RenderCameraPath(const CameraPathOptions& options, rendering::GaussianSpl
         writer = std::make_unique<t::io::H264VideoWriter>(options.output, w, h, options.fps,
                                                           video_options);
     }
+    BatchWriter output([&](size_t first, std::vector<rendering::RenderOutput>& outputs) {
+        for (size_t k = 0; k < outputs.size(); ++k) {
+            if (video) {
+                writer->WriteFrame(outputs[k].color.Data<uint8_t>(), 4);
+            } else {
+                const t::geometry::Image color = outputs[k].color.SelectChannels(0, 3);
+                t::io::OutputFileSet files;
+                files.Write(FramePath(options.output, first + k),
+                            [&](const std::string& p) { t::io::WriteImage(p, color); });
+                files.Commit();
+            }
+        }
+    });
     const auto start = std::chrono::steady_clock::now();
     double last_report = -1.0;
+    const auto report = [&](bool last) {
+        const double seconds = core::MillisecondsSince(start) / 1000.0;
+        if (!last && seconds - last_report < 1.0) return;
+        last_report = seconds;
+        const size_t done = output.Written();
+        std::printf("frame %zu/%zu (%.0f%%), %.1f frames/s\n", done, frames.size(),
+                    100.0 * double(done) / double(frames.size()),
+                    double(done) / std::max(seconds, 1e-9));
+        std::fflush(stdout);
+    };
     const size_t batch = size_t(std::max(1, options.batch));
     for (size_t begin = 0; begin < frames.size(); begin += batch) {
         const size_t end = std::min(frames.size(), begin + batch);
@@ -85,28 +184,11 @@ size_t RenderCameraPath(const CameraPathOptions& options, rendering::GaussianSpl
         // colour from the device (a quarter of the bytes to read back).
         rendering::BatchOptions batch_options;
         batch_options.color_uint8 = video;
-        const std::vector<rendering::RenderOutput> outputs =
-            backend.RenderBatch(views, config, batch_options);
-        for (size_t k = 0; k < outputs.size(); ++k) {
-            if (video) {
-                writer->WriteFrame(outputs[k].color.Data<uint8_t>(), 4);
-            } else {
-                const t::geometry::Image color = outputs[k].color.SelectChannels(0, 3);
-                t::io::OutputFileSet files;
-                files.Write(FramePath(options.output, begin + k),
-                            [&](const std::string& p) { t::io::WriteImage(p, color); });
-                files.Commit();
-            }
-        }
-        const double seconds = core::MillisecondsSince(start) / 1000.0;
-        if (end == frames.size() || seconds - last_report >= 1.0) {
-            last_report = seconds;
-            std::printf("frame %zu/%zu (%.0f%%), %.1f frames/s\n", end, frames.size(),
-                        100.0 * double(end) / double(frames.size()),
-                        double(end) / std::max(seconds, 1e-9));
-            std::fflush(stdout);
-        }
+        output.Push(begin, backend.RenderBatch(views, config, batch_options));
+        report(false);
     }
+    output.Finish();
+    report(true);
     if (video) {
         writer->Finish();
         std::printf("wrote %s (H.264, %dx%d, CRF %g, x264 preset %s)\n", options.output.c_str(),
