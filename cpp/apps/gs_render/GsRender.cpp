@@ -233,9 +233,14 @@ int Run(const Options& opt) {
     }
     int64_t lod_nodes = 0;
     if (opt.lod_budget > 0) {
+        auto* vulkan = dynamic_cast<rendering::vulkan::GaussianSplatVulkanBackend*>(backend.get());
+        // Every node goes to the device: refused with the sizes before the hierarchy is read
+        // or built (minutes for 1e8 splats) when even its least size cannot fit.
+        if (vulkan != nullptr) {
+            vulkan->CheckHierarchyFits(cloud.NumPoints(), cloud.GetGaussianSplatArrays().sh_degree);
+        }
         const t::geometry::SplatHierarchy hierarchy = LoadOrBuildHierarchy(opt, cloud);
         config.lod_budget = opt.lod_budget;
-        auto* vulkan = dynamic_cast<rendering::vulkan::GaussianSplatVulkanBackend*>(backend.get());
         if (vulkan != nullptr) {
             vulkan->SetSceneHierarchy(cloud, hierarchy);  // the cut is chosen on the GPU
         } else {

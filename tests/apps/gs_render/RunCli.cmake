@@ -2,6 +2,7 @@
 # gs-bench's checks share it).
 # -DEXE=path -DARGS="a|b|c" (| separates arguments) -DEXPECT=zero|nonzero -DPATTERN=regex
 # -DWORKDIR=folder for output files, emptied first.
+# -DABSENT=regex (optional): the output must not match it (work that should not have started).
 # -DFILES="a.png|b.png" (optional): exactly these files must be in WORKDIR afterwards, hidden
 # ones included ("none": nothing, e.g. a refused run must not leave a partial output).
 string(REPLACE "|" ";" arg_list "${ARGS}")
@@ -18,6 +19,9 @@ if(EXPECT STREQUAL "nonzero" AND rc EQUAL 0)
 endif()
 if(NOT all MATCHES "${PATTERN}")
   message(FATAL_ERROR "output does not match '${PATTERN}':\n${all}")
+endif()
+if(DEFINED ABSENT AND all MATCHES "${ABSENT}")
+  message(FATAL_ERROR "output matches '${ABSENT}', which it must not:\n${all}")
 endif()
 if(DEFINED FILES)
   file(GLOB found LIST_DIRECTORIES true RELATIVE "${WORKDIR}" "${WORKDIR}/*" "${WORKDIR}/.*")
