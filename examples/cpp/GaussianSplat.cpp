@@ -5,8 +5,10 @@
 // --exit-after-seconds, --screenshot-dir, --screenshot-on-exit, --spin.
 #include <CLI/CLI.hpp>
 #include <algorithm>
+#include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <memory>
 #include <optional>
 #include <string>
 #include <thread>
@@ -15,9 +17,12 @@
 #include "apps/NumberValidators.h"
 #include "open3d/camera/CamerasJson.h"
 #include "open3d/core/Exception.h"
+#include "open3d/core/Logging.h"
 #include "open3d/core/Timer.h"
 #include "open3d/t/geometry/PointCloudStatistics.h"
+#include "open3d/t/geometry/SplatHierarchy.h"
 #include "open3d/t/io/PointCloudIO.h"
+#include "open3d/t/io/SplatHierarchyIO.h"
 #include "open3d/t/io/SplatPageFile.h"
 #include "open3d/visualization/rendering/filament/FilamentEngine.h"
 #include "open3d/visualization/rendering/gaussian_splat/DefaultScene.h"
@@ -52,6 +57,7 @@ struct Options {
     double interactive_frame_ms = 100.0;
     std::string gpu_budget = "auto";
     bool compact_pool = false;
+    double lod_target_ms = 0.0;
 };
 
 bool IsPagedFile(const std::string& path) {
@@ -108,12 +114,44 @@ void StreamScene(vis::Visualizer& viewer, const std::string& path, const Options
     std::fflush(stdout);
 }
 
-// Puts `cloud` into the viewer as the scene (replacing the one shown, if any) with the red
-// sphere at its centre unless --no-sphere.
+// The level-of-detail hierarchy of `cloud`, read from `path`.lod (gs-convert --lod writes it
+// beside the scene) when that was built from it, else built here (--lod-target-ms).
+std::shared_ptr<const t::geometry::SplatHierarchy> SceneHierarchy(
+    const std::string& path, const t::geometry::PointCloud& cloud) {
+    const auto start = std::chrono::steady_clock::now();
+    const std::string lod = path + ".lod";
+    if (!path.empty() && std::filesystem::exists(lod)) {
+        auto hierarchy =
+            std::make_shared<const t::geometry::SplatHierarchy>(t::io::ReadSplatHierarchy(lod));
+        const std::string mismatch = t::geometry::HierarchySourceMismatch(*hierarchy, cloud);
+        if (mismatch.empty()) {
+            std::printf("GaussianSplat: level of detail: %s read in %.1f ms\n", lod.c_str(),
+                        core::MillisecondsSince(start));
+            return hierarchy;
+        }
+        core::LogWarning("'{}' was not built from '{}' ({}); building the hierarchy", lod, path,
+                         mismatch);
+    }
+    std::printf("GaussianSplat: level of detail: building the hierarchy of %lld splats...\n",
+                static_cast<long long>(cloud.NumPoints()));
+    std::fflush(stdout);
+    auto hierarchy = std::make_shared<const t::geometry::SplatHierarchy>(
+        t::geometry::BuildSplatHierarchy(cloud));
+    std::printf("GaussianSplat: level of detail: %lld nodes built in %.1f ms\n",
+                static_cast<long long>(hierarchy->NumNodes()), core::MillisecondsSince(start));
+    std::fflush(stdout);
+    return hierarchy;
+}
+
+// Puts `cloud` (read from `path`; empty for the built-in scene) into the viewer as the scene
+// (replacing the one shown, if any) with the red sphere at its centre unless --no-sphere, and
+// with --lod-target-ms its level-of-detail hierarchy.
 void ShowScene(vis::Visualizer& viewer, const t::geometry::PointCloud& cloud,
-               const std::string& name, bool default_scene, const Options& opt) {
+               const std::string& name, const std::string& path, bool default_scene,
+               const Options& opt) {
     ClearScene(viewer);
     viewer.AddGeometry(name, cloud);
+    if (opt.lod_target_ms > 0.0) viewer.SetSplatHierarchy(name, SceneHierarchy(path, cloud));
     Eigen::Vector3d center;
     double radius = 0.0;
     if (default_scene) {
@@ -157,6 +195,7 @@ int Run(const Options& opt) {
     vo.show_settings = !opt.hide_panel;
     vo.screenshot_dir = opt.screenshot_dir;
     vo.interactive_frame_ms = opt.interactive_frame_ms;
+    vo.lod_target_ms = opt.lod_target_ms;
     vis::Visualizer viewer(vo);
     viewer.GetSplatConfig().sh_degree = opt.sh_degree;
     viewer.GetSplatConfig().antialias = opt.antialias;
@@ -199,7 +238,7 @@ int Run(const Options& opt) {
                     default_scene ? "built-in default" : opt.input.c_str(),
                     static_cast<long long>(cloud.NumPoints()), cloud.GaussianSplatGetSHOrder(),
                     core::MillisecondsSince(start));
-        ShowScene(viewer, cloud, name, default_scene, opt);
+        ShowScene(viewer, cloud, name, opt.input, default_scene, opt);
     }
     if (start_camera) {
         viewer.SetCamera(*start_camera);
@@ -236,7 +275,7 @@ int Run(const Options& opt) {
         try {
             if (std::optional<t::geometry::PointCloud> loaded = reader.TakeResult()) {
                 const std::string stem = std::filesystem::path(reader.GetPath()).stem().string();
-                ShowScene(viewer, *loaded, stem, false, opt);
+                ShowScene(viewer, *loaded, stem, reader.GetPath(), false, opt);
                 viewer.ResetCamera();
                 viewer.SetStatus("");
                 std::printf("GaussianSplat: opened %s, %lld splats\n", reader.GetPath().c_str(),
@@ -283,10 +322,14 @@ int Run(const Options& opt) {
     std::printf("GaussianSplat: %dx%d, %s\n", viewer.GetWidth(), viewer.GetHeight(),
                 vis::FormatSummary(viewer.GetFrameStatistics().Summarize()).c_str());
     const rendering::RenderStats& s = viewer.GetLastFrame().splat_stats;
+    // A hierarchy scene's splats are its nodes, of which the level-of-detail cut draws some.
+    const std::string cut =
+        s.lod_cut_nodes > 0 ? fmt::format(" in a level-of-detail cut of {} nodes", s.lod_cut_nodes)
+                            : "";
     std::printf(
-        "GaussianSplat: last frame: %lld of %lld splats visible, %lld tile entries, GPU project "
+        "GaussianSplat: last frame: %lld of %lld splats visible%s, %lld tile entries, GPU project "
         "%.2f ms, sort %.2f ms, composite %.2f ms%s\n",
-        static_cast<long long>(s.num_visible), static_cast<long long>(s.num_splats),
+        static_cast<long long>(s.num_visible), static_cast<long long>(s.num_splats), cut.c_str(),
         static_cast<long long>(s.num_tile_entries), s.gpu_project_ms, s.gpu_sort_ms,
         s.gpu_composite_ms,
         s.geometry_reused ? " (geometry stage reused: the camera did not move)" : "");
@@ -374,6 +417,13 @@ int main(int argc, char** argv) {
                    "While the camera moves (drag, keys, wheel, --spin), frames whose full-size "
                    "time exceeded this are drawn at 1/2 or 1/4 of each side and scaled up; "
                    "the full-size frame follows when the motion stops (0: always full size)")
+        ->check(apps::kNonNegative)
+        ->capture_default_str();
+    app.add_option("--lod-target-ms", opt.lod_target_ms,
+                   "While the camera moves, draw the scene through a level-of-detail cut whose "
+                   "budget holds this many ms of GPU time per frame (the hierarchy is read from "
+                   "SCENE.lod, which gs-convert --lod writes, or built at start); still, every "
+                   "splat. Vulkan only; 0: off (docs/viewer.md \"Level of detail\")")
         ->check(apps::kNonNegative)
         ->capture_default_str();
     app.add_option("--gpu-budget", opt.gpu_budget,

@@ -323,6 +323,34 @@ TEST(GaussianSplatViewer, ScreenshotOnExitFailsWhenNothingIsSaved) {
     }
 }
 
+// --lod-target-ms: the built-in scene's hierarchy is built at start, and while --spin turns the
+// camera every frame is a moving one, drawn through a level-of-detail cut (a target no device
+// meets, so the cut is a fraction of the nodes whatever the machine's speed).
+TEST(GaussianSplatViewer, SpinningFramesDrawALevelOfDetailCut) {
+    const char* display = std::getenv("DISPLAY");
+    if (display == nullptr || display[0] == '\0') {
+        OPEN3D_SKIP_OR_FAIL_WHEN_UNAVAILABLE(
+            "DISPLAY is not set: run under xvfb-run (scripts/test.sh does)");
+    }
+    const std::string log = TempDir() + "/lod.log";
+    ViewerProcess viewer({GAUSSIAN_SPLAT_VIEWER, "--width", "160", "--height", "120", "--frames",
+                          "12", "--spin", "30", "--lod-target-ms", "0.000001"},
+                         log);
+    ASSERT_TRUE(viewer.Started());
+    int status = 0;
+    const Clock::time_point start = Clock::now();
+    while (!viewer.Exited(&status) &&
+           std::chrono::duration<double>(Clock::now() - start).count() < 300) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    }
+    ASSERT_TRUE(viewer.Exited(&status)) << "still running after 300 s:\n" << ReadFile(log);
+    const std::string text = ReadFile(log);
+    EXPECT_EQ(status, 0) << text;
+    EXPECT_NE(text.find("level of detail: "), std::string::npos) << text;
+    EXPECT_NE(text.find(" nodes built in "), std::string::npos) << text;
+    EXPECT_NE(text.find("in a level-of-detail cut of "), std::string::npos) << text;
+}
+
 }  // namespace
 }  // namespace tests
 }  // namespace open3d

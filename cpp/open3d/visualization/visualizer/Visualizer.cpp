@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstring>
 #include <filesystem>
 
@@ -58,6 +59,7 @@ void Visualizer::Init(const VisualizerOptions& options) {
     show_settings_ = options.show_settings;
     screenshot_dir_ = options.screenshot_dir.empty() ? "." : options.screenshot_dir;
     interactive_frame_ms_ = options.interactive_frame_ms;
+    SetLodTargetMs(options.lod_target_ms);
     first_frame_notice_splats_ = options.first_frame_notice_splats;
     rendering::FilamentEngine& engine = renderer_->GetEngine();
     window_ = std::make_unique<VisualizerWindow>(engine, options.title, options.width,
@@ -247,8 +249,24 @@ int Visualizer::InteractiveDivisor() const {
     return over <= 1.0 ? 1 : over <= 4.0 ? 2 : 4;
 }
 
+void Visualizer::SetSplatHierarchy(const std::string& name,
+                                   std::shared_ptr<const t::geometry::SplatHierarchy> hierarchy) {
+    scene_->GetScene().GetSplatRenderer().SetCloudHierarchy(name, std::move(hierarchy));
+    PostRedraw();
+}
+
+void Visualizer::SetLodTargetMs(double ms) {
+    if (!(std::isfinite(ms) && ms >= 0.0)) {
+        core::ThrowError("Visualizer: the level-of-detail target must be >= 0 ms, not {}", ms);
+    }
+    lod_target_ms_ = ms;
+    PostRedraw();
+}
+
 rendering::FrameResult Visualizer::DrawToWindow(bool read_screen, int divisor, bool skip_splats) {
     const camera::PinholeCamera camera = view_control_.GetCamera();
+    // A hierarchy scene's cut holds the target while the camera moves; still, every leaf.
+    scene_->GetSplatConfig().lod_target_ms = IsCameraMoving() ? lod_target_ms_ : 0.0;
     scene_->SetupCamera(divisor > 1 ? camera.Resized(std::max(1, camera.width / divisor),
                                                      std::max(1, camera.height / divisor))
                                     : camera);

@@ -63,6 +63,11 @@ struct VisualizerOptions {
     /// milliseconds is drawn at 1/2 (up to 4x over) or 1/4 of each side and scaled up; the
     /// full-resolution frame follows when the motion stops. 0: always full resolution.
     double interactive_frame_ms = 100.0;
+    /// While the camera moves, a splat cloud given a level-of-detail hierarchy
+    /// (SetSplatHierarchy) is drawn through a cut whose budget holds this many milliseconds of
+    /// GPU time per frame (RenderConfig::lod_target_ms); when it stops, every leaf: the cloud
+    /// exactly. 0: always exact.
+    double lod_target_ms = 0.0;
     /// After a splat cloud of at least this many splats is added or updated, the next frame
     /// is preceded by one without splats showing "Drawing the first frame of N splats" in the
     /// panel, presented while that frame's geometry stage runs (seconds on a software
@@ -182,6 +187,15 @@ public:
     /// The same settings, read only (no redraw: the panel reads them every frame, and an
     /// idle viewer must not draw).
     const rendering::RenderConfig& GetSplatConfig() const { return scene_->GetSplatConfig(); }
+    /// A level-of-detail hierarchy of splat cloud `name`, built from it
+    /// (t::geometry::BuildSplatHierarchy or a .lod file): while that cloud is the window's only
+    /// one and shown, moving frames draw a cut that holds VisualizerOptions::lod_target_ms
+    /// (docs/viewer.md "Level of detail"). nullptr drops it; so does UpdateGeometry. Throws
+    /// when the cloud is unknown or the hierarchy was built from another.
+    void SetSplatHierarchy(const std::string& name,
+                           std::shared_ptr<const t::geometry::SplatHierarchy> hierarchy);
+    void SetLodTargetMs(double ms);
+    double GetLodTargetMs() const { return lod_target_ms_; }
     void SetSplatConfig(const rendering::RenderConfig& config) {
         PostRedraw();
         scene_->GetSplatConfig() = config;
@@ -404,6 +418,7 @@ private:
     int redraw_frames_ = 2;               // frames Run still draws without new input
     float panel_rect_[4] = {0, 0, 0, 0};  // x, y, w, h of the panel in the last frame
     double interactive_frame_ms_ = 100.0;
+    double lod_target_ms_ = 0.0;
     int64_t first_frame_notice_splats_ = 1000000;
     int64_t new_splats_ = 0;       // splats added since the last frame drawn with splats
     double full_frame_ms_ = 0.0;   // time of the last full-resolution frame

@@ -15,6 +15,7 @@
 #include "open3d/camera/PinholeCamera.h"
 #include "open3d/t/geometry/Image.h"
 #include "open3d/t/geometry/PointCloud.h"
+#include "open3d/t/geometry/SplatHierarchy.h"
 #include "open3d/visualization/rendering/gaussian_splat/BatchHostMemory.h"
 #include "open3d/visualization/rendering/gaussian_splat/RenderConfig.h"
 
@@ -124,6 +125,17 @@ public:
     /// the caller rebuilds the scene from the visible splats instead.
     virtual bool SetVisibilityMask(const std::vector<uint32_t>& mask) {
         (void)mask;
+        return false;
+    }
+
+    /// The scene as the nodes of `hierarchy`, built from `source`, each frame drawing the
+    /// view's level-of-detail cut under RenderConfig::lod_budget or lod_target_ms (docs/lod.md);
+    /// a budget of 0 draws every leaf, `source` exactly. Returns false, the scene unchanged,
+    /// where the backend draws no hierarchy (the default; the Vulkan backend does).
+    virtual bool SetSceneHierarchy(const t::geometry::PointCloud& source,
+                                   const t::geometry::SplatHierarchy& hierarchy) {
+        (void)source;
+        (void)hierarchy;
         return false;
     }
 

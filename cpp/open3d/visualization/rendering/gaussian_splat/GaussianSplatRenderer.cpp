@@ -55,7 +55,7 @@ void GaussianSplatRenderer::AddCloud(const std::string& name,
             name, stream_->File().GetFilename());
     }
     cloud.ValidateGaussianSplat();
-    clouds_.emplace(name, Cloud{cloud, 0, true});
+    clouds_.emplace(name, Cloud{cloud, 0, true, nullptr});
     merged_dirty_ = true;
 }
 
@@ -65,6 +65,23 @@ void GaussianSplatRenderer::UpdateCloud(const std::string& name,
     if (it == clouds_.end()) core::ThrowError("GaussianSplatRenderer: no cloud named '{}'", name);
     cloud.ValidateGaussianSplat();
     it->second.cloud = cloud;
+    it->second.hierarchy.reset();
+    merged_dirty_ = true;
+}
+
+void GaussianSplatRenderer::SetCloudHierarchy(
+    const std::string& name, std::shared_ptr<const t::geometry::SplatHierarchy> hierarchy) {
+    auto it = clouds_.find(name);
+    if (it == clouds_.end()) core::ThrowError("GaussianSplatRenderer: no cloud named '{}'", name);
+    if (hierarchy) {
+        const std::string mismatch =
+            t::geometry::HierarchySourceMismatch(*hierarchy, it->second.cloud);
+        if (!mismatch.empty()) {
+            core::ThrowError("GaussianSplatRenderer: the hierarchy is not of cloud '{}': {}", name,
+                             mismatch);
+        }
+    }
+    it->second.hierarchy = std::move(hierarchy);
     merged_dirty_ = true;
 }
 
@@ -79,8 +96,10 @@ void GaussianSplatRenderer::ShowCloud(const std::string& name, bool show) {
     if (it == clouds_.end()) core::ThrowError("GaussianSplatRenderer: no cloud named '{}'", name);
     if (it->second.visible == show) return;
     it->second.visible = show;
-    // Without a mask in the backend, hidden clouds are left out of the merged scene.
-    if (merged_uses_mask_) {
+    // Without a mask in the backend, hidden clouds are left out of the merged scene; a
+    // hierarchy's nodes have no mask of the cloud's splats, so a scene that is or becomes a
+    // hierarchy is made again.
+    if (merged_uses_mask_ && !hierarchy_scene_ && !it->second.hierarchy) {
         mask_dirty_ = true;
     } else {
         merged_dirty_ = true;
@@ -107,6 +126,7 @@ void GaussianSplatRenderer::Clear() {
     // Prepare: a renderer kept for later scenes (open3d_gs.rasterization's cache) must not
     // hold the last one between calls.
     backend_->ReleaseResources();
+    hierarchy_scene_ = false;
     has_current_view_ = false;
 }
 
@@ -132,7 +152,7 @@ void GaussianSplatRenderer::StreamSplats(const std::string& path,
     stream_ = std::move(stream);
     stream_view_.reset();
     stream_visible_ = true;
-    merged_dirty_ = mask_dirty_ = false;
+    merged_dirty_ = mask_dirty_ = hierarchy_scene_ = false;
     has_current_view_ = false;
 }
 
@@ -244,15 +264,22 @@ void GaussianSplatRenderer::Prepare() {
             parts.push_back(&cloud.cloud);
             first += NumSplats(cloud.cloud);
         }
+        hierarchy_scene_ = false;
         if (parts.empty()) {
             backend_->ReleaseResources();
         } else {
             // One cloud goes as it is: merging copies every splat first (1.4 s for 2M splats
-            // on the 2-core machine, before the upload, with the window frozen).
-            if (parts.size() == 1) {
-                backend_->SetScene(*parts.front());
-            } else {
-                backend_->SetScene(MergeGaussianSplatClouds(parts));
+            // on the 2-core machine, before the upload, with the window frozen). The only
+            // cloud, shown, with a hierarchy goes as its nodes where the backend draws them.
+            const Cloud* only = clouds_.size() == 1 ? &clouds_.begin()->second : nullptr;
+            hierarchy_scene_ = only != nullptr && only->visible && only->hierarchy &&
+                               backend_->SetSceneHierarchy(only->cloud, *only->hierarchy);
+            if (!hierarchy_scene_) {
+                if (parts.size() == 1) {
+                    backend_->SetScene(*parts.front());
+                } else {
+                    backend_->SetScene(MergeGaussianSplatClouds(parts));
+                }
             }
             ++counters_.merged_rebuilds;
             // A new scene starts all visible: send a mask only when something is hidden.

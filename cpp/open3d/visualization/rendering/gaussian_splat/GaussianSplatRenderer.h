@@ -52,12 +52,22 @@ public:
     /// Adds a Gaussian cloud. Throws core::Open3DError when the name is taken, the cloud
     /// lacks the Gaussian attributes or a stream runs (nothing changes then).
     void AddCloud(const std::string& name, const t::geometry::PointCloud& cloud);
-    /// Replaces a cloud, keeping its visibility. Throws when the name is unknown.
-    /// Clear() also ends a stream.
+    /// Replaces a cloud, keeping its visibility (its hierarchy goes: it was built for the old
+    /// cloud). Throws when the name is unknown. Clear() also ends a stream.
     void UpdateCloud(const std::string& name, const t::geometry::PointCloud& cloud);
     bool RemoveCloud(const std::string& name);
     /// Throws when the name is unknown.
     void ShowCloud(const std::string& name, bool show);
+    /// A level-of-detail hierarchy of cloud `name` (t/geometry/SplatHierarchy.h, built from
+    /// it; nullptr drops it). While that cloud is the only one and shown, a backend that draws
+    /// hierarchies (SetSceneHierarchy) gets its nodes as the scene, and RenderConfig::
+    /// lod_budget / lod_target_ms choose each frame's cut (0 and 0: every leaf, the cloud
+    /// exactly); otherwise the cloud is drawn as it is. Throws when the name is unknown or the
+    /// hierarchy was not built from this cloud.
+    void SetCloudHierarchy(const std::string& name,
+                           std::shared_ptr<const t::geometry::SplatHierarchy> hierarchy);
+    /// Whether the backend's scene is a cloud's hierarchy (after Prepare).
+    bool DrawsHierarchy() const { return hierarchy_scene_; }
     bool HasCloud(const std::string& name) const { return clouds_.count(name) > 0; }
     /// The cloud held under `name`; throws core::Open3DError when the name is unknown.
     const t::geometry::PointCloud& GetCloud(const std::string& name) const;
@@ -130,6 +140,8 @@ private:
         t::geometry::PointCloud cloud;
         int64_t first = 0;  ///< index of its first splat in the merged scene
         bool visible = true;
+        /// SetCloudHierarchy's, dropped when the cloud is replaced.
+        std::shared_ptr<const t::geometry::SplatHierarchy> hierarchy;
     };
     struct ViewState {
         camera::PinholeCamera camera;
@@ -149,6 +161,7 @@ private:
     bool merged_dirty_ = false;     // clouds added, removed or replaced
     bool mask_dirty_ = false;       // a cloud shown or hidden
     bool merged_uses_mask_ = true;  // false: the backend has no mask; hidden clouds left out
+    bool hierarchy_scene_ = false;  // the backend's scene is a cloud's hierarchy
     Counters counters_;
 };
 

@@ -140,8 +140,8 @@ public:
     /// view's level-of-detail cut chosen on the GPU under RenderConfig::lod_budget nodes
     /// (docs/lod.md "The cut on the GPU"); 0, the default, draws every leaf: `source` exactly.
     /// SetScene returns to a plain scene. Throws for an invalid source or hierarchy.
-    void SetSceneHierarchy(const t::geometry::PointCloud& source,
-                           const t::geometry::SplatHierarchy& hierarchy);
+    bool SetSceneHierarchy(const t::geometry::PointCloud& source,
+                           const t::geometry::SplatHierarchy& hierarchy) override;
     /// Throws, naming the numbers and how many splats would fit, unless a hierarchy over
     /// `num_leaves` splats of SH degree `sh_degree` can fit in device memory in place of the
     /// present scene. Counts the least any hierarchy takes (its leaves and one inner node),

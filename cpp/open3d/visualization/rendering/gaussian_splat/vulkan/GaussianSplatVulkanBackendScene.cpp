@@ -32,7 +32,7 @@ void GaussianSplatVulkanBackend::SetScene(const t::geometry::PointCloud& cloud) 
     UploadScene(SplatPrecision::kExact);
 }
 
-void GaussianSplatVulkanBackend::SetSceneHierarchy(const t::geometry::PointCloud& source,
+bool GaussianSplatVulkanBackend::SetSceneHierarchy(const t::geometry::PointCloud& source,
                                                    const t::geometry::SplatHierarchy& hierarchy) {
     source.ValidateGaussianSplat();
     // Every pass after the cut runs over its list, at most a slot per leaf; the cut's own
@@ -56,6 +56,7 @@ void GaussianSplatVulkanBackend::SetSceneHierarchy(const t::geometry::PointCloud
     lod_controller_.Reset();
     UploadScene(SplatPrecision::kExact);
     geometry_stage_resources_.UploadLod(*context_, pool_, lod);
+    return true;
 }
 
 void GaussianSplatVulkanBackend::SetScenePool(int64_t capacity, int sh_degree,
