@@ -18,6 +18,7 @@
 #include "open3d/camera/CameraPath.h"
 #include "open3d/camera/CamerasJson.h"
 #include "open3d/core/Exception.h"
+#include "open3d/core/ParallelFor.h"
 #include "open3d/core/Timer.h"
 #include "open3d/t/io/H264VideoWriter.h"
 #include "open3d/t/io/ImageIO.h"
@@ -150,17 +151,23 @@ size_t RenderCameraPath(const CameraPathOptions& options, rendering::GaussianSpl
                                                           video_options);
     }
     BatchWriter output([&](size_t first, std::vector<rendering::RenderOutput>& outputs) {
-        for (size_t k = 0; k < outputs.size(); ++k) {
-            if (video) {
-                writer->WriteFrame(outputs[k].color.Data<uint8_t>(), 4);
-            } else {
+        if (video) {
+            for (const rendering::RenderOutput& out : outputs)
+                writer->WriteFrame(out.color.Data<uint8_t>(), 4);
+            return;
+        }
+        // A batch's PNGs compress in parallel: zlib on one thread wrote 2.4 1080p frames a
+        // second on the H100's host, a fifteenth of what the device renders.
+        core::ParallelFor(
+            int64_t(outputs.size()),
+            [&](int64_t k) {
                 const t::geometry::Image color = outputs[k].color.SelectChannels(0, 3);
                 t::io::OutputFileSet files;
-                files.Write(FramePath(options.output, first + k),
+                files.Write(FramePath(options.output, first + size_t(k)),
                             [&](const std::string& p) { t::io::WriteImage(p, color); });
                 files.Commit();
-            }
-        }
+            },
+            1);
     });
     const auto start = std::chrono::steady_clock::now();
     double last_report = -1.0;

@@ -111,6 +111,20 @@ TEST(LodBudgetController, StaysWithinTheCapAndAboveOneNode) {
     EXPECT_EQ(all.LastBudget(), 1000000u) << "every leaf is faster than the target";
 }
 
+TEST(LodBudgetController, GrowsFromAFewNodes) {
+    // After an unreachable target the budget is 1; a target the frames then beat by 4% (past
+    // the dead band, a step smaller than the grid's at such budgets) still makes it grow.
+    LodBudgetController c;
+    DeviceModel device;
+    RunFrames(c, device, 0.1, 60, 1000000);
+    ASSERT_EQ(c.LastBudget(), 1u);
+    RunFrames(c, device, device.Time(1) * 1.04, 3, 1000000);
+    EXPECT_GT(c.LastBudget(), 1u);
+    // And a large target from there reaches its budget within ~25 frames of doubling.
+    const std::vector<double> r = RunFrames(c, device, 1.5, 60, 1000000);
+    EXPECT_EQ(WithinFrom(r, 40, 0.045), 20);
+}
+
 TEST(LodBudgetController, IgnoresFramesWithoutATime) {
     LodBudgetController c;
     const uint64_t first = c.NextBudget(1.0, 1000000, 0);

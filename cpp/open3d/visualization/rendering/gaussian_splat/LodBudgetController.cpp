@@ -33,7 +33,13 @@ uint64_t LodBudgetController::NextBudget(double target_ms, uint64_t leaves, uint
             // The step scales the budget the observed frame had (frames in flight may have
             // moved budget_ since), by at most a factor of two either way.
             const double factor = std::clamp(std::pow(ratio, kGain), 0.5, 2.0);
-            budget_ = Quantized(double(observed_budget_) * factor, limit);
+            uint64_t next = Quantized(double(observed_budget_) * factor, limit);
+            // Below ~45 nodes a grid step is less than one node: the rounding must not undo
+            // the step (a budget of 1 whose frame beat the target stayed at 1 on an H100).
+            if (factor > 1.0 && next <= observed_budget_) next = observed_budget_ + 1;
+            if (factor < 1.0 && next >= observed_budget_ && observed_budget_ > 1)
+                next = observed_budget_ - 1;
+            budget_ = std::clamp<uint64_t>(next, 1, limit);
         }
         observed_ms_ = 0.0;  // each observation steers once
     }
