@@ -66,6 +66,16 @@ public:
         }
     }
     bool Started() const { return pid_ > 0; }
+    /// Waits until the process ends, at most `seconds` (a deadline only a hang reaches);
+    /// true with its exit status in `status` when it ended.
+    bool WaitForExit(int* status, double seconds) {
+        const Clock::time_point start = Clock::now();
+        while (!Exited(status) &&
+               std::chrono::duration<double>(Clock::now() - start).count() < seconds) {
+            std::this_thread::sleep_for(std::chrono::milliseconds(50));
+        }
+        return Exited(status);
+    }
     /// True once the process ended; its exit status in `status` (-1 if killed).
     bool Exited(int* status) {
         if (exited_) {
@@ -302,14 +312,10 @@ TEST(GaussianSplatViewer, ScreenshotOnExitFailsWhenNothingIsSaved) {
                              log);
         ASSERT_TRUE(viewer.Started());
         int status = 0;
-        const Clock::time_point start = Clock::now();
         // The built-in scene's frame takes well under a second on lavapipe; only a hang
         // reaches the deadline.
-        while (!viewer.Exited(&status) &&
-               std::chrono::duration<double>(Clock::now() - start).count() < 300) {
-            std::this_thread::sleep_for(std::chrono::milliseconds(50));
-        }
-        ASSERT_TRUE(viewer.Exited(&status)) << "still running after 300 s:\n" << ReadFile(log);
+        ASSERT_TRUE(viewer.WaitForExit(&status, 300)) << "still running after 300 s:\n"
+                                                      << ReadFile(log);
         if (good) {
             EXPECT_EQ(status, 0) << ReadFile(log);
             EXPECT_TRUE(std::filesystem::exists(shots + "/screenshot_0000.png")) << ReadFile(log);
@@ -338,12 +344,8 @@ TEST(GaussianSplatViewer, SpinningFramesDrawALevelOfDetailCut) {
                          log);
     ASSERT_TRUE(viewer.Started());
     int status = 0;
-    const Clock::time_point start = Clock::now();
-    while (!viewer.Exited(&status) &&
-           std::chrono::duration<double>(Clock::now() - start).count() < 300) {
-        std::this_thread::sleep_for(std::chrono::milliseconds(50));
-    }
-    ASSERT_TRUE(viewer.Exited(&status)) << "still running after 300 s:\n" << ReadFile(log);
+    ASSERT_TRUE(viewer.WaitForExit(&status, 300)) << "still running after 300 s:\n"
+                                                  << ReadFile(log);
     const std::string text = ReadFile(log);
     EXPECT_EQ(status, 0) << text;
     EXPECT_NE(text.find("level of detail: "), std::string::npos) << text;
