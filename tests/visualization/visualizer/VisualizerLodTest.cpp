@@ -1,6 +1,6 @@
 // Level of detail in the viewer (docs/viewer.md "Level of detail"): a cloud given its
-// hierarchy is drawn exactly while the camera is still (every leaf: the same picture as the
-// cloud without one) and through cuts that follow VisualizerOptions::lod_target_ms while it
+// hierarchy is drawn exactly while the camera is still (every leaf: the same picture and the
+// same pick as the cloud without one) and through cuts that follow VisualizerOptions::lod_target_ms while it
 // moves. The target is one no device meets (1e-9 ms), so the cut shrinks to the root whatever
 // the machine's speed; the waits are for the frames' own stats, with deadlines only a hang
 // reaches.
@@ -44,6 +44,8 @@ TEST_F(VisualizerLod, StillFramesAreExactAndMovingOnesFollowTheTarget) {
     vis.ResetCamera();
     ASSERT_TRUE(vis.RenderFrame());
     const t::geometry::Image plain = vis.CaptureScreenImage();
+    const auto plain_pick = vis.PickSplat(80, 60);
+    ASSERT_TRUE(plain_pick.has_value());
 
     vis.SetSplatHierarchy("scene", std::make_shared<const t::geometry::SplatHierarchy>(
                                        t::geometry::BuildSplatHierarchy(cloud)));
@@ -51,6 +53,10 @@ TEST_F(VisualizerLod, StillFramesAreExactAndMovingOnesFollowTheTarget) {
     if (vis.GetBackendName() != "vulkan") GTEST_SKIP() << "the CPU reference draws no hierarchy";
     EXPECT_EQ(vis.GetLastFrame().splat_stats.lod_cut_nodes, n) << "still: every leaf";
     EXPECT_TRUE(SameImage(vis.CaptureScreenImage(), plain));
+    // Still, the cut lists every leaf in order: picking names the cloud's splats.
+    const auto pick = vis.PickSplat(80, 60);
+    ASSERT_TRUE(pick.has_value());
+    EXPECT_EQ(pick->index, plain_pick->index);
 
     // A drag: moving for as long as the button is down, whatever the frames take.
     vis.OnCursorPos(80, 60);

@@ -4,11 +4,13 @@
 #include <gtest/gtest.h>
 
 #include <cstdint>
+#include <string>
 #include <tuple>
 
 #include "TestUtility.h"
 #include "open3d/camera/CamerasJson.h"
 #include "open3d/core/Exception.h"
+#include "open3d/t/geometry/SplatHierarchy.h"
 #include "open3d/t/io/PointCloudIO.h"
 #include "open3d/visualization/rendering/gaussian_splat/DefaultScene.h"
 #include "open3d/visualization/rendering/gaussian_splat/cpu/CpuBackend.h"
@@ -101,6 +103,35 @@ TEST_F(SplatIdImage, AnEmptyViewHoldsMinusOneAndTheStagePathFillsItAgain) {
     }
     EXPECT_GT(covered, 100);
     EXPECT_LE(differ, covered / 100);
+}
+
+TEST_F(SplatIdImage, AHierarchyDrawnWholeHasTheCloudsIdsAndACutHasNone) {
+    // A hierarchy scene whose cut opens every leaf lists the leaves in order: the same IDs,
+    // bit for bit, as the cloud drawn plainly. A smaller cut blends merged nodes: refused.
+    const t::geometry::PointCloud cloud = CreateDefaultGaussianSplatScene();
+    const t::geometry::SplatHierarchy hierarchy = t::geometry::BuildSplatHierarchy(cloud);
+    const camera::PinholeCamera cam = GetDefaultSceneCamera().Resized(40, 30);
+    auto plain = MakeBackend();
+    plain->SetScene(cloud);
+    const RenderOutput want = plain->Render(cam, {}, WithSplatId());
+    auto lod = MakeBackend();
+    ASSERT_TRUE(lod->SetSceneHierarchy(cloud, hierarchy));
+    for (const uint64_t budget : {uint64_t(0), uint64_t(cloud.NumPoints())}) {
+        RenderConfig config;
+        config.lod_budget = budget;
+        const RenderOutput got = lod->Render(cam, config, WithSplatId());
+        EXPECT_TRUE(got.splat_id.AsTensor() == want.splat_id.AsTensor()) << "budget " << budget;
+    }
+    RenderConfig cut;
+    cut.lod_budget = uint64_t(cloud.NumPoints()) / 2;
+    try {
+        lod->Render(cam, cut, WithSplatId());
+        FAIL() << "an ID image of merged nodes was drawn";
+    } catch (const core::Open3DError& e) {
+        EXPECT_NE(std::string(e.what()).find("no ID image for a level-of-detail cut"),
+                  std::string::npos)
+            << e.what();
+    }
 }
 
 }  // namespace

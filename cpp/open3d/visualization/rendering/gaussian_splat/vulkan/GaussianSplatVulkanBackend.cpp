@@ -272,11 +272,18 @@ public:
           median_depth_(inputs.median_depth),
           splat_id_(inputs.splat_id) {
         const uint32_t w = backend.color_.GetWidth(), h = backend.color_.GetHeight();
-        // Through a hierarchy the composite blends cut nodes, not the scene's splats.
+        // Through a hierarchy the composite blends the cut's list slots. Only a cut of every
+        // leaf lists the leaves in order (slot i is node i, splat i of the cloud): any other
+        // cut's pixels show merged nodes, not splats of the cloud.
         if (splat_id_ && backend.geometry_stage_resources_.HasLod()) {
-            core::ThrowError(
-                "Vulkan backend: no ID image for a scene drawn through a level-of-detail "
-                "hierarchy (its pixels show merged nodes, not splats of the cloud)");
+            const uint64_t budget = backend.geometry_.config.lod_budget;
+            if (budget != 0 && budget < backend.geometry_stage_resources_.LodLeaves()) {
+                core::ThrowError(
+                    "Vulkan backend: no ID image for a level-of-detail cut of at most {} of {} "
+                    "splats (its pixels show merged nodes, not splats of the cloud); a budget "
+                    "of 0 draws every splat",
+                    budget, backend.geometry_stage_resources_.LodLeaves());
+            }
         }
         if (splat_id_ && (!backend.splat_id_ || backend.splat_id_.GetWidth() != w ||
                           backend.splat_id_.GetHeight() != h)) {
