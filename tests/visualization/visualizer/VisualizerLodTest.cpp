@@ -1,8 +1,8 @@
 // Level of detail in the viewer (docs/viewer.md "Level of detail"): a cloud given its
 // hierarchy is drawn exactly while the camera is still (every leaf: the same picture and the
-// same pick as the cloud without one) and through cuts that follow VisualizerOptions::lod_target_ms while it
-// moves. The target is one no device meets (1e-9 ms), so the cut shrinks to the root whatever
-// the machine's speed; the waits are for the frames' own stats, with deadlines only a hang
+// same pick as the cloud without one) and through cuts that follow VisualizerOptions::lod_target_ms
+// while it moves. The target is one no device meets (1e-9 ms), so the cut shrinks to the root
+// whatever the machine's speed; the waits are for the frames' own stats, with deadlines only a hang
 // reaches.
 #include <GLFW/glfw3.h>
 #include <gtest/gtest.h>
