@@ -4,7 +4,8 @@
 # frames from each view to the next, 231 frames after 30 warm-up frames) of playbot_125k at
 # 1920x1080 (target 0.38 ms) and 3840x2160 (0.65 ms): between the hierarchy scene's floor (a
 # cut of one node: the cut's passes over every node and a frame's fixed cost, 0.29 ms at
-# 1080p on the H100) and every leaf. (gs-bench --grid has one camera: no path.)
+# 1080p on the H100) and every leaf; and the 7x7 grid of it (6.1M splats, one camera turned
+# 20 degrees either way) at 1080p with a target of 1.5 ms (every leaf ~3.1 ms).
 # Prepare here as scripts/device/camera-path-timing.sh says; the call carries .gl, .devlibs,
 # .devbin and shared/data/playbot:
 #   bash scripts/device/lod-target.sh OUT_DIR
@@ -28,4 +29,5 @@ bench() {  # NAME ARGS...
 }
 bench playbot_1080p --resolution 1920x1080 --lod-target-ms 0.38
 bench playbot_4k --resolution 3840x2160 --lod-target-ms 0.65
+bench grid7_1080p --grid 7 --resolution 1920x1080 --lod-target-ms 1.5
 nvidia-smi --query-gpu=name,clocks.sm --format=csv,noheader | tee -a "$out/gpu.txt"

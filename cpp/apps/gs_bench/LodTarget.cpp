@@ -4,6 +4,9 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <iterator>
+
+#include <Eigen/Geometry>
 
 #include "open3d/camera/CameraPath.h"
 #include "open3d/core/Exception.h"
@@ -21,6 +24,21 @@ LodTargetResult RunLodTargetPath(visualization::rendering::GaussianSplatBackend&
     // One second per keyframe at frames_per_view frames per second.
     std::vector<camera::CameraKeyframe> keyframes;
     for (size_t i = 0; i < cameras.size(); ++i) keyframes.push_back({double(i), cameras[i]});
+    if (cameras.size() == 1) {
+        // One view (gs-bench --grid): the camera turns about its own vertical axis, 20 degrees
+        // either way and back, so the path still sees more and less of the scene.
+        keyframes.clear();
+        const double degrees[] = {0, -10, -20, -10, 0, 10, 20, 10, 0};
+        for (size_t i = 0; i < std::size(degrees); ++i) {
+            camera::PinholeCamera turned = cameras[0];
+            Eigen::Matrix4d turn = Eigen::Matrix4d::Identity();
+            turn.topLeftCorner<3, 3>() =
+                Eigen::AngleAxisd(degrees[i] * M_PI / 180.0, Eigen::Vector3d::UnitY())
+                    .toRotationMatrix();
+            turned.world_to_camera = turn * cameras[0].world_to_camera;
+            keyframes.push_back({double(i), turned});
+        }
+    }
     const std::vector<camera::PinholeCamera> path =
         camera::CameraPath(keyframes).Frames(double(frames_per_view));
     for (int f = 0; f < warm_up_frames; ++f) backend.Render(cameras[0], config);

@@ -24,7 +24,8 @@ struct LodTargetResult {
 /// Renders `warm_up_frames` frames at the first camera, then `frames_per_view` frames from each
 /// camera to the next along a camera path through them (positions on a centripetal
 /// Catmull-Rom spline, orientations by squad: camera/CameraPath.h), every frame with
-/// `config.lod_target_ms` on `backend`, whose scene is a hierarchy.
+/// `config.lod_target_ms` on `backend`, whose scene is a hierarchy. One camera (a grid's)
+/// becomes nine keyframes turning it about its own vertical axis, 20 degrees each way.
 LodTargetResult RunLodTargetPath(visualization::rendering::GaussianSplatBackend& backend,
                                  const std::vector<camera::PinholeCamera>& cameras,
                                  const visualization::rendering::RenderConfig& config,
