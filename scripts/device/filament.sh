@@ -57,7 +57,7 @@ else
   export OPEN3D_VULKAN_VALIDATION=0
 fi
 suites() {
-  export LD_LIBRARY_PATH=$PWD/.devlibs
+  export LD_LIBRARY_PATH=$PWD/.devlibs OPEN3D_DATA_DIR=$PWD/shared/data
   local name
   for name in tests_filament_rendering tests_visualizer; do
     [ -x ".devbin/$name" ] || { say "$name: not carried"; continue; }
@@ -69,13 +69,35 @@ suites() {
 }
 bench() {
   export LD_LIBRARY_PATH=$PWD/.devlibs
-  local d=shared/data/playbot
-  [ -x .devbin/gs-bench ] || { say "gs-bench: not carried"; return; }
-  timeout 300 .devbin/gs-bench -i $d/playbot_125k.ply --cameras $d/cameras.json --views 0 \
-    --filament --resolution 1920x1080 --resolution 3840x2160 --repeat 200 --warm-up 20 \
-    --reference-max-splats 0 --json "$out/filament-bench.json" >"$out/filament-bench.log" 2>&1
-  say "gs-bench --filament: exit $?"
-  tail -25 "$out/filament-bench.log" | tee -a "$summary"
+  local d=shared/data/playbot size w h sharing backend log
+  [ -x .devbin/gs-render ] || { say "gs-render: not carried"; return; }
+  for size in 1920x1080 3840x2160; do
+    w=${size%x*} h=${size#*x}
+    # The integrated frame (splats, a lit sphere, Filament's mesh view, the depth-tested
+    # composite, the offscreen read and blend), zero-copy and host copies; then Filament's own
+    # frame (placeholder backend: no splats) and the splats alone (gs-bench, GPU and in flight).
+    for sharing in zero-copy host-copy; do
+      log=$out/render-$size-$sharing.log
+      OPEN3D_SPLAT_SHARING=$sharing timeout 120 .devbin/gs-render -i $d/playbot_125k.ply \
+        --cameras $d/cameras.json --view 0 --width "$w" --height "$h" --sphere --frames 100 \
+        -o /tmp/filament-$size.png >"$log" 2>&1
+      say "gs-render --sphere $size $sharing: exit $?"
+      grep -E "^filament render|^frame time|rror" "$log" | tee -a "$summary"
+    done
+    log=$out/render-$size-placeholder.log
+    timeout 120 .devbin/gs-render -i $d/playbot_125k.ply --cameras $d/cameras.json --view 0 \
+      --width "$w" --height "$h" --sphere --frames 100 --backend placeholder \
+      -o /tmp/filament-mesh-$size.png >"$log" 2>&1
+    say "gs-render --sphere $size, meshes only: exit $?"
+    grep -E "^frame time|rror" "$log" | tee -a "$summary"
+  done
+  cp /tmp/filament-1920x1080.png "$out/" 2>/dev/null
+  [ -x .devbin/gs-bench ] || return
+  timeout 120 .devbin/gs-bench -i $d/playbot_125k.ply --cameras $d/cameras.json --views 0 \
+    --knobs default --resolution 1920x1080 --resolution 3840x2160 --repeat 50 --warm-up 2 \
+    --reference-max-splats 0 >"$out/gs-bench.log" 2>&1
+  say "gs-bench, splats alone: exit $?"
+  grep -E "^default |in flight" "$out/gs-bench.log" | tee -a "$summary"
 }
 case $mode in
   probe) probe ;;

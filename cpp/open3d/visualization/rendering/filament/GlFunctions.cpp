@@ -34,6 +34,7 @@ GlFunctions GlFunctions::Load() {
     }
     GlFunctions gl;
     LoadRequired(gl.GetStringi, "glGetStringi");
+    LoadRequired(gl.GetString, "glGetString");
     LoadRequired(gl.GetIntegerv, "glGetIntegerv");
     LoadRequired(gl.GetError, "glGetError");
     LoadRequired(gl.Finish, "glFinish");
@@ -51,6 +52,14 @@ GlFunctions GlFunctions::Load() {
     LoadProc(gl.GetUnsignedBytevEXT, "glGetUnsignedBytevEXT");
     LoadProc(gl.GetUnsignedBytei_vEXT, "glGetUnsignedBytei_vEXT");
     return gl;
+}
+
+std::string GlFunctions::Describe() const {
+    auto text = [this](GLenum name) {
+        const GLubyte* value = GetString(name);
+        return value ? std::string(reinterpret_cast<const char*>(value)) : std::string("?");
+    };
+    return text(GL_VENDOR) + " " + text(GL_RENDERER) + ", " + text(GL_VERSION);
 }
 
 bool GlFunctions::HasExtension(const std::string& name) const {

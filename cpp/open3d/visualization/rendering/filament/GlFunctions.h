@@ -18,6 +18,7 @@ namespace rendering {
 struct GlFunctions {
     PFNGLGETSTRINGIPROC GetStringi = nullptr;
     // GL 1.x functions have prototypes in gl.h but no PFN typedefs.
+    decltype(&::glGetString) GetString = nullptr;
     decltype(&::glGetIntegerv) GetIntegerv = nullptr;
     decltype(&::glGetError) GetError = nullptr;
     decltype(&::glFinish) Finish = nullptr;
@@ -40,6 +41,8 @@ struct GlFunctions {
     /// 4.5 entry point is missing (the extension ones may stay null).
     static GlFunctions Load();
 
+    /// "GL_VENDOR GL_RENDERER, GL_VERSION" of the current context, for log lines.
+    std::string Describe() const;
     /// True when the current context lists `name` in GL_EXTENSIONS.
     bool HasExtension(const std::string& name) const;
     /// GL_EXT_memory_object + GL_EXT_memory_object_fd with all their entry points.

@@ -75,16 +75,23 @@ SplatTargets::SplatTargets(FilamentEngine& engine, GaussianSplatBackend& backend
     if (sharing == SplatSharing::kZeroCopy && !why.empty()) {
         core::ThrowError("zero-copy splat images are unavailable: {}", why);
     }
+    // Once per process: the choice and its reason do not change.
+    static bool logged = false;
     if (sharing != SplatSharing::kHostCopy && why.empty()) {
         CreateZeroCopy(backend);
+        if (!logged) {
+            core::LogInfo(
+                "Splat images are shared zero-copy: Vulkan memory imported into OpenGL ({}), "
+                "no host copies",
+                engine.GetGl().Describe());
+        }
     } else {
-        if (sharing == SplatSharing::kAuto) {
-            static bool logged = false;  // once per process: the reason does not change
-            if (!logged) core::LogInfo("Splat images use host copies: {}", why);
-            logged = true;
+        if (sharing == SplatSharing::kAuto && !logged) {
+            core::LogInfo("Splat images use host copies: {}", why);
         }
         CreateHostCopy();
     }
+    logged = true;
 }
 
 void SplatTargets::CreateZeroCopy(GaussianSplatBackend& backend) {
