@@ -34,8 +34,18 @@ find_program(GLSLANG_VALIDATOR glslangValidator REQUIRED)
 find_program(SPIRV_CROSS spirv-cross REQUIRED)
 
 # Filament integration (libfilament-dev + libfilament-tools 1.9.25, libglfw3-dev 3.3.8,
-# libgl-dev for the GL headers; GL entry points are loaded through GLFW at run time).
+# libgl-dev for the GL headers, libegl-dev for headless EGL; GL entry points are loaded
+# through GLFW or EGL at run time).
 find_package(filament 1.9 REQUIRED CONFIG)
+# The EGL platform declares Filament's private OpenGLPlatform as 1.9.25 lays it out
+# (filament/FilamentOpenGLPlatform.h): another version may order its virtual functions
+# differently.
+if(NOT filament_VERSION VERSION_EQUAL 1.9.25)
+  message(FATAL_ERROR "Filament ${filament_VERSION} found; 1.9.25 is needed (Debian 12's "
+    "libfilament-dev): FilamentOpenGLPlatform.h mirrors its OpenGLPlatform")
+endif()
 find_package(glfw3 3.3 REQUIRED)
 find_path(OPENGL_GLEXT_INCLUDE_DIR GL/glext.h REQUIRED)
+find_path(EGL_INCLUDE_DIR EGL/egl.h REQUIRED)
+find_library(EGL_LIBRARY EGL REQUIRED)
 find_program(FILAMENT_MATC matc REQUIRED)

@@ -14,7 +14,7 @@ packages=(
   libopenh264-dev  # the video tests decode with it
   libfilament-dev libfilament-tools libglfw3-dev libimgui-dev
   libxrandr-dev  # glfw3native.h (the GLX context handed to Filament) includes Xrandr.h
-  xvfb xauth libgl1-mesa-dri libgl-dev xdotool
+  xvfb xauth libgl1-mesa-dri libgl-dev libegl-dev libegl-mesa0 xdotool
   python3-dev pybind11-dev python3-numpy python3-pytest  # the Python package (docs/python.md)
   python3-dask python3-distributed  # open3d_gs.distributed, rendering on a Dask cluster (docs/distributed.md)
 )

@@ -1,14 +1,16 @@
 #!/usr/bin/env bash
-# The Filament layer on the GPU device machine (issue 48, docs/filament.md "On NVIDIA"):
-# Xvfb (carried, with Mesa's swrast for its GLX extension) as the X server, NVIDIA's libGLX
-# for the clients' OpenGL contexts (__GLX_VENDOR_LIBRARY_NAME=nvidia), Vulkan on the GPU.
-# Prepare here: bash scripts/device/prepare-x.sh; bash scripts/device/prepare.sh BINARIES.
-# Two calls, the second within the machine's warm period (30 s), since .xroot (55 MB) and the
-# binaries with a scene do not fit one call's 64 MB:
-#   1. carry .gl and .xroot:  bash scripts/device/filament.sh OUT probe
-#      (unpacks .xroot into /opt/xroot, which the warm machine keeps)
-#   2. carry .gl, .devlibs, .devbin and shared/data/playbot:
-#      bash scripts/device/filament.sh OUT suites|bench|all
+# The Filament layer on the GPU device machine (issue 48, docs/filament.md "On NVIDIA").
+# Headless by default: Filament and our OpenGL context on NVIDIA's EGL (no X server), Vulkan
+# on the same GPU. With an X server (.xroot carried, see below) the GLX platform runs too:
+# Xvfb with Mesa's swrast for its GLX extension, NVIDIA's libGLX for the clients' contexts
+# (__GLX_VENDOR_LIBRARY_NAME=nvidia), and the viewer's suite.
+# Prepare here: bash scripts/device/prepare.sh build/bin/{gs-render,gs-bench,tests_filament_rendering,tests_visualizer}
+# and copy those binaries into .devbin; bash scripts/device/prepare-x.sh for .xroot.
+# EGL call: carry .gl, .devlibs, .devbin, .xroot/validation.tar.xz and shared/data/playbot:
+#   bash scripts/device/filament.sh OUT [probe|suites|bench|all]
+# GLX: .xroot (55 MB) and the binaries with a scene do not fit one call's 64 MB: carry .gl and
+# .xroot first (`... OUT probe`, unpacks into /opt/xroot, which a warm machine keeps), then
+# the rest within the warm period with OPEN3D_FILAMENT_PLATFORM=glx before the command.
 # Everything is logged under OUT; the last lines printed are a summary.
 set -uo pipefail
 out=${1:?usage: bash scripts/device/filament.sh OUT probe|suites|bench|all}
@@ -19,6 +21,7 @@ say() { echo "$*" | tee -a "$summary"; }
 for f in .gl/*.deb; do dpkg -x "$f" /; done
 ldconfig
 export VK_DRIVER_FILES=${VK_DRIVER_FILES:-/usr/local/nvidia/share/vulkan/icd.d/nvidia_icd.json}
+export __EGL_VENDOR_LIBRARY_FILENAMES=${__EGL_VENDOR_LIBRARY_FILENAMES:-/usr/local/nvidia/share/glvnd/egl_vendor.d/10_nvidia.json}
 xr=/opt/xroot
 for part in xvfb mesa validation; do
   if [ -f ".xroot/$part.tar.xz" ] && [ ! -e "$xr/$part.done" ]; then
@@ -26,50 +29,61 @@ for part in xvfb mesa validation; do
   fi
 done
 [ -f .xroot/gl_probe ] && cp .xroot/gl_probe "$xr/"
-if [ ! -e "$xr/xvfb.done" ] || [ ! -e "$xr/mesa.done" ]; then
-  say "filament.sh: /opt/xroot is not unpacked: carry .xroot (scripts/device/prepare-x.sh)"
-  exit 2
-fi
-# Xvfb's GLX loads <dri>/swrast_dri.so from its compiled-in path and runs xkbcomp from
-# /usr/bin; the device has neither. Links only, nothing of / is overwritten.
-dri=/usr/lib/x86_64-linux-gnu/dri
-[ -e $dri/swrast_dri.so ] || { mkdir -p $dri && ln -s $xr/mesa/dri/swrast_dri.so $dri/swrast_dri.so; }
-[ -e /usr/bin/xkbcomp ] || ln -s $xr/xvfb/bin/xkbcomp /usr/bin/xkbcomp
-xlibs=$xr/xvfb/lib:$xr/mesa/lib
-LD_LIBRARY_PATH=$xlibs $xr/xvfb/bin/Xvfb :99 -screen 0 3840x2160x24 -nolisten tcp \
-  -xkbdir $xr/xvfb/share/X11/xkb >"$out/xvfb.log" 2>&1 &
-for _ in $(seq 100); do [ -S /tmp/.X11-unix/X99 ] && break; sleep 0.1; done
-[ -S /tmp/.X11-unix/X99 ] || { say "Xvfb did not start:"; tail -20 "$out/xvfb.log"; exit 2; }
-export DISPLAY=:99
 nvidia-smi --query-gpu=name,driver_version,clocks.sm,clocks.max.sm --format=csv,noheader | tee "$out/gpu.txt"
 
+platform=${OPEN3D_FILAMENT_PLATFORM:-egl}
+export OPEN3D_FILAMENT_PLATFORM=$platform
+unset DISPLAY
+xlibs=$xr/xvfb/lib:$xr/mesa/lib
+if [ -e "$xr/xvfb.done" ] && [ -e "$xr/mesa.done" ]; then
+  # Xvfb's GLX loads <dri>/swrast_dri.so from its compiled-in path and runs xkbcomp from
+  # /usr/bin; the device has neither. Links only, nothing of / is overwritten.
+  dri=/usr/lib/x86_64-linux-gnu/dri
+  [ -e $dri/swrast_dri.so ] || { mkdir -p $dri && ln -s $xr/mesa/dri/swrast_dri.so $dri/swrast_dri.so; }
+  [ -e /usr/bin/xkbcomp ] || ln -s $xr/xvfb/bin/xkbcomp /usr/bin/xkbcomp
+  LD_LIBRARY_PATH=$xlibs $xr/xvfb/bin/Xvfb :99 -screen 0 3840x2160x24 -nolisten tcp \
+    -xkbdir $xr/xvfb/share/X11/xkb >"$out/xvfb.log" 2>&1 &
+  for _ in $(seq 100); do [ -S /tmp/.X11-unix/X99 ] && break; sleep 0.1; done
+  if [ -S /tmp/.X11-unix/X99 ]; then
+    export DISPLAY=:99 __GLX_VENDOR_LIBRARY_NAME=nvidia
+  else
+    say "Xvfb did not start:"; tail -20 "$out/xvfb.log"
+  fi
+elif [ "$platform" = glx ]; then
+  say "filament.sh: GLX needs /opt/xroot: carry .xroot first (scripts/device/prepare-x.sh)"
+  exit 2
+fi
+say "platform: $platform, DISPLAY=${DISPLAY:-unset}"
+
 probe() {
+  [ -n "${DISPLAY:-}" ] || { say "probe: no X server"; return; }
   say "== gl_probe, Mesa (Xvfb's own GLX):"
-  LD_LIBRARY_PATH=$xlibs LIBGL_DRIVERS_PATH=$xr/mesa/dri $xr/gl_probe 2>&1 | tee -a "$summary"
+  LD_LIBRARY_PATH=$xlibs LIBGL_DRIVERS_PATH=$xr/mesa/dri __GLX_VENDOR_LIBRARY_NAME=mesa \
+    $xr/gl_probe 2>&1 | tee -a "$summary"
   say "== gl_probe, __GLX_VENDOR_LIBRARY_NAME=nvidia:"
-  LD_LIBRARY_PATH=$xlibs __GLX_VENDOR_LIBRARY_NAME=nvidia $xr/gl_probe 2>&1 | tee -a "$summary"
+  LD_LIBRARY_PATH=$xlibs $xr/gl_probe 2>&1 | tee -a "$summary"
 }
 
-export __GLX_VENDOR_LIBRARY_NAME=nvidia
 if [ -e $xr/validation.done ]; then
   export VK_LAYER_PATH=$xr/validation
 else
   export OPEN3D_VULKAN_VALIDATION=0
 fi
+say "validation: ${OPEN3D_VULKAN_VALIDATION:-on}"
 suites() {
   export LD_LIBRARY_PATH=$PWD/.devlibs OPEN3D_DATA_DIR=$PWD/shared/data
   local name
   for name in tests_filament_rendering tests_visualizer; do
     [ -x ".devbin/$name" ] || { say "$name: not carried"; continue; }
-    timeout 400 ".devbin/$name" --gtest_brief=1 >"$out/$name.log" 2>&1
-    say "$name: exit $? ($(grep -c '^\[  FAILED' "$out/$name.log") failed lines)"
-    grep -E "^\[  (PASSED|FAILED|SKIPPED) |host copies|zero-copy|Vulkan device" "$out/$name.log" |
-      sort | uniq -c | head -20 | tee -a "$summary"
+    timeout 300 ".devbin/$name" --gtest_brief=1 >"$out/$name.log" 2>&1
+    say "$name: exit $?"
+    grep -E "^\[  (PASSED|FAILED|SKIPPED) |^\[==========\]|Splat images|Vulkan device|rror" \
+      "$out/$name.log" | sort | uniq -c | sort -rn | head -12 | cut -c1-400 | tee -a "$summary"
   done
 }
 bench() {
-  export LD_LIBRARY_PATH=$PWD/.devlibs
-  local d=shared/data/playbot size w h sharing backend log
+  export LD_LIBRARY_PATH=$PWD/.devlibs OPEN3D_VULKAN_VALIDATION=0
+  local d=shared/data/playbot size w h sharing log
   [ -x .devbin/gs-render ] || { say "gs-render: not carried"; return; }
   for size in 1920x1080 3840x2160; do
     w=${size%x*} h=${size#*x}
@@ -80,24 +94,24 @@ bench() {
       log=$out/render-$size-$sharing.log
       OPEN3D_SPLAT_SHARING=$sharing timeout 120 .devbin/gs-render -i $d/playbot_125k.ply \
         --cameras $d/cameras.json --view 0 --width "$w" --height "$h" --sphere --frames 100 \
-        -o /tmp/filament-$size.png >"$log" 2>&1
+        -o /tmp/filament-$size-$sharing.png >"$log" 2>&1
       say "gs-render --sphere $size $sharing: exit $?"
-      grep -E "^filament render|^frame time|rror" "$log" | tee -a "$summary"
+      grep -E "^filament render|^frame time|rror" "$log" | cut -c1-400 | tee -a "$summary"
     done
     log=$out/render-$size-placeholder.log
     timeout 120 .devbin/gs-render -i $d/playbot_125k.ply --cameras $d/cameras.json --view 0 \
       --width "$w" --height "$h" --sphere --frames 100 --backend placeholder \
       -o /tmp/filament-mesh-$size.png >"$log" 2>&1
     say "gs-render --sphere $size, meshes only: exit $?"
-    grep -E "^frame time|rror" "$log" | tee -a "$summary"
+    grep -E "^frame time|rror" "$log" | cut -c1-400 | tee -a "$summary"
   done
-  cp /tmp/filament-1920x1080.png "$out/" 2>/dev/null
+  cp /tmp/filament-1920x1080-zero-copy.png "$out/" 2>/dev/null
   [ -x .devbin/gs-bench ] || return
   timeout 120 .devbin/gs-bench -i $d/playbot_125k.ply --cameras $d/cameras.json --views 0 \
     --knobs default --resolution 1920x1080 --resolution 3840x2160 --repeat 50 --warm-up 2 \
     --reference-max-splats 0 >"$out/gs-bench.log" 2>&1
   say "gs-bench, splats alone: exit $?"
-  grep -E "^default |in flight" "$out/gs-bench.log" | tee -a "$summary"
+  grep -E "^default |in flight" "$out/gs-bench.log" | cut -c1-300 | tee -a "$summary"
 }
 case $mode in
   probe) probe ;;

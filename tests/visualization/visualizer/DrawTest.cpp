@@ -33,7 +33,8 @@ std::pair<visualization::VisualizerOptions, visualization::RunOptions> ThreeFram
 }
 
 TEST(DrawFunction, ShowsObjectsForTheRequestedFrames) {
-    const std::string reason = visualization::rendering::FilamentUnavailableReason();
+    const std::string reason = visualization::rendering::FilamentUnavailableReason(
+        visualization::rendering::GlPlatform::kGlx);
     if (!reason.empty()) OPEN3D_SKIP_OR_FAIL_WHEN_UNAVAILABLE(reason);
     std::vector<visualization::DrawObject> objects(2);
     objects[0].name = "splats";
@@ -51,7 +52,8 @@ TEST(DrawFunction, ShowsObjectsForTheRequestedFrames) {
 // A stream among the objects: the viewer streams the paged file (the default scene's) and
 // draws; a path that is no paged file is refused before the loop runs.
 TEST(DrawFunction, StreamsAPagedFile) {
-    const std::string reason = visualization::rendering::FilamentUnavailableReason();
+    const std::string reason = visualization::rendering::FilamentUnavailableReason(
+        visualization::rendering::GlPlatform::kGlx);
     if (!reason.empty()) OPEN3D_SKIP_OR_FAIL_WHEN_UNAVAILABLE(reason);
     const t::geometry::PointCloud scene =
         visualization::rendering::CreateDefaultGaussianSplatScene();

@@ -19,7 +19,7 @@ rendering::FilamentRenderer* VisualizerTest::renderer_ = nullptr;
 std::string VisualizerTest::skip_reason_;
 
 void VisualizerTest::SetUpTestSuite() {
-    skip_reason_ = rendering::FilamentUnavailableReason();
+    skip_reason_ = rendering::FilamentUnavailableReason(rendering::GlPlatform::kGlx);
     if (!skip_reason_.empty()) return;
     rendering::vulkan::RegisterVulkanBackend();
     try {

@@ -40,7 +40,7 @@ t::geometry::Image DropAlpha(const t::geometry::Image& rgba) {
 }  // namespace
 
 Visualizer::Visualizer(const VisualizerOptions& options) {
-    owned_engine_ = std::make_unique<rendering::FilamentEngine>();
+    owned_engine_ = std::make_unique<rendering::FilamentEngine>(rendering::GlPlatform::kGlx);
     owned_renderer_ = std::make_unique<rendering::FilamentRenderer>(*owned_engine_);
     renderer_ = owned_renderer_.get();
     Init(options);

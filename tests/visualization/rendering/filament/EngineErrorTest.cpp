@@ -1,10 +1,13 @@
-// Without an X server Filament 1.9 would print "Failed to open X display" and exit the
-// process; FilamentEngine throws a message that says to run under Xvfb instead.
+// Without an X server Filament 1.9's GLX backend would print "Failed to open X display" and
+// exit the process; FilamentEngine on GLX throws a message that says to run under Xvfb
+// instead, and the automatic platform starts headless on EGL.
 #include <gtest/gtest.h>
 
 #include <cstdlib>
+#include <optional>
 #include <string>
 
+#include "TestUtility.h"
 #include "open3d/core/Exception.h"
 #include "open3d/visualization/rendering/filament/FilamentEngine.h"
 
@@ -12,25 +15,67 @@ namespace open3d {
 namespace tests {
 namespace {
 
-TEST(FilamentEngineError, NoDisplayIsAClearError) {
-    const char* display = std::getenv("DISPLAY");
-    const std::string saved = display ? display : "";
+namespace rendering = visualization::rendering;
+
+// Sets an environment variable for one scope ("" unsets it) and restores it after.
+class ScopedEnv {
+public:
+    ScopedEnv(const char* name, const char* value) : name_(name) {
+        if (const char* old = std::getenv(name)) saved_ = old;
+        if (value[0] == '\0') {
+            unsetenv(name);
+        } else {
+            setenv(name, value, 1);
+        }
+    }
+    ~ScopedEnv() {
+        if (saved_) {
+            setenv(name_, saved_->c_str(), 1);
+        } else {
+            unsetenv(name_);
+        }
+    }
+
+private:
+    const char* name_;
+    std::optional<std::string> saved_;
+};
+
+TEST(FilamentEngineError, NoDisplayIsAClearErrorOnGlx) {
     for (const char* value : {"", ":12345"}) {  // unset, and a display nobody serves
-        setenv("DISPLAY", value, 1);
-        EXPECT_NE(visualization::rendering::FilamentUnavailableReason().find("xvfb-run"),
-                  std::string::npos);
+        ScopedEnv display("DISPLAY", value);
+        EXPECT_NE(
+            rendering::FilamentUnavailableReason(rendering::GlPlatform::kGlx).find("xvfb-run"),
+            std::string::npos);
         try {
-            visualization::rendering::FilamentEngine engine;
+            rendering::FilamentEngine engine(rendering::GlPlatform::kGlx);
             ADD_FAILURE() << "the engine started without an X server";
         } catch (const core::Open3DError& e) {
             EXPECT_NE(std::string(e.what()).find("xvfb-run"), std::string::npos) << e.what();
         }
     }
-    if (display) {
-        setenv("DISPLAY", saved.c_str(), 1);
-    } else {
-        unsetenv("DISPLAY");
-    }
+}
+
+TEST(FilamentEngineError, PlatformVariableIsChecked) {
+    ScopedEnv platform("OPEN3D_FILAMENT_PLATFORM", "wayland");
+    EXPECT_NE(rendering::FilamentUnavailableReason().find("OPEN3D_FILAMENT_PLATFORM"),
+              std::string::npos);
+    EXPECT_THROW(rendering::FilamentEngine engine, core::Open3DError);
+}
+
+TEST(FilamentEngineError, WithoutDisplayTheAutomaticPlatformIsEgl) {
+    ScopedEnv display("DISPLAY", "");
+    ScopedEnv platform("OPEN3D_FILAMENT_PLATFORM", "");
+    EXPECT_EQ(rendering::ResolveGlPlatform(rendering::GlPlatform::kAuto),
+              rendering::GlPlatform::kEgl);
+    const std::string reason = rendering::FilamentUnavailableReason();
+    if (!reason.empty()) OPEN3D_SKIP_OR_FAIL_WHEN_UNAVAILABLE(reason);
+    rendering::FilamentEngine engine;
+    EXPECT_EQ(engine.GetPlatform(), rendering::GlPlatform::kEgl);
+    EXPECT_EQ(engine.GetSharedContextWindow(), nullptr);
+    EXPECT_NE(engine.DescribePlatform().find("EGL"), std::string::npos);
+    // Our context is current and loads the GL entry points (GL_VERSION 4.5 or later).
+    EXPECT_NE(engine.GetGl().Describe().find("4."), std::string::npos) << engine.GetGl().Describe();
 }
 
 }  // namespace

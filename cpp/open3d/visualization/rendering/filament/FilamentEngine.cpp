@@ -16,6 +16,7 @@
 #include "open3d/core/Exception.h"
 #include "open3d/core/Logging.h"
 #include "open3d/core/WaitCallback.h"
+#include "open3d/visualization/rendering/filament/EglPlatform.h"
 
 namespace open3d {
 namespace visualization {
@@ -71,16 +72,66 @@ void ReleaseGlfw() {
     if (--glfw_users == 0) glfwTerminate();
 }
 
+void* GlfwProc(const char* name) { return reinterpret_cast<void*>(glfwGetProcAddress(name)); }
+
 }  // namespace
 
-std::string FilamentUnavailableReason() {
+GlPlatform ResolveGlPlatform(GlPlatform platform) {
+    if (platform != GlPlatform::kAuto) return platform;
+    if (const char* env = std::getenv("OPEN3D_FILAMENT_PLATFORM"); env && env[0] != '\0') {
+        const std::string value = env;
+        if (value == "glx") return GlPlatform::kGlx;
+        if (value == "egl") return GlPlatform::kEgl;
+        if (value != "auto") {
+            core::ThrowError("OPEN3D_FILAMENT_PLATFORM must be auto, glx or egl, got '{}'", value);
+        }
+    }
+    const char* display = std::getenv("DISPLAY");
+    return display != nullptr && display[0] != '\0' ? GlPlatform::kGlx : GlPlatform::kEgl;
+}
+
+std::string FilamentUnavailableReason(GlPlatform platform) {
     std::string why;
+    try {
+        platform = ResolveGlPlatform(platform);
+    } catch (const core::Open3DError& e) {
+        return e.what();
+    }
+    if (platform == GlPlatform::kEgl) {
+        why = EglUnavailableReason();
+        return why.empty() ? why
+                           : fmt::format("{} (without an X server Filament runs on EGL)", why);
+    }
     if (!AcquireGlfw(&why)) return why;
     ReleaseGlfw();
     return {};
 }
 
-FilamentEngine::FilamentEngine() {
+FilamentEngine::FilamentEngine(GlPlatform platform) : platform_(ResolveGlPlatform(platform)) {
+    if (platform_ == GlPlatform::kEgl) {
+        StartEgl();
+    } else {
+        StartGlx();
+    }
+}
+
+void FilamentEngine::StartEgl() {
+    egl_ = std::make_unique<EglContext>();
+    gl_ = GlFunctions::Load(&EglContext::GetProcAddress);
+    filament_platform_ = CreateEglFilamentPlatform(*egl_);
+    engine_ = filament::Engine::create(filament::Engine::Backend::OPENGL, filament_platform_.get(),
+                                       egl_->NativeContext());
+    if (engine_ == nullptr) {
+        core::ThrowError("Filament: Engine::create(OPENGL) on {} failed", egl_->Description());
+    }
+    egl_->MakeCurrent();
+}
+
+std::string FilamentEngine::DescribePlatform() const {
+    return egl_ ? "EGL: " + egl_->Description() : std::string("GLX");
+}
+
+void FilamentEngine::StartGlx() {
     std::string why;
     if (!AcquireGlfw(&why)) core::ThrowError("Filament: {}", why);
     glfwDefaultWindowHints();
@@ -100,7 +151,7 @@ FilamentEngine::FilamentEngine() {
     }
     glfwMakeContextCurrent(window_);
     try {
-        gl_ = GlFunctions::Load();
+        gl_ = GlFunctions::Load(&GlfwProc);
     } catch (...) {
         glfwDestroyWindow(window_);
         ReleaseGlfw();
@@ -119,12 +170,23 @@ FilamentEngine::FilamentEngine() {
 
 FilamentEngine::~FilamentEngine() {
     filament::Engine::destroy(&engine_);
+    filament_platform_.reset();
+    if (egl_) {
+        egl_.reset();
+        return;
+    }
     glfwMakeContextCurrent(nullptr);
     glfwDestroyWindow(window_);
     ReleaseGlfw();
 }
 
-void FilamentEngine::MakeContextCurrent() const { glfwMakeContextCurrent(window_); }
+void FilamentEngine::MakeContextCurrent() const {
+    if (egl_) {
+        egl_->MakeCurrent();
+    } else {
+        glfwMakeContextCurrent(window_);
+    }
+}
 
 void FilamentEngine::FlushAndWait() const {
     if (core::HasWaitCallback()) {

@@ -1,7 +1,5 @@
 #include "open3d/visualization/rendering/filament/GlFunctions.h"
 
-#include <GLFW/glfw3.h>
-
 #include <cstring>
 
 #include "open3d/core/Exception.h"
@@ -13,14 +11,14 @@ namespace rendering {
 namespace {
 
 template <typename T>
-void LoadProc(T& pointer, const char* name) {
-    pointer = reinterpret_cast<T>(glfwGetProcAddress(name));
+void LoadProc(GlFunctions::ProcLoader get, T& pointer, const char* name) {
+    pointer = reinterpret_cast<T>(get(name));
 }
 
 // A core 4.5 entry point: missing means the context is too old.
 template <typename T>
-void LoadRequired(T& pointer, const char* name) {
-    LoadProc(pointer, name);
+void LoadRequired(GlFunctions::ProcLoader get, T& pointer, const char* name) {
+    LoadProc(get, pointer, name);
     if (pointer == nullptr) {
         core::ThrowError("OpenGL: the context lacks {} (need OpenGL 4.5 core)", name);
     }
@@ -28,29 +26,26 @@ void LoadRequired(T& pointer, const char* name) {
 
 }  // namespace
 
-GlFunctions GlFunctions::Load() {
-    if (glfwGetCurrentContext() == nullptr) {
-        core::ThrowError("OpenGL: no current context to load entry points from");
-    }
+GlFunctions GlFunctions::Load(ProcLoader get) {
     GlFunctions gl;
-    LoadRequired(gl.GetStringi, "glGetStringi");
-    LoadRequired(gl.GetString, "glGetString");
-    LoadRequired(gl.GetIntegerv, "glGetIntegerv");
-    LoadRequired(gl.GetError, "glGetError");
-    LoadRequired(gl.Finish, "glFinish");
-    LoadRequired(gl.CreateTextures, "glCreateTextures");
-    LoadRequired(gl.DeleteTextures, "glDeleteTextures");
-    LoadRequired(gl.TextureStorage2D, "glTextureStorage2D");
-    LoadRequired(gl.TextureSubImage2D, "glTextureSubImage2D");
-    LoadRequired(gl.GetTextureImage, "glGetTextureImage");
-    LoadRequired(gl.PixelStorei, "glPixelStorei");
-    LoadProc(gl.CreateMemoryObjectsEXT, "glCreateMemoryObjectsEXT");
-    LoadProc(gl.DeleteMemoryObjectsEXT, "glDeleteMemoryObjectsEXT");
-    LoadProc(gl.MemoryObjectParameterivEXT, "glMemoryObjectParameterivEXT");
-    LoadProc(gl.ImportMemoryFdEXT, "glImportMemoryFdEXT");
-    LoadProc(gl.TextureStorageMem2DEXT, "glTextureStorageMem2DEXT");
-    LoadProc(gl.GetUnsignedBytevEXT, "glGetUnsignedBytevEXT");
-    LoadProc(gl.GetUnsignedBytei_vEXT, "glGetUnsignedBytei_vEXT");
+    LoadRequired(get, gl.GetStringi, "glGetStringi");
+    LoadRequired(get, gl.GetString, "glGetString");
+    LoadRequired(get, gl.GetIntegerv, "glGetIntegerv");
+    LoadRequired(get, gl.GetError, "glGetError");
+    LoadRequired(get, gl.Finish, "glFinish");
+    LoadRequired(get, gl.CreateTextures, "glCreateTextures");
+    LoadRequired(get, gl.DeleteTextures, "glDeleteTextures");
+    LoadRequired(get, gl.TextureStorage2D, "glTextureStorage2D");
+    LoadRequired(get, gl.TextureSubImage2D, "glTextureSubImage2D");
+    LoadRequired(get, gl.GetTextureImage, "glGetTextureImage");
+    LoadRequired(get, gl.PixelStorei, "glPixelStorei");
+    LoadProc(get, gl.CreateMemoryObjectsEXT, "glCreateMemoryObjectsEXT");
+    LoadProc(get, gl.DeleteMemoryObjectsEXT, "glDeleteMemoryObjectsEXT");
+    LoadProc(get, gl.MemoryObjectParameterivEXT, "glMemoryObjectParameterivEXT");
+    LoadProc(get, gl.ImportMemoryFdEXT, "glImportMemoryFdEXT");
+    LoadProc(get, gl.TextureStorageMem2DEXT, "glTextureStorageMem2DEXT");
+    LoadProc(get, gl.GetUnsignedBytevEXT, "glGetUnsignedBytevEXT");
+    LoadProc(get, gl.GetUnsignedBytei_vEXT, "glGetUnsignedBytei_vEXT");
     return gl;
 }
 

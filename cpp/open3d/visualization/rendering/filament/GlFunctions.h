@@ -1,6 +1,7 @@
 // The few OpenGL 4.5 entry points the Filament layer calls itself (texture creation, memory
-// objects of GL_EXT_memory_object_fd, host copies), loaded through GLFW from the context
-// that is current on the calling thread. Filament keeps its own loader for its own context.
+// objects of GL_EXT_memory_object_fd, host copies), loaded through GLFW (GLX) or EGL from
+// the context that is current on the calling thread. Filament keeps its own loader for its own
+// context.
 #pragma once
 
 #define GLFW_INCLUDE_NONE
@@ -37,9 +38,12 @@ struct GlFunctions {
     PFNGLGETUNSIGNEDBYTEVEXTPROC GetUnsignedBytevEXT = nullptr;
     PFNGLGETUNSIGNEDBYTEI_VEXTPROC GetUnsignedBytei_vEXT = nullptr;
 
-    /// Loads every pointer from the current context. Throws core::Open3DError when a core
-    /// 4.5 entry point is missing (the extension ones may stay null).
-    static GlFunctions Load();
+    /// glfwGetProcAddress or eglGetProcAddress.
+    using ProcLoader = void* (*)(const char* name);
+    /// Loads every pointer from the context current on this thread through `get`. Throws
+    /// core::Open3DError when a core 4.5 entry point is missing (the extension ones may stay
+    /// null).
+    static GlFunctions Load(ProcLoader get);
 
     /// "GL_VENDOR GL_RENDERER, GL_VERSION" of the current context, for log lines.
     std::string Describe() const;
