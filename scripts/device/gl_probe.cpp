@@ -29,16 +29,16 @@ int main() {
         return 1;
     }
     glfwMakeContextCurrent(window);
-    auto get_string = reinterpret_cast<const unsigned char* (*)(unsigned)>(
-        glfwGetProcAddress("glGetString"));
+    auto get_string =
+        reinterpret_cast<const unsigned char* (*)(unsigned)>(glfwGetProcAddress("glGetString"));
     auto get_stringi = reinterpret_cast<GetStringi>(glfwGetProcAddress("glGetStringi"));
     auto get_integerv = reinterpret_cast<GetIntegerv>(glfwGetProcAddress("glGetIntegerv"));
     std::printf("GL_VENDOR   %s\nGL_RENDERER %s\nGL_VERSION  %s\n", get_string(0x1F00),
                 get_string(0x1F01), get_string(0x1F02));
     int count = 0;
     get_integerv(0x821D /* GL_NUM_EXTENSIONS */, &count);
-    const char* wanted[] = {"GL_EXT_memory_object", "GL_EXT_memory_object_fd",
-                            "GL_EXT_semaphore", "GL_EXT_semaphore_fd"};
+    const char* wanted[] = {"GL_EXT_memory_object", "GL_EXT_memory_object_fd", "GL_EXT_semaphore",
+                            "GL_EXT_semaphore_fd"};
     for (const char* name : wanted) {
         bool found = false;
         for (int i = 0; i < count && !found; ++i) {
@@ -46,7 +46,8 @@ int main() {
         }
         std::printf("%-24s %s\n", name, found ? "yes" : "no");
     }
-    auto get_uuid = reinterpret_cast<GetUnsignedBytei>(glfwGetProcAddress("glGetUnsignedBytei_vEXT"));
+    auto get_uuid =
+        reinterpret_cast<GetUnsignedBytei>(glfwGetProcAddress("glGetUnsignedBytei_vEXT"));
     auto get_uuid0 = reinterpret_cast<void (*)(unsigned, unsigned char*)>(
         glfwGetProcAddress("glGetUnsignedBytevEXT"));
     if (get_uuid && get_uuid0) {
