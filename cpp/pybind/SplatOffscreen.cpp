@@ -40,8 +40,9 @@ SplatOffscreen::SplatOffscreen(int width, int height, const std::string& backend
             std::make_unique<visualization::rendering::OffscreenRenderer>(width, height, options);
     } catch (const core::Open3DError& e) {
         core::ThrowError(
-            "OffscreenRenderer(meshes=True) draws with Filament, which needs an X server "
-            "(splats alone need none: leave meshes off): {}",
+            "OffscreenRenderer(meshes=True) draws with Filament, which needs an X server or, "
+            "headless, an EGL display with OpenGL 4.5 (splats alone need neither: leave "
+            "meshes off): {}",
             e.what());
     }
 }
@@ -78,7 +79,7 @@ void SplatOffscreen::AddMesh(const std::string& name, const t::geometry::Triangl
     if (!filament_) {
         core::ThrowError(
             "OffscreenRenderer: mesh '{}': meshes are drawn by Filament; create the renderer "
-            "with meshes=True (needs an X server)",
+            "with meshes=True (Filament: an X server, or EGL without one)",
             name);
     }
     filament_->GetScene()->AddGeometry(name, mesh, material);

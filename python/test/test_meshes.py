@@ -86,12 +86,44 @@ def test_meshes_need_meshes_true():
 
 
 def test_without_a_display_the_error_says_so():
+    # GLX asked for without an X server: the error names both ways out.
     env = {k: v for k, v in os.environ.items() if k != "DISPLAY"}
+    env["OPEN3D_FILAMENT_PLATFORM"] = "glx"
     code = ("import open3d_gs as o3d\n"
             "try:\n    o3d.visualization.rendering.OffscreenRenderer(8, 8, 'cpu', meshes=True)\n"
             "except o3d.Open3DError as e:\n    print(e)\n")
     out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, timeout=120)
     assert "needs an X server" in out.stdout and "xvfb-run" in out.stdout, out.stdout + out.stderr
+
+
+def test_without_a_display_meshes_draw_headless_on_egl():
+    # No DISPLAY: Filament runs on EGL. test_a_mesh_in_front_of_splats's scene and checks in a
+    # process without an X server.
+    env = {k: v for k, v in os.environ.items() if k not in ("DISPLAY", "OPEN3D_FILAMENT_PLATFORM")}
+    env["PYTHONPATH"] = os.pathsep.join(sys.path)
+    code = (f"import sys; sys.path.insert(0, {os.path.dirname(__file__)!r})\n"
+            "import numpy as np, open3d_gs as o3d, test_meshes as t\n"
+            "r = o3d.visualization.rendering.OffscreenRenderer(160, 120, 'cpu', meshes=True)\n"
+            "r.scene.add_geometry('wall', t.wall())\n"
+            "sphere = o3d.t.geometry.TriangleMesh.create_sphere(0.5, 40)\n"
+            "sphere.translate([0, 0, 2])\n"
+            "red = o3d.visualization.rendering.MaterialRecord()\n"
+            "red.base_color = [1, 0, 0, 1]\n"
+            "r.scene.add_geometry('sphere', sphere, red)\n"
+            "fy = 60 / np.tan(np.radians(30))\n"
+            "r.setup_camera(o3d.camera.PinholeCamera(160, 120, fy, fy, 79.5, 59.5))\n"
+            "image = r.render_to_image().astype(int)\n"
+            "depth = r.render_to_depth_image()\n"
+            "print('centre', *image[60, 80], 'beside', *image[60, 40], 'depth', depth[60, 80])\n")
+    out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, timeout=300)
+    assert out.returncode == 0, out.stdout + out.stderr
+    words = out.stdout.split()
+    centre = [int(v) for v in words[words.index("centre") + 1:][:3]]
+    beside = [int(v) for v in words[words.index("beside") + 1:][:3]]
+    depth = float(words[words.index("depth") + 1])
+    assert centre[0] > 200 and centre[1] < 10 and centre[2] < 10, out.stdout  # the sphere
+    assert beside[2] > beside[0] + 50, out.stdout  # the blue wall around it
+    assert abs(depth - 1.5) < 0.01, out.stdout  # as test_a_mesh_in_front_of_splats
 
 
 def test_mesh_arrays():
