@@ -13,6 +13,7 @@
 #include <cstring>
 
 #include "open3d/core/Exception.h"
+#include "open3d/core/ParallelFor.h"
 #include "open3d/core/Timer.h"
 #include "open3d/core/WaitCallback.h"
 #include "open3d/visualization/rendering/filament/FilamentEngine.h"
@@ -30,18 +31,25 @@ using Clock = std::chrono::steady_clock;
 
 // Host "over" of the premultiplied splat colour (float, top row first) on the mesh
 // colour (RGBA8, top row first); out = round(255 * (s + (1 - s_a) * m)).
+// Rows in parallel: at 1080p and above the blend is most of an offscreen frame's host time.
 t::geometry::Image BlendOver(const t::geometry::Image* splats, const std::vector<uint8_t>& mesh,
                              int64_t h, int64_t w) {
     t::geometry::Image out(h, w, 4, core::Dtype::UInt8);
     uint8_t* o = out.Data<uint8_t>();
     const float* s = splats ? splats->Data<float>() : nullptr;
-    for (int64_t i = 0; i < h * w * 4; i += 4) {
-        const float transmit = s ? 1.0f - s[i + 3] : 1.0f;
-        for (int c = 0; c < 4; ++c) {
-            const float v = (s ? s[i + c] : 0.0f) + transmit * (mesh[i + c] / 255.0f);
-            o[i + c] = static_cast<uint8_t>(std::lround(std::clamp(v, 0.0f, 1.0f) * 255.0f));
-        }
-    }
+    core::ParallelForRange(
+        h,
+        [&](int64_t row_begin, int64_t row_end) {
+            for (int64_t i = row_begin * w * 4; i < row_end * w * 4; i += 4) {
+                const float transmit = s ? 1.0f - s[i + 3] : 1.0f;
+                for (int c = 0; c < 4; ++c) {
+                    const float v = (s ? s[i + c] : 0.0f) + transmit * (mesh[i + c] / 255.0f);
+                    o[i + c] =
+                        static_cast<uint8_t>(std::lround(std::clamp(v, 0.0f, 1.0f) * 255.0f));
+                }
+            }
+        },
+        64);
     return out;
 }
 

@@ -6,6 +6,7 @@
 #include <cstring>
 
 #include "open3d/core/Exception.h"
+#include "open3d/core/ParallelFor.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/GaussianSplatVulkanBackend.h"
 
 namespace open3d {
@@ -224,7 +225,12 @@ public:
             out_.color = t::geometry::Image(h, w, 4, core::Dtype::Float32);
             const auto* halves = static_cast<const uint16_t*>(targets_.color_readback.GetMapped());
             float* dst = out_.color.Data<float>();
-            for (size_t i = 0; i < pixels * 4; ++i) dst[i] = HalfToFloat(halves[i]);
+            core::ParallelForRange(
+                int64_t(pixels) * 4,
+                [&](int64_t begin, int64_t end) {
+                    for (int64_t i = begin; i < end; ++i) dst[i] = HalfToFloat(halves[i]);
+                },
+                int64_t(1) << 18);
         }
         if (request_.read_depth) {
             out_.linear_depth = t::geometry::Image(h, w, 1, core::Dtype::Float32);
