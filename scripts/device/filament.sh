@@ -93,14 +93,14 @@ bench() {
     for sharing in zero-copy host-copy; do
       log=$out/render-$size-$sharing.log
       OPEN3D_SPLAT_SHARING=$sharing timeout 120 .devbin/gs-render -i $d/playbot_125k.ply \
-        --cameras $d/cameras.json --view 0 --width "$w" --height "$h" --sphere --frames 100 \
+        --cameras $d/cameras.json --view 0 --width "$w" --height "$h" --sphere --frames 60 \
         -o /tmp/filament-$size-$sharing.png >"$log" 2>&1
       say "gs-render --sphere $size $sharing: exit $?"
       grep -E "^filament render|^frame time|rror" "$log" | cut -c1-400 | tee -a "$summary"
     done
     log=$out/render-$size-placeholder.log
     timeout 120 .devbin/gs-render -i $d/playbot_125k.ply --cameras $d/cameras.json --view 0 \
-      --width "$w" --height "$h" --sphere --frames 100 --backend placeholder \
+      --width "$w" --height "$h" --sphere --frames 60 --backend placeholder \
       -o /tmp/filament-mesh-$size.png >"$log" 2>&1
     say "gs-render --sphere $size, meshes only: exit $?"
     grep -E "^frame time|rror" "$log" | cut -c1-400 | tee -a "$summary"
@@ -108,7 +108,7 @@ bench() {
   cp /tmp/filament-1920x1080-zero-copy.png "$out/" 2>/dev/null
   [ -x .devbin/gs-bench ] || return
   timeout 120 .devbin/gs-bench -i $d/playbot_125k.ply --cameras $d/cameras.json --views 0 \
-    --knobs default --resolution 1920x1080 --resolution 3840x2160 --repeat 50 --warm-up 2 \
+    --knobs default --resolution 1920x1080 --resolution 3840x2160 --repeat 30 --warm-up 1 \
     --reference-max-splats 0 >"$out/gs-bench.log" 2>&1
   say "gs-bench, splats alone: exit $?"
   grep -E "^default |in flight" "$out/gs-bench.log" | cut -c1-300 | tee -a "$summary"
