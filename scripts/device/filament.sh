@@ -13,7 +13,7 @@
 # the rest within the warm period with OPEN3D_FILAMENT_PLATFORM=glx before the command.
 # Everything is logged under OUT; the last lines printed are a summary.
 set -uo pipefail
-out=${1:?usage: bash scripts/device/filament.sh OUT probe|suites|bench|all}
+out=${1:?usage: bash scripts/device/filament.sh OUT probe|suites|bench|all|quick}
 mode=${2:-all}
 mkdir -p "$out"
 summary=$out/summary.txt
@@ -75,7 +75,7 @@ suites() {
   local name
   for name in tests_filament_rendering tests_visualizer; do
     [ -x ".devbin/$name" ] || { say "$name: not carried"; continue; }
-    timeout 300 ".devbin/$name" --gtest_brief=1 >"$out/$name.log" 2>&1
+    timeout "${SUITE_TIMEOUT:-300}" ".devbin/$name" --gtest_brief=1 >"$out/$name.log" 2>&1
     say "$name: exit $?"
     grep -E "^\[  (PASSED|FAILED|SKIPPED) |^\[==========\]|Splat images|Vulkan device|rror" \
       "$out/$name.log" | sort | uniq -c | sort -rn | head -12 | cut -c1-400 | tee -a "$summary"
@@ -118,6 +118,7 @@ case $mode in
   suites) suites ;;
   bench) bench ;;
   all) probe; suites; bench ;;
+  quick) SUITE_TIMEOUT=90 suites; bench ;;  # a short lease: each suite stops after 90 s
   *) echo "unknown mode $mode"; exit 2 ;;
 esac
 nvidia-smi --query-gpu=clocks.sm --format=csv,noheader | tee -a "$out/gpu.txt"
