@@ -2,7 +2,7 @@
 # README command 1: builds what is needed, then shows the built-in default scene (SH degree
 # 3, anisotropic, semi-transparent splats) with a red sphere composited depth-aware through
 # Filament: in the interactive viewer when a display is available, otherwise rendered to a
-# PNG with gs-render under xvfb-run (and it says so).
+# PNG with gs-render, headless on EGL (and it says so).
 # Any arguments are passed to gs-render instead (try: scripts/run.sh --help).
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -24,7 +24,5 @@ if [ $# -eq 0 ]; then
   set -- --sphere --output "$build_dir/default_scene.png" --depth-output "$build_dir/default_scene_depth.png"
 fi
 echo "run.sh: rendering: gs-render $*"
-if [ -z "${DISPLAY:-}" ] && command -v xvfb-run >/dev/null; then
-  exec xvfb-run -a -s "-screen 0 1280x1024x24" "$build_dir/bin/gs-render" "$@"
-fi
+# Without a display Filament runs headless on EGL (docs/filament.md).
 exec "$build_dir/bin/gs-render" "$@"

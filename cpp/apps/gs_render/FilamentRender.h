@@ -32,7 +32,7 @@ struct FilamentImages {
 };
 
 /// Renders the images; prints the frame time split into geometry stage, Filament, composite
-/// stage and readback. Throws core::Open3DError (e.g. no X server: run under xvfb-run).
+/// stage and readback. Throws core::Open3DError (e.g. GLX asked for without an X server).
 FilamentImages RenderWithFilament(const open3d::t::geometry::PointCloud& cloud,
                                   const open3d::camera::PinholeCamera& camera,
                                   const open3d::visualization::rendering::RenderConfig& config,

@@ -300,7 +300,8 @@ int main(int argc, char** argv) {
         "--up, --fov) optionally orbited about --up through --center (--orbit-angle); look-at\n"
         "flags given with --cameras edit that view. Without either, the scene is framed from -z.\n"
         "--sphere or --filament render through Filament (meshes and splats composited with the\n"
-        "depth test; needs an X server: run under xvfb-run -a on machines without a display).",
+        "depth test): on the X server of DISPLAY, else headless on EGL\n"
+        "(OPEN3D_FILAMENT_PLATFORM=glx|egl chooses).",
         "gs-render"};
     app.add_option("-i,--input", opt.input,
                    "Scene file in any format gs-convert reads (docs/formats.md)")
