@@ -36,6 +36,8 @@ OPEN3D_SHADER_CONST uint kCompositeBlocks = kCompositeBlocksX * kCompositeBlocks
 OPEN3D_SHADER_CONST uint kCompositeMaxSubgroups = kCompositeWorkgroupSize / 8u;
 // The depth merge runs 16x16 pixels per workgroup.
 OPEN3D_SHADER_CONST uint kDepthMergeWorkgroupSize = 16u;
+// So does the blend over the mesh colour.
+OPEN3D_SHADER_CONST uint kBlendOverWorkgroupSize = 16u;
 
 // The 3DGS blending thresholds as float32 (docs/DESIGN.md section 3; == cpu::kMaxAlpha etc.).
 OPEN3D_SHADER_CONST float kCompositeMaxAlpha = 0.99f;
@@ -118,6 +120,12 @@ OPEN3D_SHADER_CONST uint kDepthMergeNormalizedBinding = 3u;  // uimage2D r16ui
 OPEN3D_SHADER_CONST uint kDepthMergeLinearBinding = 4u;      // image2D r32f: merged view z
 OPEN3D_SHADER_CONST uint kDepthMergeNumBindings = 5u;
 
+// Descriptor set 0 of the blend over the mesh colour (push descriptors).
+OPEN3D_SHADER_CONST uint kBlendOverSplatColorBinding = 0u;  // image2D rgba16f: premultiplied
+OPEN3D_SHADER_CONST uint kBlendOverMeshColorBinding = 1u;   // texture2D: RGBA8 unorm mesh colour
+OPEN3D_SHADER_CONST uint kBlendOverOutputBinding = 2u;      // uint[W * H]: RGBA8, top row first
+OPEN3D_SHADER_CONST uint kBlendOverNumBindings = 3u;
+
 // Work-stealing state of one composite dispatch (std430): zeroed by the recorder
 // (vkCmdFillBuffer) before every dispatch; each workgroup claims tiles with atomicAdd.
 struct GaussianCompositeState {
@@ -149,6 +157,13 @@ struct GaussianDepthMergePushConstants {
     float near_plane, far_plane;  // range of the normalisation
     float scene_near;             // as in GaussianCompositePushConstants
     float min_alpha;              // min splat alpha for the splat depth to count
+};
+
+// Push constants of the blend over the mesh colour.
+struct GaussianBlendOverPushConstants {
+    uint width, height;
+    uint mesh_flip_y;  // 1: the mesh colour's row 0 is the bottom row (GL)
+    uint reserved0;
 };
 
 #ifdef __cplusplus
@@ -184,6 +199,11 @@ static_assert(offsetof(GaussianDepthMergePushConstants, near_plane) == 16);
 static_assert(offsetof(GaussianDepthMergePushConstants, far_plane) == 20);
 static_assert(offsetof(GaussianDepthMergePushConstants, scene_near) == 24);
 static_assert(offsetof(GaussianDepthMergePushConstants, min_alpha) == 28);
+
+static_assert(sizeof(GaussianBlendOverPushConstants) == 16);
+static_assert(offsetof(GaussianBlendOverPushConstants, width) == 0);
+static_assert(offsetof(GaussianBlendOverPushConstants, height) == 4);
+static_assert(offsetof(GaussianBlendOverPushConstants, mesh_flip_y) == 8);
 
 }  // namespace shader
 }  // namespace rendering

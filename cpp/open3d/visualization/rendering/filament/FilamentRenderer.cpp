@@ -156,8 +156,12 @@ FrameResult FilamentRenderer::Draw(FilamentView& view, const FrameRequest& reque
     clear.discard = true;
     renderer_->setClearOptions(clear);
     renderer_->renderStandaloneView(view.GetMeshView());
+    // Zero-copy: the splats are blended over the mesh colour on the GPU, which reads
+    // Filament's colour attachment itself; otherwise the host reads it and blends.
+    SplatTargets& targets = *view.GetSplatTargets();
+    const bool gpu_blend = request.read_color && result.splats_drawn && targets.IsZeroCopy();
     std::vector<uint8_t> mesh_rgba;
-    if (request.read_color) {
+    if (request.read_color && !gpu_blend) {
         // Filament writes straight into this buffer; it is complete after flushAndWait.
         mesh_rgba.resize(size_t(w) * h * 4);
         renderer_->readPixels(
@@ -189,12 +193,12 @@ FrameResult FilamentRenderer::Draw(FilamentView& view, const FrameRequest& reque
 
     t = Clock::now();
     SplatFrame splats;
-    SplatTargets& targets = *view.GetSplatTargets();
     if (result.splats_drawn) {
         SplatCompositeRequest composite;
         composite.use_scene_depth = result.scene_depth_used;
         composite.scene_near = static_cast<float>(view.GetMeshNearPlane());
-        composite.read_color = request.read_color;
+        composite.read_color = request.read_color && !gpu_blend;
+        composite.blend_over_mesh = gpu_blend;
         composite.read_depth = request.read_depth;
         composite.depth_near = request.depth_near;
         composite.depth_far = request.depth_far;
@@ -212,7 +216,9 @@ FrameResult FilamentRenderer::Draw(FilamentView& view, const FrameRequest& reque
     result.times.composite_stage_ms = core::MillisecondsSince(t);
 
     view.SetOverlayVisible(result.splats_drawn);
-    if (request.read_color) {
+    if (gpu_blend) {
+        result.color = std::move(splats.blended);
+    } else if (request.read_color) {
         t = Clock::now();
         result.color = BlendOver(result.splats_drawn ? &splats.color : nullptr, mesh_rgba, h, w);
         result.times.readback_ms = core::MillisecondsSince(t);

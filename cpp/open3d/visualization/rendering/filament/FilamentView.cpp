@@ -120,7 +120,10 @@ void FilamentView::ReleaseTargets() {
     // Nothing may point at the textures when they go: detach, then destroy.
     mesh_view_->setRenderTarget(nullptr);
     e.destroy(mesh_target_);
-    e.destroy(mesh_color_);
+    // A zero-copy mesh colour belongs to the splat targets.
+    if (!splat_targets_ || mesh_color_ != splat_targets_->GetMeshColorTexture()) {
+        e.destroy(mesh_color_);
+    }
     mesh_target_ = nullptr;
     mesh_color_ = nullptr;
     splat_targets_.reset();  // flushes the engine before freeing the GL and Vulkan images
@@ -138,15 +141,20 @@ void FilamentView::PrepareTargets(FilamentScene& scene) {
         splat_targets_ =
             std::make_unique<SplatTargets>(engine_, scene.GetBackend(), w, h, sharing_);
         targets_backend_ = &scene.GetBackend();
-        mesh_color_ = filament::Texture::Builder()
-                          .width(w)
-                          .height(h)
-                          .levels(1)
-                          .sampler(filament::Texture::Sampler::SAMPLER_2D)
-                          .format(filament::Texture::InternalFormat::RGBA8)
-                          .usage(filament::Texture::Usage::COLOR_ATTACHMENT |
-                                 filament::Texture::Usage::SAMPLEABLE)
-                          .build(e);
+        // Zero-copy: Filament draws the mesh colour into Vulkan memory, which the blend over
+        // it reads (FilamentRenderer::Draw, offscreen).
+        mesh_color_ = splat_targets_->GetMeshColorTexture();
+        if (mesh_color_ == nullptr) {
+            mesh_color_ = filament::Texture::Builder()
+                              .width(w)
+                              .height(h)
+                              .levels(1)
+                              .sampler(filament::Texture::Sampler::SAMPLER_2D)
+                              .format(filament::Texture::InternalFormat::RGBA8)
+                              .usage(filament::Texture::Usage::COLOR_ATTACHMENT |
+                                     filament::Texture::Usage::SAMPLEABLE)
+                              .build(e);
+        }
         mesh_target_ = filament::RenderTarget::Builder()
                            .texture(filament::RenderTarget::AttachmentPoint::COLOR, mesh_color_)
                            .texture(filament::RenderTarget::AttachmentPoint::DEPTH,

@@ -97,12 +97,12 @@ SplatTargets::SplatTargets(FilamentEngine& engine, GaussianSplatBackend& backend
 void SplatTargets::CreateZeroCopy(GaussianSplatBackend& backend) {
     interop_ = std::make_unique<vulkan::InteropTargets>(backend, width_, height_);
     const GlFunctions& gl = engine_.GetGl();
-    const vulkan::ExportedImageMemory exports[2] = {interop_->ExportColor(),
-                                                    interop_->ExportDepth()};
-    const GLenum formats[2] = {GL_RGBA16F, GL_DEPTH_COMPONENT32F};
-    uint32_t* names[2] = {&gl_color_, &gl_depth_};
-    gl.CreateMemoryObjectsEXT(2, gl_memory_);
-    for (int i = 0; i < 2; ++i) {
+    const vulkan::ExportedImageMemory exports[3] = {
+        interop_->ExportColor(), interop_->ExportDepth(), interop_->ExportMeshColor()};
+    const GLenum formats[3] = {GL_RGBA16F, GL_DEPTH_COMPONENT32F, GL_RGBA8};
+    uint32_t* names[3] = {&gl_color_, &gl_depth_, &gl_mesh_color_};
+    gl.CreateMemoryObjectsEXT(3, gl_memory_);
+    for (int i = 0; i < 3; ++i) {
         const GLint dedicated = exports[i].dedicated ? GL_TRUE : GL_FALSE;
         gl.MemoryObjectParameterivEXT(gl_memory_[i], GL_DEDICATED_MEMORY_OBJECT_EXT, &dedicated);
         // GL owns the descriptor after a successful import.
@@ -116,6 +116,10 @@ void SplatTargets::CreateZeroCopy(GaussianSplatBackend& backend) {
     // Filament's context must see complete objects.
     gl.Finish();
     ImportIntoFilament();
+    mesh_color_texture_ = ImportTexture(
+        engine_.GetEngine(), gl_mesh_color_, width_, height_,
+        filament::Texture::InternalFormat::RGBA8,
+        filament::Texture::Usage::COLOR_ATTACHMENT | filament::Texture::Usage::SAMPLEABLE);
 }
 
 void SplatTargets::CreateHostCopy() {
@@ -145,14 +149,15 @@ SplatTargets::~SplatTargets() {
     filament::Engine& e = engine_.GetEngine();
     e.destroy(color_texture_);
     e.destroy(depth_texture_);
+    if (mesh_color_texture_ != nullptr) e.destroy(mesh_color_texture_);
     // Filament deletes imported textures lazily on its thread; the GL names and memory
     // must outlive that.
     e.flushAndWait();
     engine_.MakeContextCurrent();
     const GlFunctions& gl = engine_.GetGl();
-    const GLuint names[2] = {gl_color_, gl_depth_};
-    gl.DeleteTextures(2, names);
-    if (gl_memory_[0] != 0) gl.DeleteMemoryObjectsEXT(2, gl_memory_);
+    const GLuint names[3] = {gl_color_, gl_depth_, gl_mesh_color_};
+    gl.DeleteTextures(gl_mesh_color_ != 0 ? 3 : 2, names);
+    if (gl_memory_[0] != 0) gl.DeleteMemoryObjectsEXT(3, gl_memory_);
     gl.Finish();
     interop_.reset();
 }
@@ -167,12 +172,14 @@ void SplatTargets::Composite(GaussianSplatBackend& backend, const SplatComposite
     vk.use_scene_depth = request.use_scene_depth;
     vk.scene_near = request.scene_near;
     vk.read_color = request.read_color;
+    vk.blend_over_mesh = request.blend_over_mesh;
     vk.read_depth = request.read_depth;
     vk.depth_near = request.depth_near;
     vk.depth_far = request.depth_far;
     vulkan::InteropFrame out;
     vulkan::RenderCompositeToInterop(backend, *interop_, vk, out);
     frame.color = std::move(out.color);
+    frame.blended = std::move(out.blended);
     frame.linear_depth = std::move(out.linear_depth);
     frame.normalized_depth = std::move(out.normalized_depth);
     frame.stats = out.stats;
@@ -180,6 +187,9 @@ void SplatTargets::Composite(GaussianSplatBackend& backend, const SplatComposite
 
 void SplatTargets::CompositeHostCopy(GaussianSplatBackend& backend,
                                      const SplatCompositeRequest& request, SplatFrame& frame) {
+    if (request.blend_over_mesh) {
+        core::ThrowError("splat targets: the blend over the mesh colour needs zero-copy images");
+    }
     engine_.MakeContextCurrent();
     const GlFunctions& gl = engine_.GetGl();
     t::geometry::Image scene_z;

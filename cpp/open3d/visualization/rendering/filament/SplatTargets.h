@@ -50,6 +50,9 @@ struct SplatCompositeRequest {
     /// Near plane of the mesh view's projection: z_view = scene_near / d.
     float scene_near = 0.1f;
     bool read_color = false;  ///< fill SplatFrame::color
+    /// Fill SplatFrame::blended on the GPU (zero-copy targets only): the splats over the
+    /// mesh view's colour, which Filament drew into GetMeshColorTexture().
+    bool blend_over_mesh = false;
     bool read_depth = false;  ///< fill SplatFrame::linear_depth / normalized_depth
     float depth_near = 0.2f;  ///< normalisation of normalized_depth
     float depth_far = 100.0f;
@@ -57,6 +60,7 @@ struct SplatCompositeRequest {
 
 struct SplatFrame {
     t::geometry::Image color;             ///< Float32 [H, W, 4] premultiplied, top row first
+    t::geometry::Image blended;           ///< UInt8 [H, W, 4] splats over mesh, top row first
     t::geometry::Image linear_depth;      ///< Float32 [H, W, 1] merged view z, 0 = nothing
     t::geometry::Image normalized_depth;  ///< UInt16 [H, W, 1], 65535 = nothing
     RenderStats stats;
@@ -82,6 +86,11 @@ public:
     filament::Texture* GetColorTexture() const { return color_texture_; }
     /// DEPTH32F, the mesh view's depth attachment (Filament writes reversed-Z).
     filament::Texture* GetDepthTexture() const { return depth_texture_; }
+    /// RGBA8, for the mesh view's colour attachment (zero-copy only, else null): Vulkan reads
+    /// it for the blend over the mesh colour.
+    filament::Texture* GetMeshColorTexture() const { return mesh_color_texture_; }
+    /// Its GL texture name (0 without zero-copy), for tests that read it from GL.
+    uint32_t GetMeshColorGlName() const { return gl_mesh_color_; }
 
     /// Composite stage of the backend's last geometry stage into the colour image, after Filament
     /// drew the mesh view and finished (flushAndWait).
@@ -105,10 +114,11 @@ private:
     uint32_t width_ = 0;
     uint32_t height_ = 0;
     std::unique_ptr<vulkan::InteropTargets> interop_;
-    uint32_t gl_color_ = 0, gl_depth_ = 0;  // GL texture names
-    uint32_t gl_memory_[2] = {0, 0};        // GL memory objects (zero-copy only)
+    uint32_t gl_color_ = 0, gl_depth_ = 0, gl_mesh_color_ = 0;  // GL texture names
+    uint32_t gl_memory_[3] = {0, 0, 0};  // GL memory objects (zero-copy only)
     filament::Texture* color_texture_ = nullptr;
     filament::Texture* depth_texture_ = nullptr;
+    filament::Texture* mesh_color_texture_ = nullptr;  // zero-copy only
 };
 
 /// The host-side depth merge (the GPU depth merge's rule, for the host-copy path): per pixel

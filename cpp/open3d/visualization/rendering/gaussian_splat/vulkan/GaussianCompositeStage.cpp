@@ -130,6 +130,12 @@ GaussianCompositeStage::GaussianCompositeStage(const VulkanContext& context) : c
     merge_set_layout_ = CreatePushLayout(context, merge);
     merge_layout_ = CreatePipelineLayout(context, merge_set_layout_.Get(),
                                          sizeof(GaussianDepthMergePushConstants));
+    std::vector<VkDescriptorType> blend(kBlendOverNumBindings, kStorage);
+    blend[kBlendOverMeshColorBinding] = kSampled;
+    blend[kBlendOverOutputBinding] = kBuffer;
+    blend_set_layout_ = CreatePushLayout(context, blend);
+    blend_layout_ = CreatePipelineLayout(context, blend_set_layout_.Get(),
+                                         sizeof(GaussianBlendOverPushConstants));
     placeholder_depth_ = Image(context, 1, 1, VK_FORMAT_R32_SFLOAT, VK_IMAGE_USAGE_SAMPLED_BIT);
     placeholder_splat_id_ =
         Image(context, 1, 1, kSplatIdFormat, GetStorageRequirements().image_usage);
@@ -417,6 +423,44 @@ void GaussianCompositeStage::RecordDepthMerge(VkCommandBuffer cmd, const DepthMe
                        &push);
     RecordDispatch(cmd, (images.width + kDepthMergeWorkgroupSize - 1) / kDepthMergeWorkgroupSize,
                    (images.height + kDepthMergeWorkgroupSize - 1) / kDepthMergeWorkgroupSize, 1);
+}
+
+void GaussianCompositeStage::RecordBlendOver(VkCommandBuffer cmd, const BlendOverImages& images) {
+    if (images.width == 0 || images.height == 0) {
+        core::ThrowError("GaussianCompositeStage: the image is {}x{}", images.width, images.height);
+    }
+    RequireView(images.splat_color, "splat_color");
+    RequireView(images.mesh_color, "mesh_color");
+    if (images.output == VK_NULL_HANDLE) {
+        core::ThrowError("GaussianCompositeStage: the blend has no output buffer");
+    }
+    if (!blend_) {
+        blend_ = CreateComputePipeline(context_, blend_layout_.Get(), spirv::kGaussianBlendOver,
+                                       "gaussian_blend_over");
+    }
+    GaussianBlendOverPushConstants push{};
+    push.width = images.width;
+    push.height = images.height;
+    push.mesh_flip_y = images.mesh_flip_y ? 1u : 0u;
+    VkDescriptorImageInfo mesh{};
+    mesh.imageView = images.mesh_color;
+    mesh.imageLayout = VK_IMAGE_LAYOUT_GENERAL;
+    const VkDescriptorImageInfo splat = StorageImage(images.splat_color);
+    const VkDescriptorBufferInfo output{images.output, 0,
+                                        VkDeviceSize(images.width) * images.height * 4};
+    std::array<VkWriteDescriptorSet, kBlendOverNumBindings> writes{};
+    writes[kBlendOverSplatColorBinding] =
+        ImageWrite(kBlendOverSplatColorBinding, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, &splat);
+    writes[kBlendOverMeshColorBinding] =
+        ImageWrite(kBlendOverMeshColorBinding, VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE, &mesh);
+    writes[kBlendOverOutputBinding] = BufferWrite(kBlendOverOutputBinding, &output);
+    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, blend_.Get());
+    context_.GetCmdPushDescriptorSet()(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, blend_layout_.Get(), 0,
+                                       kBlendOverNumBindings, writes.data());
+    vkCmdPushConstants(cmd, blend_layout_.Get(), VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(push),
+                       &push);
+    RecordDispatch(cmd, (images.width + kBlendOverWorkgroupSize - 1) / kBlendOverWorkgroupSize,
+                   (images.height + kBlendOverWorkgroupSize - 1) / kBlendOverWorkgroupSize, 1);
 }
 
 }  // namespace vulkan

@@ -147,6 +147,18 @@ struct DepthMergeImages {
     VkImageView linear = VK_NULL_HANDLE;       ///< R32F out: merged view z, 0 where nothing is
 };
 
+/// The blend over the mesh colour: the composite's colour (RGBA16F, GENERAL) over an RGBA8
+/// mesh colour (sampled, GENERAL), into a storage buffer of width * height packed RGBA8
+/// words, top row first.
+struct BlendOverImages {
+    uint32_t width = 0;
+    uint32_t height = 0;
+    VkImageView splat_color = VK_NULL_HANDLE;
+    VkImageView mesh_color = VK_NULL_HANDLE;
+    bool mesh_flip_y = true;  ///< the mesh colour's row 0 is the bottom row (GL)
+    VkBuffer output = VK_NULL_HANDLE;
+};
+
 class GaussianCompositeStage {
 public:
     /// Workgroups of the default work-stealing grid (enough to fill a large GPU; a CPU
@@ -182,6 +194,9 @@ public:
     /// composite's writes must be made visible to COMPUTE_SHADER reads before.
     void RecordDepthMerge(VkCommandBuffer cmd, const DepthMergeImages& images,
                           const DepthMergeParams& params);
+    /// Records the blend over the mesh colour (gaussian_blend_over.comp). Synchronisation as
+    /// above; after, the output buffer is a COMPUTE_SHADER storage write.
+    void RecordBlendOver(VkCommandBuffer cmd, const BlendOverImages& images);
 
 private:
     VkPipeline GetCompositePipeline(CompositeColorFormat format, const CompositeParams& params,
@@ -197,6 +212,9 @@ private:
     UniquePipelineLayout composite_layout_;
     UniqueDescriptorSetLayout merge_set_layout_;
     UniquePipelineLayout merge_layout_;
+    UniqueDescriptorSetLayout blend_set_layout_;
+    UniquePipelineLayout blend_layout_;
+    UniquePipeline blend_;  // made on first use
     UniquePipeline tile_ranges_;
     VkDescriptorImageInfo SplatIdDescriptor(VkCommandBuffer cmd, VkImageView splat_id) const;
 

@@ -18,6 +18,7 @@ namespace {
 
 constexpr VkFormat kColorFormat = VK_FORMAT_R16G16B16A16_SFLOAT;
 constexpr VkFormat kDepthFormat = VK_FORMAT_D32_SFLOAT;
+constexpr VkFormat kMeshColorFormat = VK_FORMAT_R8G8B8A8_UNORM;
 
 GaussianSplatVulkanBackend& RequireVulkan(GaussianSplatBackend& backend) {
     auto* vulkan = dynamic_cast<GaussianSplatVulkanBackend*>(&backend);
@@ -88,10 +89,15 @@ struct InteropTargets::Impl {
                       VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT |
                           VK_IMAGE_USAGE_TRANSFER_DST_BIT,
                       ImageMemory::kExportableFd);
+        // Filament's mesh colour (its colour attachment in GL), read by the blend over it.
+        mesh_color = Image(context, width, height, kMeshColorFormat,
+                           VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT |
+                               VK_IMAGE_USAGE_TRANSFER_DST_BIT,
+                           ImageMemory::kExportableFd);
         // Transparent colour and depth 0 ("nothing drawn" in reversed Z) until GL or a
         // composite writes them, then both go to the external queue family.
         SubmitAndWait(context, pool, [&](VkCommandBuffer cmd) {
-            for (const Image* image : {&color, &depth}) {
+            for (const Image* image : {&color, &depth, &mesh_color}) {
                 RecordImageBarrier(cmd, image->Get(), AspectOf(image->GetFormat()),
                                    VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_GENERAL,
                                    VK_PIPELINE_STAGE_2_NONE, VK_ACCESS_2_NONE,
@@ -101,11 +107,13 @@ struct InteropTargets::Impl {
             const VkImageSubresourceRange color_range{VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
             vkCmdClearColorImage(cmd, color.Get(), VK_IMAGE_LAYOUT_GENERAL, &transparent, 1,
                                  &color_range);
+            vkCmdClearColorImage(cmd, mesh_color.Get(), VK_IMAGE_LAYOUT_GENERAL, &transparent, 1,
+                                 &color_range);
             const VkClearDepthStencilValue nothing{0.0f, 0};
             const VkImageSubresourceRange depth_range{VK_IMAGE_ASPECT_DEPTH_BIT, 0, 1, 0, 1};
             vkCmdClearDepthStencilImage(cmd, depth.Get(), VK_IMAGE_LAYOUT_GENERAL, &nothing, 1,
                                         &depth_range);
-            for (const Image* image : {&color, &depth}) {
+            for (const Image* image : {&color, &depth, &mesh_color}) {
                 RecordOwnershipTransfer(cmd, context, *image, Transfer::kRelease,
                                         VK_IMAGE_LAYOUT_GENERAL, VK_IMAGE_LAYOUT_GENERAL,
                                         VK_PIPELINE_STAGE_2_CLEAR_BIT,
@@ -118,6 +126,12 @@ struct InteropTargets::Impl {
     // use.
     void EnsureColorReadback() {
         if (!color_readback) color_readback = ReadbackBuffer(context, Width(), Height(), 8);
+    }
+    // The blend writes its RGBA8 words straight into host-readable memory.
+    void EnsureBlendReadback() {
+        if (blend_readback) return;
+        blend_readback = Buffer(context, VkDeviceSize(Width()) * Height() * 4,
+                                VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, MemoryUsage::kHostReadback);
     }
     void EnsureDepthReadback() {
         if (merged_linear) return;
@@ -135,9 +149,11 @@ struct InteropTargets::Impl {
     GaussianSplatVulkanBackend& backend;
     const VulkanContext& context;
     CommandPool pool;
-    Image color;  // RGBA16F, exported
-    Image depth;  // D32_SFLOAT, exported
+    Image color;       // RGBA16F, exported
+    Image depth;       // D32_SFLOAT, exported
+    Image mesh_color;  // RGBA8, exported
     Buffer color_readback;
+    Buffer blend_readback;
     Image merged_linear, merged_normalized;
     Buffer linear_readback, normalized_readback;
     Buffer depth_upload;
@@ -166,6 +182,7 @@ public:
         scene_.near_plane = request.scene_near;
         scene_.flip_y = true;
         if (request.read_color) targets.EnsureColorReadback();
+        if (request.blend_over_mesh) targets.EnsureBlendReadback();
         if (request.read_depth) targets.EnsureDepthReadback();
     }
 
@@ -189,6 +206,12 @@ public:
                                 VK_IMAGE_LAYOUT_GENERAL, VK_IMAGE_LAYOUT_GENERAL,
                                 VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
                                 VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);
+        if (request_.blend_over_mesh) {
+            RecordOwnershipTransfer(frame.cmd, targets_.context, targets_.mesh_color,
+                                    Transfer::kAcquire, VK_IMAGE_LAYOUT_GENERAL,
+                                    VK_IMAGE_LAYOUT_GENERAL, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                                    VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);
+        }
     }
 
     void RecordAfter(const Frame& frame) override {
@@ -197,6 +220,7 @@ public:
         VkPipelineStageFlags2 color_stages = frame.write_stage;
         VkAccessFlags2 color_access = frame.write_access;
         if (request_.read_depth) RecordDepthMerge(frame);
+        if (request_.blend_over_mesh) RecordBlendOver(frame);
         if (request_.read_color) {
             // Copied in TRANSFER_SRC_OPTIMAL; released in GENERAL.
             color_layout = VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL;
@@ -213,12 +237,22 @@ public:
         RecordOwnershipTransfer(cmd, targets_.context, targets_.depth, Transfer::kRelease,
                                 VK_IMAGE_LAYOUT_GENERAL, VK_IMAGE_LAYOUT_GENERAL,
                                 VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_NONE);
+        if (request_.blend_over_mesh) {
+            RecordOwnershipTransfer(cmd, targets_.context, targets_.mesh_color, Transfer::kRelease,
+                                    VK_IMAGE_LAYOUT_GENERAL, VK_IMAGE_LAYOUT_GENERAL,
+                                    VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_NONE);
+            // The host reads the blend's words after the fence.
+            RecordMemoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                                VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, VK_PIPELINE_STAGE_2_HOST_BIT,
+                                VK_ACCESS_2_HOST_READ_BIT);
+        }
     }
 
     void ReadBack() override {
         const int64_t w = targets_.Width(), h = targets_.Height();
         const size_t pixels = size_t(w) * h;
         out_.color = t::geometry::Image();
+        out_.blended = t::geometry::Image();
         out_.linear_depth = t::geometry::Image();
         out_.normalized_depth = t::geometry::Image();
         if (request_.read_color) {
@@ -231,6 +265,11 @@ public:
                     for (int64_t i = begin; i < end; ++i) dst[i] = HalfToFloat(halves[i]);
                 },
                 int64_t(1) << 18);
+        }
+        if (request_.blend_over_mesh) {
+            out_.blended = t::geometry::Image(h, w, 4, core::Dtype::UInt8);
+            std::memcpy(out_.blended.Data<uint8_t>(), targets_.blend_readback.GetMapped(),
+                        pixels * 4);
         }
         if (request_.read_depth) {
             out_.linear_depth = t::geometry::Image(h, w, 1, core::Dtype::Float32);
@@ -245,6 +284,21 @@ public:
 private:
     const SceneDepthTexture* SceneDepth() const {
         return request_.use_scene_depth ? &scene_ : nullptr;
+    }
+
+    // The splat colour over the mesh colour, into the host-readable RGBA8 words.
+    void RecordBlendOver(const Frame& frame) {
+        RecordMemoryBarrier(frame.cmd, frame.write_stage, frame.write_access,
+                            VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                            VK_ACCESS_2_SHADER_STORAGE_READ_BIT);
+        BlendOverImages images;
+        images.width = targets_.Width();
+        images.height = targets_.Height();
+        images.splat_color = targets_.color.GetView();
+        images.mesh_color = targets_.mesh_color.GetView();
+        images.mesh_flip_y = true;
+        images.output = targets_.blend_readback.Get();
+        frame.composite_stage->RecordBlendOver(frame.cmd, images);
     }
 
     // Splat expected depth (where 1 - T >= 0.5) merged with the scene depth, both outputs
@@ -335,6 +389,11 @@ ExportedImageMemory InteropTargets::ExportColor() {
 
 ExportedImageMemory InteropTargets::ExportDepth() {
     const ImageMemoryFd memory = impl_->depth.ExportFd(impl_->context);
+    return {memory.fd, memory.size, true};
+}
+
+ExportedImageMemory InteropTargets::ExportMeshColor() {
+    const ImageMemoryFd memory = impl_->mesh_color.ExportFd(impl_->context);
     return {memory.fd, memory.size, true};
 }
 

@@ -69,6 +69,9 @@ public:
 
     ExportedImageMemory ExportColor();
     ExportedImageMemory ExportDepth();
+    /// RGBA8 unorm: the mesh view's colour attachment (row 0 = GL's bottom row), read by the
+    /// blend over it (InteropCompositeRequest::blend_over_mesh).
+    ExportedImageMemory ExportMeshColor();
 
     /// Writes the depth image from the host: `reversed_z` holds width * height floats in GL
     /// row order (bottom row first), stored as given. For tests and for drivers where GL
@@ -92,6 +95,9 @@ struct InteropCompositeRequest {
     float scene_near = 0.1f;
     /// Copy the splat colour to InteropFrame::color (offscreen rendering).
     bool read_color = false;
+    /// Blend the splat colour over the mesh colour image on the GPU into InteropFrame::blended
+    /// (offscreen rendering with an 8-bit picture: no float readback, no host blend).
+    bool blend_over_mesh = false;
     /// Merge the splat depth (expected depth where 1 - T >= 0.5) with the scene depth on
     /// the GPU and read both merged images back (RenderToDepthImage).
     bool read_depth = false;
@@ -104,6 +110,8 @@ struct InteropCompositeRequest {
 struct InteropFrame {
     /// Float32 [H, W, 4], premultiplied rgb and a = 1 - T, top row first (read_color).
     t::geometry::Image color;
+    /// UInt8 [H, W, 4]: round(255 * (s + (1 - s_a) * m)), top row first (blend_over_mesh).
+    t::geometry::Image blended;
     /// Float32 [H, W, 1] merged view z, 0 where neither splat nor mesh is (read_depth).
     t::geometry::Image linear_depth;
     /// UInt16 [H, W, 1] merged depth normalised, 65535 where nothing is (read_depth).
