@@ -415,14 +415,9 @@ void GaussianCompositeStage::RecordDepthMerge(VkCommandBuffer cmd, const DepthMe
                                                                  : VK_DESCRIPTOR_TYPE_STORAGE_IMAGE,
                                &infos[i]);
     }
-    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE,
-                      GetDepthMergePipeline(params.scene_depth != nullptr));
-    context_.GetCmdPushDescriptorSet()(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, merge_layout_.Get(), 0,
-                                       kDepthMergeNumBindings, writes.data());
-    vkCmdPushConstants(cmd, merge_layout_.Get(), VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(push),
-                       &push);
-    RecordDispatch(cmd, (images.width + kDepthMergeWorkgroupSize - 1) / kDepthMergeWorkgroupSize,
-                   (images.height + kDepthMergeWorkgroupSize - 1) / kDepthMergeWorkgroupSize, 1);
+    RecordPerPixelPass(cmd, GetDepthMergePipeline(params.scene_depth != nullptr),
+                       merge_layout_.Get(), writes, &push, sizeof(push), images.width,
+                       images.height, kDepthMergeWorkgroupSize);
 }
 
 void GaussianCompositeStage::RecordBlendOver(VkCommandBuffer cmd, const BlendOverImages& images) {
@@ -454,13 +449,22 @@ void GaussianCompositeStage::RecordBlendOver(VkCommandBuffer cmd, const BlendOve
     writes[kBlendOverMeshColorBinding] =
         ImageWrite(kBlendOverMeshColorBinding, VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE, &mesh);
     writes[kBlendOverOutputBinding] = BufferWrite(kBlendOverOutputBinding, &output);
-    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, blend_.Get());
-    context_.GetCmdPushDescriptorSet()(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, blend_layout_.Get(), 0,
-                                       kBlendOverNumBindings, writes.data());
-    vkCmdPushConstants(cmd, blend_layout_.Get(), VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(push),
-                       &push);
-    RecordDispatch(cmd, (images.width + kBlendOverWorkgroupSize - 1) / kBlendOverWorkgroupSize,
-                   (images.height + kBlendOverWorkgroupSize - 1) / kBlendOverWorkgroupSize, 1);
+    RecordPerPixelPass(cmd, blend_.Get(), blend_layout_.Get(), writes, &push, sizeof(push),
+                       images.width, images.height, kBlendOverWorkgroupSize);
+}
+
+void GaussianCompositeStage::RecordPerPixelPass(VkCommandBuffer cmd, VkPipeline pipeline,
+                                                VkPipelineLayout layout,
+                                                std::span<const VkWriteDescriptorSet> writes,
+                                                const void* push, uint32_t push_bytes,
+                                                uint32_t width, uint32_t height,
+                                                uint32_t workgroup_size) const {
+    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline);
+    context_.GetCmdPushDescriptorSet()(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, layout, 0,
+                                       static_cast<uint32_t>(writes.size()), writes.data());
+    vkCmdPushConstants(cmd, layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, push_bytes, push);
+    RecordDispatch(cmd, (width + workgroup_size - 1) / workgroup_size,
+                   (height + workgroup_size - 1) / workgroup_size, 1);
 }
 
 }  // namespace vulkan

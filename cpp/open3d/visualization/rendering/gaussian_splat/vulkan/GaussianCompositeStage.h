@@ -9,6 +9,7 @@
 
 #include <array>
 #include <cstdint>
+#include <span>
 
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/Buffer.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/Image.h"
@@ -202,6 +203,12 @@ private:
     VkPipeline GetCompositePipeline(CompositeColorFormat format, const CompositeParams& params,
                                     bool color_buffer);
     VkPipeline GetDepthMergePipeline(bool scene_depth);
+    // The per-pixel passes (depth merge, blend): bind, push descriptors and constants, and
+    // dispatch workgroup_size x workgroup_size pixels per workgroup.
+    void RecordPerPixelPass(VkCommandBuffer cmd, VkPipeline pipeline, VkPipelineLayout layout,
+                            std::span<const VkWriteDescriptorSet> writes, const void* push,
+                            uint32_t push_bytes, uint32_t width, uint32_t height,
+                            uint32_t workgroup_size) const;
     // The view and layout to bind for `scene_depth`; records the placeholder's transition
     // when it stands in.
     VkDescriptorImageInfo SceneDepthDescriptor(VkCommandBuffer cmd,
