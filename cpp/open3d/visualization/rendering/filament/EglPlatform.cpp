@@ -127,8 +127,8 @@ EGLSurface CreatePbuffer(EGLDisplay display, EGLConfig config, uint32_t width, u
     return eglCreatePbufferSurface(display, config, attributes);
 }
 
-// Filament 1.9.25's OpenGL platform on EGL. Every method runs on Filament's driver thread
-// except createSwapChain / destroySwapChain's bookkeeping, which Filament also defers there.
+// Filament 1.9.25's OpenGL platform on EGL; Filament calls it from its driver thread, whose
+// context createDriver makes.
 class EglFilamentPlatform final : public filament::backend::OpenGLPlatform {
 public:
     explicit EglFilamentPlatform(const EglContext& shared)
