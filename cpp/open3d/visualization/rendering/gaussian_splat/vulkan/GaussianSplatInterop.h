@@ -1,7 +1,8 @@
 // Sharing the Vulkan backend's frame images with an OpenGL renderer (Filament) without
 // copies (docs/filament.md "Zero-copy images"): the splat colour (RGBA16F, written by the
-// composite) and the scene depth (D32_SFLOAT, written by Filament, sampled by the
-// composite) live in Vulkan memory exported as POSIX file descriptors, which GL imports
+// composite), the scene depth (D32_SFLOAT, written by Filament, sampled by the composite)
+// and the mesh colour (RGBA8, written by Filament, read by the blend over it) live in
+// Vulkan memory exported as POSIX file descriptors, which GL imports
 // with GL_EXT_memory_object_fd. This header has no Vulkan types so the Filament layer can
 // use it (docs/DESIGN.md "Layers"); synchronisation is on the CPU (fence waits), because lavapipe
 // has no external semaphores (docs/environment-notes.md).
@@ -51,8 +52,9 @@ struct InteropFrame;
 /// - colour: RGBA16F, premultiplied splat colour (rgb = C, a = 1 - T, no background),
 ///   row 0 = the top image row (GL, whose row 0 is the bottom, must flip y);
 /// - depth: D32_SFLOAT, Filament's depth attachment: reversed-Z d = near / z_view, 0 where
-///   nothing was drawn, row 0 = GL's bottom row.
-/// Both stay in VK_IMAGE_LAYOUT_GENERAL and are owned by the external queue family between
+///   nothing was drawn, row 0 = GL's bottom row;
+/// - mesh colour: RGBA8 unorm, Filament's colour attachment, row 0 = GL's bottom row.
+/// All stay in VK_IMAGE_LAYOUT_GENERAL and are owned by the external queue family between
 /// composites. Destroy them only after GL/Filament stopped using the imported textures, and
 /// before the backend (whose device they live on).
 class InteropTargets {
