@@ -12,6 +12,38 @@ namespace gs_render {
 namespace rendering = open3d::visualization::rendering;
 using namespace open3d;
 
+namespace {
+
+// The square through the sphere's lower half: normal = the camera's up (OpenCV: -y of the camera
+// frame, in the world), one side along the camera's right axis flattened onto the plane.
+t::geometry::TriangleMesh MakePlane(const camera::PinholeCamera& camera,
+                                    const FilamentRenderOptions& options) {
+    const Eigen::Matrix3d to_world = camera.world_to_camera.topLeftCorner<3, 3>().transpose();
+    const Eigen::Vector3d up = -(to_world * Eigen::Vector3d::UnitY()).normalized();
+    Eigen::Vector3d right = to_world * Eigen::Vector3d::UnitX();
+    right = (right - right.dot(up) * up).normalized();
+    const Eigen::Vector3d forward = up.cross(right);
+    const double r = options.sphere_radius, half = 3.0 * r;
+    const Eigen::Vector3d centre = options.sphere_center - 0.5 * r * up;
+    std::vector<float> positions;
+    for (const auto& [a, b] : {std::pair{-1, -1}, {1, -1}, {1, 1}, {-1, 1}}) {
+        const Eigen::Vector3d p = centre + half * (a * right + b * forward);
+        positions.insert(positions.end(), {float(p.x()), float(p.y()), float(p.z())});
+    }
+    // Two-sided when lit (defaultLit), so the winding only has to be consistent.
+    return t::geometry::TriangleMesh(core::Tensor::FromVector(positions, {4, 3}),
+                                     {Eigen::Vector3i(0, 1, 2), Eigen::Vector3i(0, 2, 3)});
+}
+
+rendering::MaterialRecord MakeGrey() {
+    rendering::MaterialRecord grey;
+    grey.shader = rendering::kShaderDefaultLit;
+    grey.base_color = Eigen::Vector4f(0.6f, 0.6f, 0.6f, 1.0f);
+    return grey;
+}
+
+}  // namespace
+
 FilamentImages RenderWithFilament(const t::geometry::PointCloud& cloud,
                                   const camera::PinholeCamera& camera,
                                   const rendering::RenderConfig& config,
@@ -31,6 +63,7 @@ FilamentImages RenderWithFilament(const t::geometry::PointCloud& cloud,
         red.base_color = Eigen::Vector4f(1, 0, 0, 1);
         scene.AddGeometry("sphere", sphere, red);
     }
+    if (options.plane) scene.AddGeometry("plane", MakePlane(camera, options), MakeGrey());
     const Eigen::Vector3f bg = options.background.cast<float>();
     scene.SetBackground(Eigen::Vector4f(bg.x(), bg.y(), bg.z(), 1.0f));
     scene.SetupCamera(camera);

@@ -20,6 +20,10 @@ struct FilamentRenderOptions {
     bool sphere = false;
     Eigen::Vector3d sphere_center = Eigen::Vector3d::Zero();
     double sphere_radius = 1.0;
+    /// A grey lit square through the sphere's lower half (half a radius below its centre,
+    /// side 6 radii), level with the camera's horizon: a second, larger mesh that splats
+    /// stand in front of and behind.
+    bool plane = false;
     Eigen::Vector3d background = Eigen::Vector3d::Zero();
     int frames = 1;      ///< frames rendered; times are averaged over all but the first
     bool depth = false;  ///< also render the merged splat and mesh depth

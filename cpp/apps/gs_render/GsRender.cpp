@@ -177,10 +177,10 @@ int Run(const Options& opt) {
     if (!opt.lod.empty() && opt.lod_budget == 0) {
         core::ThrowError("--lod '{}' is read for --lod-budget: give a budget too", opt.lod);
     }
-    if (opt.lod_budget > 0 && (opt.filament || opt.sphere)) {
+    if (opt.lod_budget > 0 && (opt.filament || opt.sphere || opt.plane)) {
         core::ThrowError(
-            "--lod-budget draws through the splat backend alone, not --filament or "
-            "--sphere");
+            "--lod-budget draws through the splat backend alone, not --filament, "
+            "--sphere or --plane");
     }
     rendering::vulkan::RegisterVulkanBackend();
     const auto start = std::chrono::steady_clock::now();
@@ -210,10 +210,11 @@ int Run(const Options& opt) {
     rendering::RenderConfig config = MakeConfig(opt);
     std::unique_ptr<rendering::GaussianSplatBackend> backend = MakeBackend(opt);
     const std::string backend_name = backend->GetName();
-    if (opt.filament || opt.sphere) {
+    if (opt.filament || opt.sphere || opt.plane) {
         gs_render::FilamentRenderOptions fo;
         fo.backend = backend_name;
         fo.sphere = opt.sphere;
+        fo.plane = opt.plane;
         fo.sphere_center = default_scene ? rendering::GetDefaultSceneMeshSphere().center
                                          : t::geometry::ComputeMedianCenter(cloud);
         fo.sphere_radius =
@@ -340,7 +341,7 @@ int main(int argc, char** argv) {
     app.add_option("--id-output", opt.id_output,
                    "ID image (.npy, int32 H x W): the index in --input of the splat that "
                    "contributes most to each pixel, -1 where none (docs/editing.md); not with "
-                   "--filament/--sphere or --lod-budget");
+                   "--filament/--sphere/--plane or --lod-budget");
     app.add_option("--sh-degree", opt.sh_degree, "Highest SH degree evaluated")
         ->check(CLI::Range(0, 3))
         ->capture_default_str();
@@ -390,6 +391,9 @@ int main(int argc, char** argv) {
     app.add_flag("--sphere", opt.sphere,
                  "Add a red sphere (implies --filament) at the scene centre (the median splat "
                  "position): splats behind it are hidden, splats in front stay");
+    app.add_flag("--plane", opt.plane,
+                 "Add a grey lit square through the lower half of the sphere's place (implies "
+                 "--filament), level with the camera's horizon, 6 sphere radii wide");
     app.add_option("--sphere-radius", opt.sphere_radius,
                    "Sphere radius (default: 0.3 x the 80th-percentile splat distance from the "
                    "centre; the default scene has its own place for the sphere)")

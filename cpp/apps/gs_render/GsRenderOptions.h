@@ -35,6 +35,7 @@ struct Options {
     double orbit_angle = 0.0;
     bool filament = false;
     bool sphere = false;
+    bool plane = false;
     std::optional<double> sphere_radius;
     int frames = 1;
     uint64_t lod_budget = 0;  // 0: no level of detail
