@@ -32,9 +32,10 @@ py::array CopyOfTensor(const core::Tensor& tensor) {
 
 void BindMesh(py::module_& m) {
     using t::geometry::TriangleMesh;
-    py::class_<TriangleMesh>(m, "TriangleMesh",
-                             "Vertices [N, 3] float32 and triangles [M, 3] (counter-clockwise "
-                             "seen from the front); drawn by Filament (needs an X server)")
+    py::class_<TriangleMesh>(
+        m, "TriangleMesh",
+        "Vertices [N, 3] float32 and triangles [M, 3] (counter-clockwise "
+        "seen from the front); drawn by Filament (OffscreenRenderer(meshes=True))")
         .def(py::init([](const py::array& vertices, const py::array_t<int64_t>& triangles) {
                  if (triangles.ndim() != 2 || triangles.shape(1) != 3) {
                      core::ThrowError("TriangleMesh: triangles must have shape (M, 3)");

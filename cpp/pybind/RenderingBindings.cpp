@@ -152,7 +152,8 @@ void BindRendering(py::module_& m) {
         "Renders scenes to numpy arrays. Default: splat clouds only, drawn by the splat backend "
         "alone without a display: 'vulkan' (any Vulkan 1.3 device, lavapipe without a GPU) or "
         "'cpu' (the double-precision reference). meshes=True: Filament draws meshes and points "
-        "and composites the splats by depth (needs an X server; 8-bit colour).")
+        "and composites the splats by depth (on the X server of DISPLAY, else headless on EGL; "
+        "8-bit colour).")
         .def(py::init([](int width, int height, const std::string& backend, bool meshes,
                          int sh_degree, bool antialias, bool compact_storage, double near_plane) {
                  auto r = std::make_shared<SplatOffscreen>(width, height, backend, meshes);

@@ -1,7 +1,7 @@
 // The state behind Python's OffscreenRenderer and its `scene`: the geometry, the camera and
 // the settings. Without meshes the splat backend alone draws (GaussianSplatRenderer, no
 // display needed); with `meshes` Filament's OffscreenRenderer does (meshes and splats
-// composited by depth; needs an X server). Python's OffscreenRenderer and its Scene share
+// composited by depth; GLX or headless EGL). Python's OffscreenRenderer and its Scene share
 // one of these through a shared_ptr.
 #pragma once
 

@@ -201,7 +201,7 @@ class PointCloud:
 
 
 class TriangleMesh:
-    """Vertices [N, 3] float32 and triangles [M, 3] (counter-clockwise seen from the front); drawn by Filament (needs an X server)"""
+    """Vertices [N, 3] float32 and triangles [M, 3] (counter-clockwise seen from the front); drawn by Filament (OffscreenRenderer(meshes=True))"""
     def __init__(self, vertices: numpy.typing.ArrayLike, triangles: numpy.typing.ArrayLike) -> None:
         """A mesh of vertices [N, 3] (any real dtype, copied as float32) and triangles [M, 3] of vertex indices"""
         ...

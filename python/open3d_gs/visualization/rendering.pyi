@@ -53,7 +53,7 @@ class MaterialRecord:
 
 
 class OffscreenRenderer:
-    """Renders scenes to numpy arrays. Default: splat clouds only, drawn by the splat backend alone without a display: 'vulkan' (any Vulkan 1.3 device, lavapipe without a GPU) or 'cpu' (the double-precision reference). meshes=True: Filament draws meshes and points and composites the splats by depth (needs an X server; 8-bit colour)."""
+    """Renders scenes to numpy arrays. Default: splat clouds only, drawn by the splat backend alone without a display: 'vulkan' (any Vulkan 1.3 device, lavapipe without a GPU) or 'cpu' (the double-precision reference). meshes=True: Filament draws meshes and points and composites the splats by depth (on the X server of DISPLAY, else headless on EGL; 8-bit colour)."""
     def __init__(self, width: int, height: int, backend: str = ..., meshes: bool = ..., *, sh_degree: int = ..., antialias: bool = ..., compact_storage: bool = ..., near_plane: float = ...) -> None:
         """The knobs are keyword arguments and properties: sh_degree (cap, 0..3), antialias (Mip-Splatting's), compact_storage (Vulkan, half precision), near_plane"""
         ...
