@@ -133,7 +133,7 @@ class EglFilamentPlatform final : public filament::backend::OpenGLPlatform {
 public:
     explicit EglFilamentPlatform(const EglContext& shared)
         : display_(shared.NativeDisplay()),
-          config_(ChooseConfig(shared.NativeDisplay())),
+          config_(shared.NativeConfig()),
           shared_(shared.NativeContext()) {}
 
     int getOSVersion() const noexcept override { return 0; }
@@ -232,23 +232,28 @@ EglContext::EglContext() {
     if (display_ == EGL_NO_DISPLAY) {
         core::ThrowError("EGL: no display could be initialized (tried {})", tried);
     }
+    // On failure the display stays initialized, as in the destructor.
     config_ = ChooseConfig(display_);
     if (config_ == nullptr) {
-        eglTerminate(display_);
         core::ThrowError("EGL: {} has no RGB8 pbuffer configuration for OpenGL", description_);
     }
     context_ = CreateContext(display_, config_, EGL_NO_CONTEXT);
     if (context_ == EGL_NO_CONTEXT) {
-        const EGLint error = eglGetError();
-        eglTerminate(display_);
         core::ThrowError("EGL: {} gives no OpenGL 4.5 core context (EGL error 0x{:x})",
-                         description_, error);
+                         description_, eglGetError());
     }
     surface_ = CreatePbuffer(display_, config_, 16, 16);
-    MakeCurrent();
+    try {
+        MakeCurrent();
+    } catch (...) {
+        Release();
+        throw;
+    }
 }
 
-EglContext::~EglContext() {
+EglContext::~EglContext() { Release(); }
+
+void EglContext::Release() {
     eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
     if (surface_ != EGL_NO_SURFACE) eglDestroySurface(display_, surface_);
     eglDestroyContext(display_, context_);

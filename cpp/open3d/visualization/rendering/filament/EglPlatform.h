@@ -33,6 +33,8 @@ public:
     /// The EGLContext, given to Filament as its shared context.
     void* NativeContext() const { return context_; }
     void* NativeDisplay() const { return display_; }
+    /// The EGLConfig of the context and its pbuffer (RGB8, pbuffers, OpenGL).
+    void* NativeConfig() const { return config_; }
     /// Which display was opened, e.g. "EGL device 0 (EGL_NV_device_cuda), NVIDIA".
     const std::string& Description() const { return description_; }
 
@@ -40,6 +42,9 @@ public:
     static void* GetProcAddress(const char* name);
 
 private:
+    // Destroys the pbuffer and the context (the constructor's failure path and the destructor).
+    void Release();
+
     void* display_ = nullptr;
     void* config_ = nullptr;
     void* context_ = nullptr;
