@@ -177,7 +177,7 @@ int Run(const Options& opt) {
     if (!opt.lod.empty() && opt.lod_budget == 0) {
         core::ThrowError("--lod '{}' is read for --lod-budget: give a budget too", opt.lod);
     }
-    if (opt.lod_budget > 0 && (opt.filament || opt.sphere || opt.plane)) {
+    if (opt.lod_budget > 0 && opt.UsesFilament()) {
         core::ThrowError(
             "--lod-budget draws through the splat backend alone, not --filament, "
             "--sphere or --plane");
@@ -210,7 +210,7 @@ int Run(const Options& opt) {
     rendering::RenderConfig config = MakeConfig(opt);
     std::unique_ptr<rendering::GaussianSplatBackend> backend = MakeBackend(opt);
     const std::string backend_name = backend->GetName();
-    if (opt.filament || opt.sphere || opt.plane) {
+    if (opt.UsesFilament()) {
         gs_render::FilamentRenderOptions fo;
         fo.backend = backend_name;
         fo.sphere = opt.sphere;

@@ -45,6 +45,9 @@ struct Options {
     double seconds_per_keyframe = open3d::camera::kDefaultSecondsPerKeyframe;
     float crf = 23.0f;                // --camera-path -o x.mp4: x264's constant rate factor
     std::string preset = "veryfast";  // and its speed preset
+
+    /// --filament, --sphere or --plane: the frame goes through Filament.
+    bool UsesFilament() const { return filament || sphere || plane; }
 };
 
 }  // namespace gs_render

@@ -34,15 +34,15 @@ gs_render::CameraPathOptions PathOptions(const Options& opt) {
 // format (a .jpg depth output was written as PNG bytes).
 void CheckOutputs(const Options& opt) {
     if (!opt.camera_path.empty()) {
-        const char* single =
-            !opt.depth_output.empty()                            ? "--depth-output"
-            : !opt.float_output.empty()                          ? "--float-output"
-            : !opt.id_output.empty()                             ? "--id-output"
-            : opt.filament || opt.sphere || opt.plane            ? "--filament/--sphere/--plane"
-            : opt.lod_budget > 0                                 ? "--lod-budget"
-            : !opt.cameras.empty()                               ? "--cameras"
-            : !opt.eye.empty() || !opt.center.empty() || opt.fov ? "--eye/--center/--fov"
-                                                                 : nullptr;
+        const char* single = !opt.depth_output.empty()   ? "--depth-output"
+                             : !opt.float_output.empty() ? "--float-output"
+                             : !opt.id_output.empty()    ? "--id-output"
+                             : opt.UsesFilament()        ? "--filament/--sphere/--plane"
+                             : opt.lod_budget > 0        ? "--lod-budget"
+                             : !opt.cameras.empty()      ? "--cameras"
+                             : !opt.eye.empty() || !opt.center.empty() || opt.fov
+                                 ? "--eye/--center/--fov"
+                                 : nullptr;
         if (single != nullptr) {
             core::ThrowError(
                 "{} is for a single view; --camera-path '{}' renders the path's "
@@ -89,13 +89,12 @@ void CheckOutputs(const Options& opt) {
             }
         }
     }
-    if (!opt.float_output.empty() && (opt.filament || opt.sphere || opt.plane)) {
+    if (!opt.float_output.empty() && opt.UsesFilament()) {
         core::ThrowError(
             "--float-output is not available with --filament/--sphere/--plane (the Filament "
-            "path "
-            "returns 8-bit colour)");
+            "path returns 8-bit colour)");
     }
-    if (!opt.id_output.empty() && (opt.filament || opt.sphere || opt.plane || opt.lod_budget > 0)) {
+    if (!opt.id_output.empty() && (opt.UsesFilament() || opt.lod_budget > 0)) {
         core::ThrowError(
             "--id-output is not available with {}: its pixels show {}, not splats of --input",
             opt.lod_budget > 0 ? "--lod-budget" : "--filament/--sphere/--plane",
