@@ -96,14 +96,14 @@ bench() {
         --cameras $d/cameras.json --view 0 --width "$w" --height "$h" --sphere --plane --frames 60 \
         -o /tmp/filament-$size-$sharing.png >"$log" 2>&1
       say "gs-render --sphere --plane $size $sharing: exit $?"
-      grep -E "^filament render|^frame time|rror" "$log" | cut -c1-400 | tee -a "$summary"
+      grep -E "^filament render|^frame time|^presented|rror" "$log" | cut -c1-400 | tee -a "$summary"
     done
     log=$out/render-$size-placeholder.log
     timeout 120 .devbin/gs-render -i $d/playbot_125k.ply --cameras $d/cameras.json --view 0 \
       --width "$w" --height "$h" --sphere --plane --frames 60 --backend placeholder \
       -o /tmp/filament-mesh-$size.png >"$log" 2>&1
     say "gs-render --sphere --plane $size, meshes only: exit $?"
-    grep -E "^frame time|rror" "$log" | cut -c1-400 | tee -a "$summary"
+    grep -E "^frame time|^presented|rror" "$log" | cut -c1-400 | tee -a "$summary"
   done
   cp /tmp/filament-1920x1080-zero-copy.png "$out/" 2>/dev/null
   [ -x .devbin/gs-bench ] || return

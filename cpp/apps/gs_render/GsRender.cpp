@@ -399,8 +399,10 @@ int main(int argc, char** argv) {
                    "centre; the default scene has its own place for the sphere)")
         ->check(kPositive);
     app.add_option("--frames", opt.frames,
-                   "With --filament/--sphere: render this many frames, each running the whole "
-                   "pipeline, and print the mean time of all but the first")
+                   "With --filament/--sphere/--plane: render this many frames read back like the "
+                   "output, each running the whole pipeline, then as many presented to a "
+                   "headless swap chain without readback (the viewer's frame); print the mean "
+                   "times of all but the first of each")
         ->check(CLI::Range(1, 100000))
         ->capture_default_str();
     app.add_option("--camera-path", opt.camera_path,

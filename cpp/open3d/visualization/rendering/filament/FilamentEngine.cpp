@@ -188,6 +188,16 @@ void FilamentEngine::MakeContextCurrent() const {
     }
 }
 
+HeadlessSwapChain::HeadlessSwapChain(const FilamentEngine& engine, int width, int height)
+    : engine_(engine),
+      swap_chain_(engine.GetEngine().createSwapChain(uint32_t(width), uint32_t(height), 0)) {
+    if (swap_chain_ == nullptr) {
+        core::ThrowError("Filament: no headless swap chain of {} x {}", width, height);
+    }
+}
+
+HeadlessSwapChain::~HeadlessSwapChain() { engine_.GetEngine().destroy(swap_chain_); }
+
 void FilamentEngine::FlushAndWait() const {
     if (core::HasWaitCallback()) {
         // A fence after the work so far, waited for in slices; flushAndWait then returns at

@@ -14,6 +14,7 @@
 struct GLFWwindow;
 namespace filament {
 class Engine;
+class SwapChain;
 namespace backend {
 class Platform;
 }  // namespace backend
@@ -70,6 +71,21 @@ private:
     std::unique_ptr<filament::backend::Platform> filament_platform_;  // EGL: outlives engine_
     filament::Engine* engine_ = nullptr;
     GlFunctions gl_;
+};
+
+/// A swap chain with no window (a pbuffer surface of width x height): frames presented
+/// offscreen, as the viewer presents them to its window, e.g. to time them.
+class HeadlessSwapChain {
+public:
+    HeadlessSwapChain(const FilamentEngine& engine, int width, int height);
+    ~HeadlessSwapChain();
+    HeadlessSwapChain(const HeadlessSwapChain&) = delete;
+    HeadlessSwapChain& operator=(const HeadlessSwapChain&) = delete;
+    filament::SwapChain* Get() const { return swap_chain_; }
+
+private:
+    const FilamentEngine& engine_;
+    filament::SwapChain* swap_chain_ = nullptr;
 };
 
 /// Why no Filament engine of `platform` can start here (GLX: no DISPLAY, no X server
