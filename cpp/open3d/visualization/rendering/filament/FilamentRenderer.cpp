@@ -102,8 +102,10 @@ void FilamentRenderer::StartFrame(filament::SwapChain* swap_chain) {
     frame_begun_ = true;
     swap_chain_ = swap_chain;
     drawn_.clear();
-    // The previous frame's GL work on the shared images is done before Vulkan reuses them.
-    engine_.FlushAndWait();
+    // No wait for the previous frame's GL work: the geometry stages submitted next touch no
+    // shared image, and Vulkan writes one only in a view's composite, after Draw's
+    // flushAndWait, which the previous frame's compose views precede in Filament's stream.
+    // Targets replaced for a new size flush before they free their images (~SplatTargets).
     Report(FrameEvent::kBeginFrame, nullptr);
 }
 

@@ -63,7 +63,7 @@ struct FrameRequest {
 
 /// The steps of a frame, in the order the seed's design fixes (reported to a listener).
 enum class FrameEvent {
-    kBeginFrame,     ///< previous GL work drained
+    kBeginFrame,     ///< a frame begun (the previous frame's GL work may still run)
     kGeometryStage,  ///< a view's splat geometry stage submitted
     kFilamentDraw,   ///< a view's meshes and points drawn, depth ready
     kComposite,      ///< a view's splats composited against that depth
