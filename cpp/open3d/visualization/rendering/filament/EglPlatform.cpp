@@ -8,6 +8,7 @@
 
 #include "open3d/core/Exception.h"
 #include "open3d/core/Logging.h"
+#include "open3d/visualization/rendering/filament/FilamentDriverThread.h"
 #include "open3d/visualization/rendering/filament/FilamentOpenGLPlatform.h"
 
 namespace open3d {
@@ -131,10 +132,11 @@ EGLSurface CreatePbuffer(EGLDisplay display, EGLConfig config, uint32_t width, u
 // context createDriver makes.
 class EglFilamentPlatform final : public filament::backend::OpenGLPlatform {
 public:
-    explicit EglFilamentPlatform(const EglContext& shared)
+    EglFilamentPlatform(const EglContext& shared, DriverThreadQueue& queue)
         : display_(shared.NativeDisplay()),
           config_(shared.NativeConfig()),
-          shared_(shared.NativeContext()) {}
+          shared_(shared.NativeContext()),
+          queue_(queue) {}
 
     int getOSVersion() const noexcept override { return 0; }
 
@@ -189,8 +191,13 @@ public:
     }
     void setPresentationTime(int64_t) noexcept override {}
 
-    // No platform fences: Filament then times with its own GL queries.
-    Fence* createFence() noexcept override { return nullptr; }
+    // Filament asks for a platform fence only for the hard fences RunOnDriverThread makes
+    // (FilamentDriverThread.h): each runs the next queued action, here on the driver thread
+    // at its place in the stream. No fence is made: nobody waits for these.
+    Fence* createFence() noexcept override {
+        queue_.RunNext();
+        return nullptr;
+    }
     void destroyFence(Fence*) noexcept override {}
     filament::backend::FenceStatus waitFence(Fence*, uint64_t) noexcept override {
         return filament::backend::FenceStatus::ERROR;
@@ -222,6 +229,7 @@ private:
     EGLContext shared_;
     EGLContext context_ = EGL_NO_CONTEXT;
     EGLSurface pbuffer_ = EGL_NO_SURFACE;
+    DriverThreadQueue& queue_;
 };
 
 }  // namespace
@@ -276,8 +284,9 @@ void* EglContext::GetProcAddress(const char* name) {
     return reinterpret_cast<void*>(eglGetProcAddress(name));
 }
 
-std::unique_ptr<filament::backend::Platform> CreateEglFilamentPlatform(const EglContext& context) {
-    return std::make_unique<EglFilamentPlatform>(context);
+std::unique_ptr<filament::backend::Platform> CreateEglFilamentPlatform(const EglContext& context,
+                                                                       DriverThreadQueue& queue) {
+    return std::make_unique<EglFilamentPlatform>(context, queue);
 }
 
 std::string EglUnavailableReason() {

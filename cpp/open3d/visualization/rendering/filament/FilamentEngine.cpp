@@ -17,6 +17,7 @@
 #include "open3d/core/Logging.h"
 #include "open3d/core/WaitCallback.h"
 #include "open3d/visualization/rendering/filament/EglPlatform.h"
+#include "open3d/visualization/rendering/filament/FilamentDriverThread.h"
 
 namespace open3d {
 namespace visualization {
@@ -118,7 +119,8 @@ FilamentEngine::FilamentEngine(GlPlatform platform) : platform_(ResolveGlPlatfor
 void FilamentEngine::StartEgl() {
     egl_ = std::make_unique<EglContext>();
     gl_ = GlFunctions::Load(&EglContext::GetProcAddress);
-    filament_platform_ = CreateEglFilamentPlatform(*egl_);
+    driver_queue_ = std::make_unique<DriverThreadQueue>();
+    filament_platform_ = CreateEglFilamentPlatform(*egl_, *driver_queue_);
     engine_ = filament::Engine::create(filament::Engine::Backend::OPENGL, filament_platform_.get(),
                                        egl_->NativeContext());
     if (engine_ == nullptr) {
@@ -197,6 +199,19 @@ HeadlessSwapChain::HeadlessSwapChain(const FilamentEngine& engine, int width, in
 }
 
 HeadlessSwapChain::~HeadlessSwapChain() { engine_.GetEngine().destroy(swap_chain_); }
+
+void FilamentEngine::Flush() const {
+    // Filament 1.9 has no Engine::flush; a fence's flushing wait with no time flushes alone.
+    filament::Fence* fence = engine_->createFence();
+    fence->wait(filament::Fence::Mode::FLUSH, 0);
+    engine_->destroy(fence);
+}
+
+bool FilamentEngine::RunOnDriverThread(std::function<void()> action) const {
+    if (!driver_queue_) return false;
+    rendering::RunOnDriverThread(*engine_, *driver_queue_, std::move(action));
+    return true;
+}
 
 void FilamentEngine::FlushAndWait() const {
     if (core::HasWaitCallback()) {

@@ -6,6 +6,7 @@
 // memory, host-copy textures) are Filament textures.
 #pragma once
 
+#include <functional>
 #include <memory>
 #include <string>
 
@@ -25,6 +26,7 @@ namespace visualization {
 namespace rendering {
 
 class EglContext;
+class DriverThreadQueue;
 
 /// How the OpenGL contexts are made. kGlx: an X server (GLFW windows, the viewer); kEgl:
 /// headless, offscreen only; kAuto: kGlx where DISPLAY is set, else kEgl. The environment
@@ -50,6 +52,12 @@ public:
     /// Engine::flushAndWait, calling the thread's core::WaitCallback while Filament's
     /// thread works (the viewer's window stays responsive during long frames).
     void FlushAndWait() const;
+    /// Hands the commands issued so far to Filament's thread without waiting for them.
+    void Flush() const;
+    /// Runs `action` on Filament's driver thread, its GL context current, after the commands
+    /// issued so far and before later ones (FilamentDriverThread.h), once flushed. Only on
+    /// EGL, whose platform is Open3D's: on GLX it returns false and nothing runs.
+    bool RunOnDriverThread(std::function<void()> action) const;
     /// The hidden window whose context shares objects with Filament's (null on EGL).
     GLFWwindow* GetSharedContextWindow() const { return window_; }
     /// kGlx or kEgl.
@@ -68,6 +76,7 @@ private:
     GlPlatform platform_;
     GLFWwindow* window_ = nullptr;
     std::unique_ptr<EglContext> egl_;
+    std::unique_ptr<DriverThreadQueue> driver_queue_;  // EGL: outlives filament_platform_
     std::unique_ptr<filament::backend::Platform> filament_platform_;  // EGL: outlives engine_
     filament::Engine* engine_ = nullptr;
     GlFunctions gl_;

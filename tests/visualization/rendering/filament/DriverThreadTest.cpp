@@ -1,0 +1,110 @@
+// FilamentEngine::RunOnDriverThread (FilamentDriverThread.h): on EGL an action runs on
+// Filament's driver thread with a GL context current, at its place in Filament's command
+// stream: after a texture upload issued before it (it reads the uploaded bytes back), and
+// before an action issued after it. On GLX nothing runs and the call says so.
+#include <gtest/gtest.h>
+
+#include <filament/Engine.h>
+#include <filament/Texture.h>
+
+#include <array>
+#include <cstdint>
+#include <thread>
+#include <vector>
+
+#include "TestUtility.h"
+#include "open3d/visualization/rendering/filament/FilamentEngine.h"
+
+namespace open3d {
+namespace tests {
+namespace {
+
+namespace rendering = visualization::rendering;
+
+TEST(FilamentDriverThread, ActionsRunInStreamOrderOnFilamentsThread) {
+    const std::string reason = rendering::FilamentUnavailableReason(rendering::GlPlatform::kEgl);
+    if (!reason.empty()) OPEN3D_SKIP_OR_FAIL_WHEN_UNAVAILABLE(reason);
+    rendering::FilamentEngine engine(rendering::GlPlatform::kEgl);
+    const rendering::GlFunctions& gl = engine.GetGl();
+    filament::Engine& e = engine.GetEngine();
+
+    // A 4x4 RGBA8 texture of ours, zeroed, then imported into Filament.
+    constexpr int kSide = 4;
+    constexpr size_t kBytes = kSide * kSide * 4;
+    GLuint id = 0;
+    gl.CreateTextures(GL_TEXTURE_2D, 1, &id);
+    gl.TextureStorage2D(id, 1, GL_RGBA8, kSide, kSide);
+    const std::vector<uint8_t> zeros(kBytes, 0);
+    gl.PixelStorei(GL_UNPACK_ALIGNMENT, 1);
+    gl.TextureSubImage2D(id, 0, 0, 0, kSide, kSide, GL_RGBA, GL_UNSIGNED_BYTE, zeros.data());
+    gl.Finish();
+    filament::Texture* texture = filament::Texture::Builder()
+                                     .width(kSide)
+                                     .height(kSide)
+                                     .levels(1)
+                                     .sampler(filament::Texture::Sampler::SAMPLER_2D)
+                                     .format(filament::Texture::InternalFormat::RGBA8)
+                                     .import(intptr_t(id))
+                                     .build(e);
+    ASSERT_NE(texture, nullptr);
+
+    // Filament uploads these bytes on its thread; the action, issued after, reads them back.
+    auto* upload = new std::vector<uint8_t>(kBytes);
+    for (size_t i = 0; i < kBytes; ++i) (*upload)[i] = uint8_t(7 * i + 1);
+    const std::vector<uint8_t> expected = *upload;
+    texture->setImage(
+        e, 0,
+        filament::Texture::PixelBufferDescriptor(
+            upload->data(), kBytes, filament::Texture::Format::RGBA, filament::Texture::Type::UBYTE,
+            [](void*, size_t, void* user) { delete static_cast<std::vector<uint8_t>*>(user); },
+            upload));
+
+    struct Seen {
+        std::thread::id thread;
+        bool context = false;
+        std::vector<uint8_t> bytes;
+    };
+    std::vector<int> order;
+    Seen first, second;
+    ASSERT_TRUE(engine.RunOnDriverThread([&] {
+        order.push_back(1);
+        first.thread = std::this_thread::get_id();
+        first.context = gl.GetString(GL_VERSION) != nullptr;
+        first.bytes.assign(kBytes, 0);
+        gl.PixelStorei(GL_PACK_ALIGNMENT, 1);
+        gl.GetTextureImage(id, 0, GL_RGBA, GL_UNSIGNED_BYTE, GLsizei(kBytes), first.bytes.data());
+    }));
+    ASSERT_TRUE(engine.RunOnDriverThread([&] {
+        order.push_back(2);
+        second.thread = std::this_thread::get_id();
+        second.context = gl.GetString(GL_VERSION) != nullptr;
+    }));
+    EXPECT_TRUE(order.empty()) << "an action ran before Filament's stream was flushed";
+    engine.FlushAndWait();
+
+    EXPECT_EQ(order, (std::vector<int>{1, 2}));
+    EXPECT_NE(first.thread, std::this_thread::get_id());
+    EXPECT_EQ(first.thread, second.thread);
+    EXPECT_TRUE(first.context);
+    EXPECT_TRUE(second.context);
+    EXPECT_EQ(first.bytes, expected) << "the action ran before the upload issued before it";
+
+    e.destroy(texture);
+    engine.FlushAndWait();
+    engine.MakeContextCurrent();
+    gl.DeleteTextures(1, &id);
+}
+
+TEST(FilamentDriverThread, GlxRunsNothing) {
+    const std::string reason = rendering::FilamentUnavailableReason(rendering::GlPlatform::kGlx);
+    if (!reason.empty()) OPEN3D_SKIP_OR_FAIL_WHEN_UNAVAILABLE(reason);
+    rendering::FilamentEngine engine(rendering::GlPlatform::kGlx);
+    bool ran = false;
+    EXPECT_FALSE(engine.RunOnDriverThread([&] { ran = true; }));
+    engine.FlushAndWait();
+    EXPECT_FALSE(ran);
+}
+
+}  // namespace
+}  // namespace tests
+}  // namespace open3d
