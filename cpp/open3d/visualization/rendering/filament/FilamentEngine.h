@@ -58,6 +58,8 @@ public:
     /// issued so far and before later ones (FilamentDriverThread.h), once flushed. Only on
     /// EGL, whose platform is Open3D's: on GLX it returns false and nothing runs.
     bool RunOnDriverThread(std::function<void()> action) const;
+    /// Whether RunOnDriverThread runs actions (EGL) or refuses them (GLX).
+    bool CanRunOnDriverThread() const { return driver_queue_ != nullptr; }
     /// The hidden window whose context shares objects with Filament's (null on EGL).
     GLFWwindow* GetSharedContextWindow() const { return window_; }
     /// kGlx or kEgl.

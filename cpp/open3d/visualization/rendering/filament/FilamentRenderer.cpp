@@ -172,7 +172,11 @@ FrameResult FilamentRenderer::Draw(FilamentView& view, const FrameRequest& reque
                                                      filament::backend::PixelDataFormat::RGBA,
                                                      filament::backend::PixelDataType::UBYTE));
     }
-    engine_.FlushAndWait();
+    // Zero-copy on EGL, Vulkan waits for GL's semaphore on the GPU; otherwise the host waits
+    // for Filament's GL work. A frame that may be cancelled waits on the host: a signal no
+    // composite waits for would be left pending.
+    const bool signalled = result.splats_drawn && !request.cancelled && targets.SignalMeshDrawn();
+    if (!signalled) engine_.FlushAndWait();
     result.times.filament_ms = core::MillisecondsSince(t);
     Report(FrameEvent::kFilamentDraw, &view);
     if (request.cancelled) {

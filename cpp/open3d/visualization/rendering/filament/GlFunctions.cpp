@@ -33,6 +33,7 @@ GlFunctions GlFunctions::Load(ProcLoader get) {
     LoadRequired(get, gl.GetIntegerv, "glGetIntegerv");
     LoadRequired(get, gl.GetError, "glGetError");
     LoadRequired(get, gl.Finish, "glFinish");
+    LoadRequired(get, gl.Flush, "glFlush");
     LoadRequired(get, gl.CreateTextures, "glCreateTextures");
     LoadRequired(get, gl.DeleteTextures, "glDeleteTextures");
     LoadRequired(get, gl.TextureStorage2D, "glTextureStorage2D");
@@ -46,6 +47,10 @@ GlFunctions GlFunctions::Load(ProcLoader get) {
     LoadProc(get, gl.TextureStorageMem2DEXT, "glTextureStorageMem2DEXT");
     LoadProc(get, gl.GetUnsignedBytevEXT, "glGetUnsignedBytevEXT");
     LoadProc(get, gl.GetUnsignedBytei_vEXT, "glGetUnsignedBytei_vEXT");
+    LoadProc(get, gl.GenSemaphoresEXT, "glGenSemaphoresEXT");
+    LoadProc(get, gl.DeleteSemaphoresEXT, "glDeleteSemaphoresEXT");
+    LoadProc(get, gl.ImportSemaphoreFdEXT, "glImportSemaphoreFdEXT");
+    LoadProc(get, gl.SignalSemaphoreEXT, "glSignalSemaphoreEXT");
     return gl;
 }
 
@@ -72,6 +77,11 @@ bool GlFunctions::HasMemoryObjectFd() const {
            CreateMemoryObjectsEXT && DeleteMemoryObjectsEXT && MemoryObjectParameterivEXT &&
            ImportMemoryFdEXT && TextureStorageMem2DEXT && GetUnsignedBytevEXT &&
            GetUnsignedBytei_vEXT;
+}
+
+bool GlFunctions::HasSemaphoreFd() const {
+    return HasExtension("GL_EXT_semaphore") && HasExtension("GL_EXT_semaphore_fd") &&
+           GenSemaphoresEXT && DeleteSemaphoresEXT && ImportSemaphoreFdEXT && SignalSemaphoreEXT;
 }
 
 std::array<uint8_t, 16> GlFunctions::DeviceUuid() const {

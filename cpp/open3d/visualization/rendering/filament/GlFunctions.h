@@ -37,6 +37,12 @@ struct GlFunctions {
     PFNGLTEXTURESTORAGEMEM2DEXTPROC TextureStorageMem2DEXT = nullptr;
     PFNGLGETUNSIGNEDBYTEVEXTPROC GetUnsignedBytevEXT = nullptr;
     PFNGLGETUNSIGNEDBYTEI_VEXTPROC GetUnsignedBytei_vEXT = nullptr;
+    // GL_EXT_semaphore, GL_EXT_semaphore_fd (null when the driver lacks them).
+    PFNGLGENSEMAPHORESEXTPROC GenSemaphoresEXT = nullptr;
+    PFNGLDELETESEMAPHORESEXTPROC DeleteSemaphoresEXT = nullptr;
+    PFNGLIMPORTSEMAPHOREFDEXTPROC ImportSemaphoreFdEXT = nullptr;
+    PFNGLSIGNALSEMAPHOREEXTPROC SignalSemaphoreEXT = nullptr;
+    decltype(&::glFlush) Flush = nullptr;
 
     /// glfwGetProcAddress or eglGetProcAddress.
     using ProcLoader = void* (*)(const char* name);
@@ -51,6 +57,8 @@ struct GlFunctions {
     bool HasExtension(const std::string& name) const;
     /// GL_EXT_memory_object + GL_EXT_memory_object_fd with all their entry points.
     bool HasMemoryObjectFd() const;
+    /// GL_EXT_semaphore + GL_EXT_semaphore_fd with all their entry points.
+    bool HasSemaphoreFd() const;
     /// GL_DEVICE_UUID_EXT of device 0 and GL_DRIVER_UUID_EXT (zeros without the extension).
     std::array<uint8_t, 16> DeviceUuid() const;
     std::array<uint8_t, 16> DriverUuid() const;

@@ -7,6 +7,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
+#include <future>
+#include <string>
 
 #include "open3d/core/Exception.h"
 #include "open3d/core/Logging.h"
@@ -120,6 +123,59 @@ void SplatTargets::CreateZeroCopy(GaussianSplatBackend& backend) {
         engine_.GetEngine(), gl_mesh_color_, width_, height_,
         filament::Texture::InternalFormat::RGBA8,
         filament::Texture::Usage::COLOR_ATTACHMENT | filament::Texture::Usage::SAMPLEABLE);
+    SetUpGpuHandover(backend);
+}
+
+void SplatTargets::SetUpGpuHandover(GaussianSplatBackend& backend) {
+    const GlFunctions& gl = engine_.GetGl();
+    const char* env = std::getenv("OPEN3D_GL_VK_SEMAPHORES");
+    std::string why;
+    if (env != nullptr && std::string(env) == "0") {
+        why = "OPEN3D_GL_VK_SEMAPHORES=0";
+    } else if (!engine_.CanRunOnDriverThread()) {
+        why = "GLX: Filament's own platform gives no place on its thread for the signal";
+    } else if (!vulkan::QueryInteropSupport(backend).external_semaphore_fd) {
+        why = "the Vulkan device cannot export semaphores (VK_KHR_external_semaphore_fd)";
+    } else if (!gl.HasSemaphoreFd()) {
+        why = "the OpenGL driver lacks GL_EXT_semaphore_fd";
+    }
+    if (why.empty()) {
+        const int fd = interop_->ExportMeshDrawnSemaphore();
+        gl.GenSemaphoresEXT(1, &gl_mesh_drawn_);
+        // GL owns the descriptor after a successful import.
+        gl.ImportSemaphoreFdEXT(gl_mesh_drawn_, GL_HANDLE_TYPE_OPAQUE_FD_EXT, fd);
+        gl.CheckError("importing the mesh-drawn semaphore (glImportSemaphoreFdEXT)");
+        gl.Finish();
+    }
+    static bool logged = false;
+    if (!logged) {
+        logged = true;
+        if (why.empty()) {
+            core::LogInfo("GL hands the mesh view to Vulkan with a semaphore: no host wait");
+        } else {
+            core::LogInfo("GL hands the mesh view to Vulkan through a host wait: {}", why);
+        }
+    }
+}
+
+bool SplatTargets::SignalMeshDrawn() {
+    if (gl_mesh_drawn_ == 0) return false;
+    const GlFunctions gl = engine_.GetGl();
+    const GLuint semaphore = gl_mesh_drawn_;
+    const GLuint textures[2] = {gl_depth_, gl_mesh_color_};
+    std::promise<void> flushed;
+    std::future<void> done = flushed.get_future();
+    // The composite acquires both images in GENERAL layout (GaussianSplatInterop.cpp).
+    engine_.RunOnDriverThread([gl, semaphore, textures, &flushed] {
+        const GLenum layouts[2] = {GL_LAYOUT_GENERAL_EXT, GL_LAYOUT_GENERAL_EXT};
+        gl.SignalSemaphoreEXT(semaphore, 0, nullptr, 2, textures, layouts);
+        gl.Flush();  // a signal reaches the GPU only when flushed
+        flushed.set_value();
+    });
+    engine_.Flush();
+    done.wait();  // Filament's thread issued what came before: host work, not GPU time
+    mesh_drawn_signaled_ = true;
+    return true;
 }
 
 void SplatTargets::CreateHostCopy() {
@@ -158,6 +214,7 @@ SplatTargets::~SplatTargets() {
     const GLuint names[3] = {gl_color_, gl_depth_, gl_mesh_color_};
     gl.DeleteTextures(gl_mesh_color_ != 0 ? 3 : 2, names);
     if (gl_memory_[0] != 0) gl.DeleteMemoryObjectsEXT(3, gl_memory_);
+    if (gl_mesh_drawn_ != 0) gl.DeleteSemaphoresEXT(1, &gl_mesh_drawn_);
     gl.Finish();
     interop_.reset();
 }
@@ -176,6 +233,8 @@ void SplatTargets::Composite(GaussianSplatBackend& backend, const SplatComposite
     vk.read_depth = request.read_depth;
     vk.depth_near = request.depth_near;
     vk.depth_far = request.depth_far;
+    vk.wait_mesh_drawn = mesh_drawn_signaled_;
+    mesh_drawn_signaled_ = false;  // one wait per signal
     vulkan::InteropFrame out;
     vulkan::RenderCompositeToInterop(backend, *interop_, vk, out);
     frame.color = std::move(out.color);

@@ -92,8 +92,18 @@ public:
     /// Its GL texture name (0 without zero-copy), for tests that read it from GL.
     uint32_t GetMeshColorGlName() const { return gl_mesh_color_; }
 
+    /// GPU-side hand-over from GL to Vulkan: whether GL signals a semaphore after the mesh
+    /// view that the composite waits for (zero-copy on EGL where Vulkan exports and GL
+    /// imports semaphores, unless OPEN3D_GL_VK_SEMAPHORES=0), instead of the host waiting.
+    bool HasGpuHandover() const { return gl_mesh_drawn_ != 0; }
+    /// After Filament's mesh view was issued: GL signals "mesh drawn" on Filament's thread
+    /// after it, and this returns once that signal is flushed to the GPU (no wait for the GPU
+    /// work). The next Composite waits for it on the GPU. False, and nothing is signalled,
+    /// without HasGpuHandover(): then wait for Filament on the host (flushAndWait).
+    bool SignalMeshDrawn();
+
     /// Composite stage of the backend's last geometry stage into the colour image, after Filament
-    /// drew the mesh view and finished (flushAndWait).
+    /// drew the mesh view and either finished (flushAndWait) or SignalMeshDrawn.
     void Composite(GaussianSplatBackend& backend, const SplatCompositeRequest& request,
                    SplatFrame& frame);
 
@@ -105,6 +115,8 @@ private:
     t::geometry::Image ReadSceneDepth(float scene_near);
     void CreateZeroCopy(GaussianSplatBackend& backend);
     void CreateHostCopy();
+    // Imports the "mesh drawn" semaphore where both sides can; logs the choice once.
+    void SetUpGpuHandover(GaussianSplatBackend& backend);
     // Wraps the two GL textures (complete, finished) as Filament textures.
     void ImportIntoFilament();
     void CompositeHostCopy(GaussianSplatBackend& backend, const SplatCompositeRequest& request,
@@ -116,6 +128,8 @@ private:
     std::unique_ptr<vulkan::InteropTargets> interop_;
     uint32_t gl_color_ = 0, gl_depth_ = 0, gl_mesh_color_ = 0;  // GL texture names
     uint32_t gl_memory_[3] = {0, 0, 0};  // GL memory objects (zero-copy only)
+    uint32_t gl_mesh_drawn_ = 0;         // GL semaphore (GPU hand-over only)
+    bool mesh_drawn_signaled_ = false;   // signalled, not yet waited for by a composite
     filament::Texture* color_texture_ = nullptr;
     filament::Texture* depth_texture_ = nullptr;
     filament::Texture* mesh_color_texture_ = nullptr;  // zero-copy only

@@ -117,6 +117,8 @@ protected:
                                                             bool export_enabled = true) {
         vulkan::BorrowedVulkanHandles handles = BorrowedHandles();
         handles.external_memory_fd_enabled = export_enabled;
+        handles.external_semaphore_fd_enabled =
+            export_enabled && handles.external_semaphore_fd_enabled;
         return std::make_unique<GaussianSplatVulkanBackend>(
             vulkan::VulkanContext::CreateFromBorrowed(handles), entry_capacity);
     }
@@ -183,6 +185,34 @@ TEST_F(Interop, ExportsGiveNewDescriptorsOfWholeAllocations) {
     EXPECT_GE(depth.size, uint64_t(kWidth) * kHeight * 4);  // D32
     EXPECT_EQ(color_again.size, color.size);
     for (const auto* memory : {&color, &depth, &color_again}) EXPECT_EQ(close(memory->fd), 0);
+}
+
+// The "mesh drawn" semaphore where the device exports semaphores (NVIDIA): new descriptors
+// of one semaphore; where it cannot (lavapipe), an error that names the extension. Either way
+// a composite told to wait for a semaphore never exported is refused instead of hanging.
+TEST_F(Interop, MeshDrawnSemaphoreIsExportedWhereTheDeviceCan) {
+    OPEN3D_REQUIRE_DATA(kScene);
+    auto backend = PlaybotBackend();
+    const bool can = Context().SupportsExternalSemaphoreFd();
+    EXPECT_EQ(vulkan::QueryInteropSupport(*backend).external_semaphore_fd, can);
+    InteropTargets targets(*backend, kWidth, kHeight);
+    InteropCompositeRequest request;
+    request.wait_mesh_drawn = true;
+    InteropFrame frame;
+    ExpectErrorContaining([&] { RenderCompositeToInterop(*backend, targets, request, frame); },
+                          "never exported");
+    if (!can) {
+        ExpectErrorContaining([&] { targets.ExportMeshDrawnSemaphore(); },
+                              "cannot export semaphores (VK_KHR_external_semaphore_fd");
+        return;
+    }
+    const int a = targets.ExportMeshDrawnSemaphore();
+    const int b = targets.ExportMeshDrawnSemaphore();
+    ASSERT_GE(a, 0);
+    ASSERT_GE(b, 0);
+    EXPECT_NE(a, b);
+    EXPECT_EQ(close(a), 0);
+    EXPECT_EQ(close(b), 0);
 }
 
 TEST_F(Interop, CompositeEqualsTheReadbackPathWithinHalfPrecision) {

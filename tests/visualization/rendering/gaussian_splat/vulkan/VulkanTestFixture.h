@@ -54,6 +54,7 @@ protected:
         handles.transfer_queue = Context().GetTransferQueue();
         handles.transfer_queue_family_index = Context().GetTransferQueueFamilyIndex();
         handles.host_memory_import_enabled = Context().CanImportHostMemory();
+        handles.external_semaphore_fd_enabled = Context().SupportsExternalSemaphoreFd();
         return handles;
     }
     static visualization::rendering::vulkan::CommandPool& Pool() { return *pool_; }

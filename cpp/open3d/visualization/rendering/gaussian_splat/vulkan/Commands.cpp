@@ -85,9 +85,13 @@ void SubmitToQueue(VkQueue queue, VkCommandBuffer cmd, VkFence fence, VkSemaphor
     CheckVk(vkQueueSubmit2(queue, 1, &submit, fence), "vkQueueSubmit2");
 }
 
-UniqueSemaphore CreateBinarySemaphore(const VulkanContext& context) {
+UniqueSemaphore CreateBinarySemaphore(const VulkanContext& context, bool exportable_fd) {
     VkSemaphoreCreateInfo info =
         MakeInfo<VkSemaphoreCreateInfo>(VK_STRUCTURE_TYPE_SEMAPHORE_CREATE_INFO);
+    VkExportSemaphoreCreateInfo export_info =
+        MakeInfo<VkExportSemaphoreCreateInfo>(VK_STRUCTURE_TYPE_EXPORT_SEMAPHORE_CREATE_INFO);
+    export_info.handleTypes = VK_EXTERNAL_SEMAPHORE_HANDLE_TYPE_OPAQUE_FD_BIT;
+    if (exportable_fd) info.pNext = &export_info;
     VkSemaphore semaphore = VK_NULL_HANDLE;
     CheckVk(vkCreateSemaphore(context.GetDevice(), &info, nullptr, &semaphore),
             "vkCreateSemaphore");

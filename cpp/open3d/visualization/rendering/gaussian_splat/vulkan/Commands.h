@@ -77,8 +77,9 @@ void Submit(const VulkanContext& context, VkCommandBuffer cmd, VkFence fence);
 void SubmitToQueue(VkQueue queue, VkCommandBuffer cmd, VkFence fence, VkSemaphore wait,
                    VkPipelineStageFlags2 wait_stages, VkSemaphore signal);
 
-/// A binary semaphore.
-UniqueSemaphore CreateBinarySemaphore(const VulkanContext& context);
+/// A binary semaphore; with `exportable_fd`, one whose payload vkGetSemaphoreFdKHR can export
+/// as an OPAQUE_FD (the context must support it).
+UniqueSemaphore CreateBinarySemaphore(const VulkanContext& context, bool exportable_fd = false);
 
 /// Waits for `fence` (no timeout: a hung GPU surfaces as VK_ERROR_DEVICE_LOST).
 void Wait(const VulkanContext& context, VkFence fence);

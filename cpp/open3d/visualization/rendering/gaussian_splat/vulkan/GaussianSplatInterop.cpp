@@ -157,6 +157,7 @@ struct InteropTargets::Impl {
     Image merged_linear, merged_normalized;
     Buffer linear_readback, normalized_readback;
     Buffer depth_upload;
+    UniqueSemaphore mesh_drawn;  // exportable; made by ExportMeshDrawnSemaphore
 };
 
 namespace {
@@ -171,6 +172,11 @@ public:
         if (request.use_scene_depth && !(request.scene_near > 0.f)) {
             core::ThrowError("Gaussian splat interop: scene_near must be > 0, not {}",
                              request.scene_near);
+        }
+        if (request.wait_mesh_drawn && !targets.mesh_drawn) {
+            core::ThrowError(
+                "Gaussian splat interop: a composite waits for the mesh-drawn semaphore, which "
+                "was never exported");
         }
         if (request.read_depth && !(request.depth_far > request.depth_near)) {
             core::ThrowError("Gaussian splat interop: depth range [{}, {}] is empty",
@@ -187,6 +193,12 @@ public:
     }
 
     const Image& ColorTarget() const override { return targets_.color; }
+
+    VkSemaphore TakeWaitSemaphore() override {
+        if (!request_.wait_mesh_drawn || waited_) return VK_NULL_HANDLE;
+        waited_ = true;  // a binary semaphore: one wait per signal (a retried frame waits none)
+        return targets_.mesh_drawn.Get();
+    }
 
     void AdjustParams(CompositeParams& params) const override {
         params.background = {0.f, 0.f, 0.f};  // premultiplied overlay: Filament has the background
@@ -348,6 +360,7 @@ private:
     const InteropCompositeRequest& request_;
     InteropFrame& out_;
     SceneDepthTexture scene_;
+    bool waited_ = false;
 };
 
 }  // namespace
@@ -358,6 +371,7 @@ InteropSupport QueryInteropSupport(const GaussianSplatBackend& backend) {
     if (vulkan == nullptr) return support;
     const VulkanContext& context = vulkan->GetContext();
     support.external_memory_fd = context.SupportsExternalMemoryFd();
+    support.external_semaphore_fd = context.SupportsExternalSemaphoreFd();
     support.device_uuid = context.GetDeviceInfo().device_uuid;
     support.driver_uuid = context.GetDeviceInfo().driver_uuid;
     return support;
@@ -395,6 +409,25 @@ ExportedImageMemory InteropTargets::ExportDepth() {
 ExportedImageMemory InteropTargets::ExportMeshColor() {
     const ImageMemoryFd memory = impl_->mesh_color.ExportFd(impl_->context);
     return {memory.fd, memory.size, true};
+}
+
+int InteropTargets::ExportMeshDrawnSemaphore() {
+    Impl& impl = *impl_;
+    if (!impl.context.SupportsExternalSemaphoreFd()) {
+        core::ThrowError(
+            "Gaussian splat interop: the Vulkan device {} cannot export semaphores ({} is not "
+            "enabled)",
+            impl.context.GetDeviceInfo().name, VK_KHR_EXTERNAL_SEMAPHORE_FD_EXTENSION_NAME);
+    }
+    if (!impl.mesh_drawn) impl.mesh_drawn = CreateBinarySemaphore(impl.context, true);
+    VkSemaphoreGetFdInfoKHR info =
+        MakeInfo<VkSemaphoreGetFdInfoKHR>(VK_STRUCTURE_TYPE_SEMAPHORE_GET_FD_INFO_KHR);
+    info.semaphore = impl.mesh_drawn.Get();
+    info.handleType = VK_EXTERNAL_SEMAPHORE_HANDLE_TYPE_OPAQUE_FD_BIT;
+    int fd = -1;
+    CheckVk(impl.context.GetSemaphoreFd()(impl.context.GetDevice(), &info, &fd),
+            "vkGetSemaphoreFdKHR");
+    return fd;
 }
 
 void InteropTargets::UploadDepth(const float* reversed_z) {

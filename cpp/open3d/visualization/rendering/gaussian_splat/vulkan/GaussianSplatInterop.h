@@ -4,8 +4,10 @@
 // and the mesh colour (RGBA8, written by Filament, read by the blend over it) live in
 // Vulkan memory exported as POSIX file descriptors, which GL imports
 // with GL_EXT_memory_object_fd. This header has no Vulkan types so the Filament layer can
-// use it (docs/DESIGN.md "Layers"); synchronisation is on the CPU (fence waits), because lavapipe
-// has no external semaphores (docs/environment-notes.md).
+// use it (docs/DESIGN.md "Layers"). GL's mesh view reaches the composite through a semaphore
+// GL signals where both sides can export and import one (NVIDIA), else through a host wait
+// (lavapipe has no semaphore export, llvmpipe no GL_EXT_semaphore); the composite's results
+// reach GL through the host's fence wait.
 #pragma once
 
 #include <array>
@@ -24,6 +26,9 @@ namespace vulkan {
 struct InteropSupport {
     /// The backend is the Vulkan backend and its device has VK_KHR_external_memory_fd.
     bool external_memory_fd = false;
+    /// ... and VK_KHR_external_semaphore_fd: GL can signal a semaphore that the composite
+    /// waits for (InteropTargets::ExportMeshDrawnSemaphore).
+    bool external_semaphore_fd = false;
     /// VkPhysicalDeviceIDProperties: GL must report the same UUIDs
     /// (GL_DEVICE_UUID_EXT / GL_DRIVER_UUID_EXT) before it may import the memory.
     std::array<uint8_t, 16> device_uuid{};
@@ -74,6 +79,13 @@ public:
     /// RGBA8 unorm: the mesh view's colour attachment (row 0 = GL's bottom row), read by the
     /// blend over it (InteropCompositeRequest::blend_over_mesh).
     ExportedImageMemory ExportMeshColor();
+    /// A descriptor (OPAQUE_FD, the caller owns it as above) of the binary semaphore "GL drew
+    /// the mesh view": GL imports it (GL_EXT_semaphore_fd) and signals it after its draw, with
+    /// the depth and mesh colour in GENERAL layout; a composite with
+    /// InteropCompositeRequest::wait_mesh_drawn waits for it on the GPU instead of the host
+    /// waiting for GL. Made on the first call; every call exports the same semaphore.
+    /// Throws core::Open3DError when the device cannot export semaphores.
+    int ExportMeshDrawnSemaphore();
 
     /// Writes the depth image from the host: `reversed_z` holds width * height floats in GL
     /// row order (bottom row first), stored as given. For tests and for drivers where GL
@@ -95,6 +107,10 @@ struct InteropCompositeRequest {
     bool use_scene_depth = false;
     /// Near plane of the projection that wrote the depth: z_view = scene_near / d.
     float scene_near = 0.1f;
+    /// The submission waits for the "mesh drawn" semaphore (ExportMeshDrawnSemaphore), which
+    /// GL signalled once since the last composite that waited for it; without it the caller
+    /// must have waited for GL on the host.
+    bool wait_mesh_drawn = false;
     /// Copy the splat colour to InteropFrame::color (offscreen rendering).
     bool read_color = false;
     /// Blend the splat colour over the mesh colour image on the GPU into InteropFrame::blended

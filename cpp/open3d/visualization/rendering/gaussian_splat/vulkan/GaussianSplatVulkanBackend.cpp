@@ -519,7 +519,8 @@ RenderStats GaussianSplatVulkanBackend::RenderComposite(CompositeSink& sink) {
     UniqueFence fence = CreateFence(*context_);
     const double record_ms = core::MillisecondsSince(record_start);
     const auto submit_start = std::chrono::steady_clock::now();
-    Submit(*context_, cmd, fence.Get());
+    SubmitToQueue(context_->GetQueue(), cmd, fence.Get(), sink.TakeWaitSemaphore(),
+                  VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_NULL_HANDLE);
     const double submit_ms = core::MillisecondsSince(submit_start);
     const auto wait_start = std::chrono::steady_clock::now();
     Wait(*context_, fence.Get());

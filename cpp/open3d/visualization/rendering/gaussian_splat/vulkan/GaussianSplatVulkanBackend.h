@@ -79,6 +79,10 @@ public:
     virtual void RecordAfter(const Frame& frame) = 0;
     /// After the frame's fence: reads the results.
     virtual void ReadBack() = 0;
+    /// A semaphore the frame's submission waits for before anything runs (another API's
+    /// signal, e.g. GL's), or VK_NULL_HANDLE. Asked once per submission; a binary semaphore
+    /// must be handed out once per signal.
+    virtual VkSemaphore TakeWaitSemaphore() { return VK_NULL_HANDLE; }
 };
 
 class GaussianSplatVulkanBackend final : public GaussianSplatBackend {

@@ -321,13 +321,17 @@ std::unique_ptr<VulkanContext> VulkanContext::CreateHeadless(const VulkanContext
         core::ThrowError("Vulkan: no usable device.{}\n{}", rejected, kInstallHint);
     }
     const DeviceQuery chosen(best);
-    context->InitDevice(best, *chosen.FindQueueFamily(),
-                        chosen.HasExtension(VK_KHR_EXTERNAL_MEMORY_FD_EXTENSION_NAME),
+    OptionalExtensions optional;
+    optional.external_memory_fd = chosen.HasExtension(VK_KHR_EXTERNAL_MEMORY_FD_EXTENSION_NAME);
+    optional.external_semaphore_fd =
+        optional.external_memory_fd &&
+        chosen.HasExtension(VK_KHR_EXTERNAL_SEMAPHORE_FD_EXTENSION_NAME);
+    optional.host_memory_import = EnvironmentSwitchOn("OPEN3D_VULKAN_HOST_IMPORT") &&
+                                  chosen.HasExtension(VK_EXT_EXTERNAL_MEMORY_HOST_EXTENSION_NAME);
+    context->InitDevice(best, *chosen.FindQueueFamily(), optional,
                         EnvironmentSwitchOn("OPEN3D_VULKAN_TRANSFER_QUEUE")
                             ? chosen.FindTransferFamily()
-                            : std::nullopt,
-                        EnvironmentSwitchOn("OPEN3D_VULKAN_HOST_IMPORT") &&
-                            chosen.HasExtension(VK_EXT_EXTERNAL_MEMORY_HOST_EXTENSION_NAME));
+                            : std::nullopt);
     context->LimitWorkgroupsX(options.max_workgroups_x);
     return context;
 }
@@ -365,9 +369,11 @@ std::unique_ptr<VulkanContext> VulkanContext::CreateFromBorrowed(
         context->transfer_queue_ = handles.transfer_queue;
         context->transfer_family_ = handles.transfer_queue_family_index;
     }
-    context->InitDevice(handles.physical_device, handles.queue_family_index,
-                        handles.external_memory_fd_enabled, std::nullopt,
-                        handles.host_memory_import_enabled);
+    OptionalExtensions optional;
+    optional.external_memory_fd = handles.external_memory_fd_enabled;
+    optional.external_semaphore_fd = handles.external_semaphore_fd_enabled;
+    optional.host_memory_import = handles.host_memory_import_enabled;
+    context->InitDevice(handles.physical_device, handles.queue_family_index, optional);
     context->LimitWorkgroupsX(handles.max_workgroups_x);
     return context;
 }
@@ -378,16 +384,21 @@ void VulkanContext::LimitWorkgroupsX(uint32_t max_workgroups_x) {
 }
 
 void VulkanContext::InitDevice(VkPhysicalDevice physical_device, uint32_t queue_family_index,
-                               bool external_memory_fd, std::optional<uint32_t> transfer_family,
-                               bool host_memory_import) {
+                               const OptionalExtensions& optional,
+                               std::optional<uint32_t> transfer_family) {
     physical_device_ = physical_device;
     DeviceQuery query(physical_device);
     if (owns_handles_) {
         // Memory export (zero-copy sharing with GL) is optional: enabled when present.
         std::vector<const char*> extensions(std::begin(kRequiredDeviceExtensions),
                                             std::end(kRequiredDeviceExtensions));
-        if (external_memory_fd) extensions.push_back(VK_KHR_EXTERNAL_MEMORY_FD_EXTENSION_NAME);
-        if (host_memory_import) {
+        if (optional.external_memory_fd) {
+            extensions.push_back(VK_KHR_EXTERNAL_MEMORY_FD_EXTENSION_NAME);
+        }
+        if (optional.external_semaphore_fd) {
+            extensions.push_back(VK_KHR_EXTERNAL_SEMAPHORE_FD_EXTENSION_NAME);
+        }
+        if (optional.host_memory_import) {
             extensions.push_back(VK_EXT_EXTERNAL_MEMORY_HOST_EXTENSION_NAME);
         }
         const float priority = 1.0f;
@@ -483,7 +494,7 @@ void VulkanContext::InitDevice(VkPhysicalDevice physical_device, uint32_t queue_
     std::copy(std::begin(query.ids.driverUUID), std::end(query.ids.driverUUID),
               info_.driver_uuid.begin());
 
-    if (host_memory_import) {
+    if (optional.host_memory_import) {
         VkPhysicalDeviceExternalMemoryHostPropertiesEXT host_import =
             MakeInfo<VkPhysicalDeviceExternalMemoryHostPropertiesEXT>(
                 VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_EXTERNAL_MEMORY_HOST_PROPERTIES_EXT);
@@ -493,12 +504,12 @@ void VulkanContext::InitDevice(VkPhysicalDevice physical_device, uint32_t queue_
         vkGetPhysicalDeviceProperties2(physical_device, &host_properties);
         host_import_alignment_ = host_import.minImportedHostPointerAlignment;
     }
-    LoadDeviceFunctions(external_memory_fd, host_memory_import);
+    LoadDeviceFunctions(optional);
     ReportDevice();
 }
 
-void VulkanContext::LoadDeviceFunctions(bool external_memory_fd, bool host_memory_import) {
-    if (host_memory_import) {
+void VulkanContext::LoadDeviceFunctions(const OptionalExtensions& optional) {
+    if (optional.host_memory_import) {
         get_host_pointer_properties_ = reinterpret_cast<PFN_vkGetMemoryHostPointerPropertiesEXT>(
             vkGetDeviceProcAddr(device_, "vkGetMemoryHostPointerPropertiesEXT"));
     }
@@ -510,7 +521,16 @@ void VulkanContext::LoadDeviceFunctions(bool external_memory_fd, bool host_memor
             "created with {}",
             VK_KHR_PUSH_DESCRIPTOR_EXTENSION_NAME);
     }
-    if (external_memory_fd) {
+    if (optional.external_semaphore_fd) {
+        get_semaphore_fd_ = reinterpret_cast<PFN_vkGetSemaphoreFdKHR>(
+            vkGetDeviceProcAddr(device_, "vkGetSemaphoreFdKHR"));
+        if (get_semaphore_fd_ == nullptr) {
+            core::ThrowError(
+                "Vulkan: vkGetSemaphoreFdKHR is unavailable although {} was reported enabled",
+                VK_KHR_EXTERNAL_SEMAPHORE_FD_EXTENSION_NAME);
+        }
+    }
+    if (optional.external_memory_fd) {
         get_memory_fd_ = reinterpret_cast<PFN_vkGetMemoryFdKHR>(
             vkGetDeviceProcAddr(device_, "vkGetMemoryFdKHR"));
         if (get_memory_fd_ == nullptr) {
@@ -524,14 +544,15 @@ void VulkanContext::LoadDeviceFunctions(bool external_memory_fd, bool host_memor
 void VulkanContext::ReportDevice() const {
     core::LogInfo(
         "Vulkan device: {} ({}), driver {} [{}], Vulkan {}, subgroup size {} (range {}..{}), "
-        "{} KiB shared memory, queue family {}{}, memory export {}, host import {}, validation "
+        "{} KiB shared memory, queue family {}{}, memory export {}, semaphore export {}, host "
+        "import {}, validation "
         "{}{}",
         info_.name, info_.type, info_.driver_name, info_.driver_info,
         VersionString(info_.api_version), info_.subgroup_size, info_.min_subgroup_size,
         info_.max_subgroup_size, info_.max_compute_shared_memory / 1024, info_.queue_family_index,
         HasTransferQueue() ? fmt::format(" (+ transfer family {})", transfer_family_) : "",
-        SupportsExternalMemoryFd() ? "on" : "off", CanImportHostMemory() ? "on" : "off",
-        IsValidationEnabled() ? "on" : "off",
+        SupportsExternalMemoryFd() ? "on" : "off", SupportsExternalSemaphoreFd() ? "on" : "off",
+        CanImportHostMemory() ? "on" : "off", IsValidationEnabled() ? "on" : "off",
         owns_handles_ ? "" : ", handles borrowed from the host application");
 }
 

@@ -51,6 +51,9 @@ struct BorrowedVulkanHandles {
     /// The host created the device with VK_KHR_external_memory_fd (a context cannot ask a
     /// device which extensions it was created with): enables exporting image memory.
     bool external_memory_fd_enabled = false;
+    /// The host created the device with VK_KHR_external_semaphore_fd: enables exporting
+    /// semaphores (GL waits for none of ours; ours wait for GL's, docs/filament.md).
+    bool external_semaphore_fd_enabled = false;
     /// The host created the device with VK_EXT_external_memory_host: enables importing
     /// BatchHostMemory (the device then copies batch colours straight into it).
     bool host_memory_import_enabled = false;
@@ -153,6 +156,12 @@ public:
     /// vkGetMemoryFdKHR of this device; nullptr unless SupportsExternalMemoryFd().
     PFN_vkGetMemoryFdKHR GetMemoryFd() const { return get_memory_fd_; }
 
+    /// True when VK_KHR_external_semaphore_fd is enabled: headless contexts enable it with
+    /// memory export whenever the device has both; borrowed ones when the host did.
+    bool SupportsExternalSemaphoreFd() const { return get_semaphore_fd_ != nullptr; }
+    /// vkGetSemaphoreFdKHR of this device; nullptr unless SupportsExternalSemaphoreFd().
+    PFN_vkGetSemaphoreFdKHR GetSemaphoreFd() const { return get_semaphore_fd_; }
+
     /// True when VK_EXT_external_memory_host is enabled: host allocations can back buffers
     /// (a batch's colours copied by the device straight into the caller's memory). Headless
     /// contexts enable it whenever the device has it, unless the environment sets
@@ -172,10 +181,16 @@ private:
     VulkanContext();
     // VulkanContextOptions::max_workgroups_x (0: nothing changes).
     void LimitWorkgroupsX(uint32_t max_workgroups_x);
+    // The optional device extensions a device is created (or was, when borrowed) with.
+    struct OptionalExtensions {
+        bool external_memory_fd = false;
+        bool external_semaphore_fd = false;
+        bool host_memory_import = false;
+    };
     void InitDevice(VkPhysicalDevice physical_device, uint32_t queue_family_index,
-                    bool external_memory_fd, std::optional<uint32_t> transfer_family = std::nullopt,
-                    bool host_memory_import = false);
-    void LoadDeviceFunctions(bool external_memory_fd, bool host_memory_import);
+                    const OptionalExtensions& optional,
+                    std::optional<uint32_t> transfer_family = std::nullopt);
+    void LoadDeviceFunctions(const OptionalExtensions& optional);
     void ReportDevice() const;
 
     bool owns_handles_ = false;
@@ -192,6 +207,7 @@ private:
     DeviceMemoryBudget memory_budget_;
     PFN_vkCmdPushDescriptorSetKHR push_descriptor_set_ = nullptr;
     PFN_vkGetMemoryFdKHR get_memory_fd_ = nullptr;
+    PFN_vkGetSemaphoreFdKHR get_semaphore_fd_ = nullptr;
     PFN_vkGetMemoryHostPointerPropertiesEXT get_host_pointer_properties_ = nullptr;
     uint64_t host_import_alignment_ = 0;
     VulkanDeviceInfo info_;
