@@ -73,30 +73,39 @@ say "validation: ${OPEN3D_VULKAN_VALIDATION:-on}"
 suites() {
   export LD_LIBRARY_PATH=$PWD/.devlibs OPEN3D_DATA_DIR=$PWD/shared/data
   local name
-  for name in tests_filament_rendering tests_visualizer; do
+  # The Vulkan suite's interop tests: memory and semaphore export on the GPU.
+  for name in tests_filament_rendering tests_visualizer tests_gaussian_splat_vulkan; do
     [ -x ".devbin/$name" ] || { say "$name: not carried"; continue; }
-    timeout "${SUITE_TIMEOUT:-300}" ".devbin/$name" --gtest_brief=1 >"$out/$name.log" 2>&1
+    local filter='*'
+    [ "$name" = tests_gaussian_splat_vulkan ] && filter='Interop.*'
+    timeout "${SUITE_TIMEOUT:-300}" ".devbin/$name" --gtest_brief=1 --gtest_filter="$filter" \
+      >"$out/$name.log" 2>&1
     say "$name: exit $?"
-    grep -E "^\[  (PASSED|FAILED|SKIPPED) |^\[==========\]|Splat images|Vulkan device|rror" \
+    grep -E "^\[  (PASSED|FAILED|SKIPPED) |^\[==========\]|Splat images|hands the mesh|Vulkan device|rror" \
       "$out/$name.log" | sort | uniq -c | sort -rn | head -12 | cut -c1-400 | tee -a "$summary"
   done
 }
 bench() {
   export LD_LIBRARY_PATH=$PWD/.devlibs OPEN3D_VULKAN_VALIDATION=0
-  local d=shared/data/playbot size w h sharing log
+  local d=shared/data/playbot size w h variant sharing semaphores log
   [ -x .devbin/gs-render ] || { say "gs-render: not carried"; return; }
   for size in 1920x1080 3840x2160; do
     w=${size%x*} h=${size#*x}
     # The integrated frame (splats, a lit sphere, Filament's mesh view, the depth-tested
     # composite, the offscreen read and blend), zero-copy and host copies; then Filament's own
     # frame (placeholder backend: no splats) and the splats alone (gs-bench, GPU and in flight).
-    for sharing in zero-copy host-copy; do
-      log=$out/render-$size-$sharing.log
-      OPEN3D_SPLAT_SHARING=$sharing timeout 120 .devbin/gs-render -i $d/playbot_125k.ply \
+    # zero-copy-hostwait: zero-copy with the host waiting for GL instead of the semaphore.
+    for variant in zero-copy zero-copy-hostwait host-copy; do
+      sharing=${variant%-hostwait}
+      semaphores=1
+      [ "$variant" = zero-copy-hostwait ] && semaphores=0
+      log=$out/render-$size-$variant.log
+      OPEN3D_SPLAT_SHARING=$sharing OPEN3D_GL_VK_SEMAPHORES=$semaphores timeout 120 \
+        .devbin/gs-render -i $d/playbot_125k.ply \
         --cameras $d/cameras.json --view 0 --width "$w" --height "$h" --sphere --plane --frames 60 \
-        -o /tmp/filament-$size-$sharing.png >"$log" 2>&1
-      say "gs-render --sphere --plane $size $sharing: exit $?"
-      grep -E "^filament render|^frame time|^presented|rror" "$log" | cut -c1-400 | tee -a "$summary"
+        -o /tmp/filament-$size-$variant.png >"$log" 2>&1
+      say "gs-render --sphere --plane $size $variant: exit $?"
+      grep -E "^filament render|^frame time|^presented|hands the mesh|rror" "$log" | cut -c1-400 | tee -a "$summary"
     done
     log=$out/render-$size-placeholder.log
     timeout 120 .devbin/gs-render -i $d/playbot_125k.ply --cameras $d/cameras.json --view 0 \
@@ -122,3 +131,5 @@ case $mode in
   *) echo "unknown mode $mode"; exit 2 ;;
 esac
 nvidia-smi --query-gpu=clocks.sm --format=csv,noheader | tee -a "$out/gpu.txt"
+# At most 8 files come back from a device call: the logs travel as one archive.
+(cd "$out" && ls ./*.log >/dev/null 2>&1 && tar -czf logs.tar.gz ./*.log && rm -f ./*.log)
