@@ -161,6 +161,12 @@ void AddRedSphere(rendering::FilamentScene& scene, const std::string& name) {
     scene.AddGeometry(name, sphere, material);
 }
 
+void AddSplatsAroundRedSphere(rendering::FilamentScene& scene) {
+    scene.AddGeometry("wall", MakeSplatWall(4.0, 3.0, 24, Eigen::Vector3d(0.1, 0.2, 0.9)));
+    scene.AddGeometry("front", MakeSplatBlob(0.2, 0.0, 1.2, 0.08, Eigen::Vector3d(0.1, 0.9, 0.2)));
+    AddRedSphere(scene);
+}
+
 double SphereDepthTolerance(double cos_incidence) {
     return cos_incidence < 0.3 ? -1.0 : 2e-3 / cos_incidence;
 }

@@ -76,6 +76,9 @@ std::array<int, 4> ExpectedOver(const float* splat_rgba, const Eigen::Vector4f& 
 constexpr double kSphereRadius = 0.5;
 constexpr double kSphereZ = 2.0;
 void AddRedSphere(rendering::FilamentScene& scene, const std::string& name = "sphere");
+/// The red sphere between a half-transparent blue splat wall behind it (z = 4) and a green
+/// splat blob in front of it (z = 1.2): splats over, under and beside a mesh.
+void AddSplatsAroundRedSphere(rendering::FilamentScene& scene);
 
 /// Depth of the sphere's surface along the ray of pixel (u, v), or 0 when the ray misses;
 /// `cos_incidence` (optional) gets |cos| of the angle between the ray and the normal.

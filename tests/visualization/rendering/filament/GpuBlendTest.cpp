@@ -25,9 +25,7 @@ TEST_F(FilamentTest, GpuBlendOverTheMeshColourIsTheHostBlend) {
     const camera::PinholeCamera camera = MakeFilamentTestCamera(64, 48);
     rendering::FilamentScene& scene = MakeScene();
     // Half-transparent splats in front of and behind the sphere: every case of the blend.
-    scene.AddGeometry("wall", MakeSplatWall(4.0, 3.0, 24, Eigen::Vector3d(0.1, 0.2, 0.9)));
-    scene.AddGeometry("front", MakeSplatBlob(0.2, 0.0, 1.2, 0.08, Eigen::Vector3d(0.1, 0.9, 0.2)));
-    AddRedSphere(scene);
+    AddSplatsAroundRedSphere(scene);
     // A yellow box in the upper half (y < 0 is up) and nothing mirrored below it, so a mesh
     // colour read with its rows the wrong way up would not match.
     t::geometry::TriangleMesh box = t::geometry::TriangleMesh::CreateBox(0.6, 0.3, 0.2);

@@ -32,9 +32,7 @@ bool SameBytes(const t::geometry::Image& a, const t::geometry::Image& b) {
 TEST_F(FilamentTest, GpuHandoverGivesTheHostWaitsFrame) {
     const camera::PinholeCamera camera = MakeFilamentTestCamera(64, 48);
     rendering::FilamentScene& scene = MakeScene();
-    scene.AddGeometry("wall", MakeSplatWall(4.0, 3.0, 24, Eigen::Vector3d(0.1, 0.2, 0.9)));
-    scene.AddGeometry("front", MakeSplatBlob(0.2, 0.0, 1.2, 0.08, Eigen::Vector3d(0.1, 0.9, 0.2)));
-    AddRedSphere(scene);
+    AddSplatsAroundRedSphere(scene);
 
     // Three frames of colour, then one of depth, on one view.
     struct Frames {

@@ -21,6 +21,17 @@ namespace vulkan {
 
 namespace {
 
+// An entry point of an enabled device extension; a missing one means the device was not
+// created with the extension it was reported to have.
+template <typename T>
+void LoadExtensionFunction(VkDevice device, const char* name, const char* extension, T& function) {
+    function = reinterpret_cast<T>(vkGetDeviceProcAddr(device, name));
+    if (function == nullptr) {
+        core::ThrowError("Vulkan: {} is unavailable although {} was reported enabled", name,
+                         extension);
+    }
+}
+
 constexpr const char* kValidationLayer = "VK_LAYER_KHRONOS_validation";
 constexpr uint32_t kRequiredApiVersion = VK_API_VERSION_1_3;
 // What the compute shaders use: scans and reductions (arithmetic), subgroupElect (basic),
@@ -522,22 +533,12 @@ void VulkanContext::LoadDeviceFunctions(const OptionalExtensions& optional) {
             VK_KHR_PUSH_DESCRIPTOR_EXTENSION_NAME);
     }
     if (optional.external_semaphore_fd) {
-        get_semaphore_fd_ = reinterpret_cast<PFN_vkGetSemaphoreFdKHR>(
-            vkGetDeviceProcAddr(device_, "vkGetSemaphoreFdKHR"));
-        if (get_semaphore_fd_ == nullptr) {
-            core::ThrowError(
-                "Vulkan: vkGetSemaphoreFdKHR is unavailable although {} was reported enabled",
-                VK_KHR_EXTERNAL_SEMAPHORE_FD_EXTENSION_NAME);
-        }
+        LoadExtensionFunction(device_, "vkGetSemaphoreFdKHR",
+                              VK_KHR_EXTERNAL_SEMAPHORE_FD_EXTENSION_NAME, get_semaphore_fd_);
     }
     if (optional.external_memory_fd) {
-        get_memory_fd_ = reinterpret_cast<PFN_vkGetMemoryFdKHR>(
-            vkGetDeviceProcAddr(device_, "vkGetMemoryFdKHR"));
-        if (get_memory_fd_ == nullptr) {
-            core::ThrowError(
-                "Vulkan: vkGetMemoryFdKHR is unavailable although {} was reported enabled",
-                VK_KHR_EXTERNAL_MEMORY_FD_EXTENSION_NAME);
-        }
+        LoadExtensionFunction(device_, "vkGetMemoryFdKHR", VK_KHR_EXTERNAL_MEMORY_FD_EXTENSION_NAME,
+                              get_memory_fd_);
     }
 }
 
