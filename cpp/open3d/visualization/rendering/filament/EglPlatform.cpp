@@ -4,6 +4,9 @@
 #include <EGL/eglext.h>
 
 #include <cstring>
+#include <functional>
+#include <mutex>
+#include <thread>
 #include <vector>
 
 #include "open3d/core/Exception.h"
@@ -39,11 +42,34 @@ struct Candidate {
     std::string description;
 };
 
+// EGL_KHR_debug: the driver's own words for an EGL error (which call, why), logged with the
+// calling thread, since a failed eglMakeCurrent on Filament's thread surfaces only later as
+// libepoxy's "Couldn't find current GLX or EGL context". Installed once per process.
+void EGLAPIENTRY OnEglDebugMessage(EGLenum error, const char* command, EGLint type, EGLLabelKHR,
+                                   EGLLabelKHR, const char* message) {
+    if (type != EGL_DEBUG_MSG_CRITICAL_KHR && type != EGL_DEBUG_MSG_ERROR_KHR) return;
+    core::LogWarning("EGL error 0x{:x} in {} (thread {}): {}", error, command ? command : "?",
+                     std::hash<std::thread::id>{}(std::this_thread::get_id()) % 100000,
+                     message ? message : "");
+}
+
+void InstallEglDebugCallback(const char* client_extensions) {
+    static std::once_flag once;
+    std::call_once(once, [client_extensions] {
+        if (!HasToken(client_extensions, "EGL_KHR_debug")) return;
+        auto control = Proc<PFNEGLDEBUGMESSAGECONTROLKHRPROC>("eglDebugMessageControlKHR");
+        const EGLAttrib attributes[] = {EGL_DEBUG_MSG_CRITICAL_KHR, EGL_TRUE,
+                                        EGL_DEBUG_MSG_ERROR_KHR, EGL_TRUE, EGL_NONE};
+        if (control) control(OnEglDebugMessage, attributes);
+    });
+}
+
 // Hardware devices first (their GL can share memory with the Vulkan device), then Mesa's
 // surfaceless platform, software devices, and the default display.
 std::vector<Candidate> Candidates() {
     std::vector<Candidate> hardware, software;
     const char* client = eglQueryString(EGL_NO_DISPLAY, EGL_EXTENSIONS);
+    InstallEglDebugCallback(client);
     if (HasToken(client, "EGL_EXT_platform_device")) {
         auto query_devices = Proc<PFNEGLQUERYDEVICESEXTPROC>("eglQueryDevicesEXT");
         auto query_string = Proc<PFNEGLQUERYDEVICESTRINGEXTPROC>("eglQueryDeviceStringEXT");
@@ -70,14 +96,24 @@ std::vector<Candidate> Candidates() {
     return all;
 }
 
-EGLDisplay OpenDisplay(std::string* description, std::string* tried) {
+// An EGL display is one per process and attribute list, and eglTerminate ends it for every
+// user: NVIDIA's Vulkan driver terminates the device's display when a Vulkan instance goes
+// (seen on the H100 with driver 580: every context of ours then became invalid). Where
+// EGL_KHR_display_reference exists, our display asks for reference tracking, which makes it a
+// display of its own, initialized and terminated in pairs (docs/environment-notes.md).
+EGLDisplay OpenDisplay(std::string* description, std::string* tried, bool* tracked) {
     auto get_platform_display = Proc<PFNEGLGETPLATFORMDISPLAYEXTPROC>("eglGetPlatformDisplayEXT");
+    const bool can_track =
+        HasToken(eglQueryString(EGL_NO_DISPLAY, EGL_EXTENSIONS), "EGL_KHR_display_reference");
+    const EGLint track[] = {EGL_TRACK_REFERENCES_KHR, EGL_TRUE, EGL_NONE};
     for (const Candidate& c : Candidates()) {
         EGLDisplay display = EGL_NO_DISPLAY;
+        *tracked = false;
         if (c.platform == EGL_NONE) {
             display = eglGetDisplay(EGL_DEFAULT_DISPLAY);
         } else if (get_platform_display) {
-            display = get_platform_display(c.platform, c.native, nullptr);
+            display = get_platform_display(c.platform, c.native, can_track ? track : nullptr);
+            *tracked = can_track && display != EGL_NO_DISPLAY;
         }
         EGLint major = 0, minor = 0;
         if (display != EGL_NO_DISPLAY && eglInitialize(display, &major, &minor)) {
@@ -184,7 +220,11 @@ public:
         delete surface;
     }
     void makeCurrent(SwapChain* draw, SwapChain* read) noexcept override {
-        eglMakeCurrent(display_, SurfaceOf(draw), SurfaceOf(read), context_);
+        if (!eglMakeCurrent(display_, SurfaceOf(draw), SurfaceOf(read), context_)) {
+            core::LogError(
+                "Filament on EGL: eglMakeCurrent on its thread failed (EGL error 0x{:x})",
+                eglGetError());
+        }
     }
     void commit(SwapChain* swap_chain) noexcept override {
         eglSwapBuffers(display_, SurfaceOf(swap_chain));
@@ -236,22 +276,21 @@ private:
 
 EglContext::EglContext() {
     std::string tried;
-    display_ = OpenDisplay(&description_, &tried);
+    display_ = OpenDisplay(&description_, &tried, &tracked_);
     if (display_ == EGL_NO_DISPLAY) {
         core::ThrowError("EGL: no display could be initialized (tried {})", tried);
     }
-    // On failure the display stays initialized, as in the destructor.
-    config_ = ChooseConfig(display_);
-    if (config_ == nullptr) {
-        core::ThrowError("EGL: {} has no RGB8 pbuffer configuration for OpenGL", description_);
-    }
-    context_ = CreateContext(display_, config_, EGL_NO_CONTEXT);
-    if (context_ == EGL_NO_CONTEXT) {
-        core::ThrowError("EGL: {} gives no OpenGL 4.5 core context (EGL error 0x{:x})",
-                         description_, eglGetError());
-    }
-    surface_ = CreatePbuffer(display_, config_, 16, 16);
     try {
+        config_ = ChooseConfig(display_);
+        if (config_ == nullptr) {
+            core::ThrowError("EGL: {} has no RGB8 pbuffer configuration for OpenGL", description_);
+        }
+        context_ = CreateContext(display_, config_, EGL_NO_CONTEXT);
+        if (context_ == EGL_NO_CONTEXT) {
+            core::ThrowError("EGL: {} gives no OpenGL 4.5 core context (EGL error 0x{:x})",
+                             description_, eglGetError());
+        }
+        surface_ = CreatePbuffer(display_, config_, 16, 16);
         MakeCurrent();
     } catch (...) {
         Release();
@@ -264,9 +303,10 @@ EglContext::~EglContext() { Release(); }
 void EglContext::Release() {
     eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
     if (surface_ != EGL_NO_SURFACE) eglDestroySurface(display_, surface_);
-    eglDestroyContext(display_, context_);
-    // The display stays initialized: EGL displays are per process and another engine (or
-    // Filament's thread of this one, until it ends) may still use it.
+    if (context_ != EGL_NO_CONTEXT) eglDestroyContext(display_, context_);
+    // A tracked display counts its initializations: this one is ours to end. An untracked
+    // one stays initialized: it is per process and another engine may still use it.
+    if (tracked_) eglTerminate(display_);
 }
 
 void EglContext::MakeCurrent() const {
