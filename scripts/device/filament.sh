@@ -13,7 +13,7 @@
 # the rest within the warm period with OPEN3D_FILAMENT_PLATFORM=glx before the command.
 # Everything is logged under OUT; the last lines printed are a summary.
 set -uo pipefail
-out=${1:?usage: bash scripts/device/filament.sh OUT probe|suites|bench|all|quick}
+out=${1:?usage: bash scripts/device/filament.sh OUT probe|suites|bench|all|quick|check}
 mode=${2:-all}
 mkdir -p "$out"
 summary=$out/summary.txt
@@ -74,7 +74,7 @@ suites() {
   export LD_LIBRARY_PATH=$PWD/.devlibs OPEN3D_DATA_DIR=$PWD/shared/data
   local name
   # The Vulkan suite's interop tests: memory and semaphore export on the GPU.
-  for name in tests_filament_rendering tests_visualizer tests_gaussian_splat_vulkan; do
+  for name in ${SUITES:-tests_filament_rendering tests_visualizer tests_gaussian_splat_vulkan}; do
     [ -x ".devbin/$name" ] || { say "$name: not carried"; continue; }
     local filter='*'
     [ "$name" = tests_gaussian_splat_vulkan ] && filter='Interop.*'
@@ -89,11 +89,11 @@ bench() {
   export LD_LIBRARY_PATH=$PWD/.devlibs OPEN3D_VULKAN_VALIDATION=0
   local d=shared/data/playbot size w h variant sharing semaphores log
   [ -x .devbin/gs-render ] || { say "gs-render: not carried"; return; }
-  for size in 1920x1080 3840x2160; do
+  for size in ${SIZES:-1920x1080 3840x2160}; do
     w=${size%x*} h=${size#*x}
     # The integrated frame (splats, a lit sphere, Filament's mesh view, the depth-tested
     # composite, the offscreen read and blend), zero-copy and host copies; then Filament's own
-    # frame (placeholder backend: no splats) and the splats alone (gs-bench, GPU and in flight).
+    # frame (--meshes-only: no splats) and the splats alone (gs-bench, GPU and in flight).
     # zero-copy-hostwait: zero-copy with the host waiting for GL instead of the semaphore.
     for variant in zero-copy zero-copy-hostwait host-copy; do
       sharing=${variant%-hostwait}
@@ -109,7 +109,7 @@ bench() {
     done
     log=$out/render-$size-placeholder.log
     timeout 120 .devbin/gs-render -i $d/playbot_125k.ply --cameras $d/cameras.json --view 0 \
-      --width "$w" --height "$h" --sphere --plane --frames 60 --backend placeholder \
+      --width "$w" --height "$h" --sphere --plane --frames 60 --meshes-only \
       -o /tmp/filament-mesh-$size.png >"$log" 2>&1
     say "gs-render --sphere --plane $size, meshes only: exit $?"
     grep -E "^frame time|^presented|rror" "$log" | cut -c1-400 | tee -a "$summary"
@@ -128,6 +128,8 @@ case $mode in
   bench) bench ;;
   all) probe; suites; bench ;;
   quick) SUITE_TIMEOUT=90 suites; bench ;;  # a short lease: each suite stops after 90 s
+  # The least that says whether the integrated frame works and what it costs, at 1080p.
+  check) SUITE_TIMEOUT=100 SUITES=tests_filament_rendering suites; SIZES=1920x1080 bench ;;
   *) echo "unknown mode $mode"; exit 2 ;;
 esac
 nvidia-smi --query-gpu=clocks.sm --format=csv,noheader | tee -a "$out/gpu.txt"

@@ -96,7 +96,7 @@ FilamentImages RenderWithFilament(const t::geometry::PointCloud& cloud,
     rendering::Open3DSceneOptions scene_options;
     scene_options.backend = options.backend;
     rendering::Open3DScene scene(renderer, scene_options);
-    scene.AddGeometry("splats", cloud);
+    if (options.splats) scene.AddGeometry("splats", cloud);
     if (options.sphere) {
         t::geometry::TriangleMesh sphere =
             t::geometry::TriangleMesh::CreateSphere(options.sphere_radius, 40);

@@ -24,6 +24,7 @@ struct FilamentRenderOptions {
     /// side 6 radii), level with the camera's horizon: a second, larger mesh that splats
     /// stand in front of and behind.
     bool plane = false;
+    bool splats = true;  ///< false: the meshes alone (the scene holds no splats)
     Eigen::Vector3d background = Eigen::Vector3d::Zero();
     int frames = 1;      ///< frames rendered; times are averaged over all but the first
     bool depth = false;  ///< also render the merged splat and mesh depth

@@ -215,6 +215,7 @@ int Run(const Options& opt) {
         fo.backend = backend_name;
         fo.sphere = opt.sphere;
         fo.plane = opt.plane;
+        fo.splats = !opt.meshes_only;
         fo.sphere_center = default_scene ? rendering::GetDefaultSceneMeshSphere().center
                                          : t::geometry::ComputeMedianCenter(cloud);
         fo.sphere_radius =
@@ -394,6 +395,9 @@ int main(int argc, char** argv) {
     app.add_flag("--plane", opt.plane,
                  "Add a grey lit square through the lower half of the sphere's place (implies "
                  "--filament), level with the camera's horizon, 6 sphere radii wide");
+    app.add_flag("--meshes-only", opt.meshes_only,
+                 "With --sphere/--plane: Filament draws the meshes alone, the splats are not "
+                 "added (Filament's own frame: what the integrated frame costs beyond the splats)");
     app.add_option("--sphere-radius", opt.sphere_radius,
                    "Sphere radius (default: 0.3 x the 80th-percentile splat distance from the "
                    "centre; the default scene has its own place for the sphere)")

@@ -36,6 +36,7 @@ struct Options {
     bool filament = false;
     bool sphere = false;
     bool plane = false;
+    bool meshes_only = false;
     std::optional<double> sphere_radius;
     int frames = 1;
     uint64_t lod_budget = 0;  // 0: no level of detail
@@ -47,7 +48,7 @@ struct Options {
     std::string preset = "veryfast";  // and its speed preset
 
     /// --filament, --sphere or --plane: the frame goes through Filament.
-    bool UsesFilament() const { return filament || sphere || plane; }
+    bool UsesFilament() const { return filament || sphere || plane || meshes_only; }
 };
 
 }  // namespace gs_render
