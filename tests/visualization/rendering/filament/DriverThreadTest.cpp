@@ -14,6 +14,8 @@
 
 #include "TestUtility.h"
 #include "open3d/visualization/rendering/filament/FilamentEngine.h"
+#include "open3d/visualization/rendering/gaussian_splat/GaussianSplatBackend.h"
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/VulkanBackendRegistry.h"
 
 namespace open3d {
 namespace tests {
@@ -93,6 +95,27 @@ TEST(FilamentDriverThread, ActionsRunInStreamOrderOnFilamentsThread) {
     engine.FlushAndWait();
     engine.MakeContextCurrent();
     gl.DeleteTextures(1, &id);
+}
+
+// NVIDIA's Vulkan driver ends the GPU's EGL display when the loader unloads it, i.e. when the
+// process's last Vulkan instance goes (docs/environment-notes.md "NVIDIA GPUs"); the engine
+// keeps the drivers loaded. A Vulkan backend made and destroyed after the engine must leave
+// its contexts usable: on the H100 this threw "eglMakeCurrent failed" before the fix.
+TEST(FilamentDriverThread, EglContextsOutliveAVulkanBackend) {
+    const std::string reason = rendering::FilamentUnavailableReason(rendering::GlPlatform::kEgl);
+    if (!reason.empty()) OPEN3D_SKIP_OR_FAIL_WHEN_UNAVAILABLE(reason);
+    rendering::FilamentEngine engine(rendering::GlPlatform::kEgl);
+    rendering::vulkan::RegisterVulkanBackend();
+    for (int i = 0; i < 2; ++i) {
+        auto backend = rendering::CreateGaussianSplatBackend("vulkan");
+        ASSERT_NE(backend, nullptr);
+    }
+    EXPECT_NO_THROW(engine.MakeContextCurrent());
+    EXPECT_NE(engine.GetGl().GetString(GL_VERSION), nullptr);
+    bool ran = false;
+    engine.RunOnDriverThread([&] { ran = engine.GetGl().GetString(GL_VERSION) != nullptr; });
+    engine.FlushAndWait();
+    EXPECT_TRUE(ran) << "Filament's thread lost its context";
 }
 
 TEST(FilamentDriverThread, GlxRunsNothing) {

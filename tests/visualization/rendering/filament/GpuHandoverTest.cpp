@@ -1,7 +1,8 @@
 // The hand-over from GL's mesh view to Vulkan's composite (SplatTargets::SignalMeshDrawn):
 // where Vulkan exports and GL imports semaphores and Filament's thread can be reached (EGL),
 // GL signals a semaphore after the mesh view and the composite waits for it on the GPU;
-// elsewhere the host waits for GL. Both must give the same frame, byte for byte, over several
+// elsewhere the host waits for GL. The semaphore is opt-in (OPEN3D_GL_VK_SEMAPHORES=1, set here).
+// Both must give the same frame, byte for byte, over several
 // frames (a binary semaphore signalled and waited once per frame), colour and depth. On
 // llvmpipe and lavapipe (no semaphore export) both frames take the host wait; on NVIDIA this
 // checks the semaphore.
@@ -58,7 +59,11 @@ TEST_F(FilamentTest, GpuHandoverGivesTheHostWaitsFrame) {
         EXPECT_TRUE(view.GetSplatTargets()->IsZeroCopy());
         return frames;
     };
-    const Frames gpu = render(MakeView(camera, SplatSharing::kZeroCopy));
+    Frames gpu;
+    {
+        ScopedEnvironment on("OPEN3D_GL_VK_SEMAPHORES", "1");
+        gpu = render(MakeView(camera, SplatSharing::kZeroCopy));
+    }
     Frames host;
     {
         ScopedEnvironment off("OPEN3D_GL_VK_SEMAPHORES", "0");

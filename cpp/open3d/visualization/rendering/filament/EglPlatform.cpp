@@ -45,8 +45,13 @@ struct Candidate {
 // EGL_KHR_debug: the driver's own words for an EGL error (which call, why), logged with the
 // calling thread, since a failed eglMakeCurrent on Filament's thread surfaces only later as
 // libepoxy's "Couldn't find current GLX or EGL context". Installed once per process.
+// Set while displays are tried one after another: their failures are expected, and the
+// one that matters is reported by the caller.
+thread_local bool trying_displays = false;
+
 void EGLAPIENTRY OnEglDebugMessage(EGLenum error, const char* command, EGLint type, EGLLabelKHR,
                                    EGLLabelKHR, const char* message) {
+    if (trying_displays) return;
     if (type != EGL_DEBUG_MSG_CRITICAL_KHR && type != EGL_DEBUG_MSG_ERROR_KHR) return;
     core::LogWarning("EGL error 0x{:x} in {} (thread {}): {}", error, command ? command : "?",
                      std::hash<std::thread::id>{}(std::this_thread::get_id()) % 100000,
@@ -96,24 +101,22 @@ std::vector<Candidate> Candidates() {
     return all;
 }
 
-// An EGL display is one per process and attribute list, and eglTerminate ends it for every
-// user: NVIDIA's Vulkan driver terminates the device's display when a Vulkan instance goes
-// (seen on the H100 with driver 580: every context of ours then became invalid). Where
-// EGL_KHR_display_reference exists, our display asks for reference tracking, which makes it a
-// display of its own, initialized and terminated in pairs (docs/environment-notes.md).
-EGLDisplay OpenDisplay(std::string* description, std::string* tried, bool* tracked) {
+// The display of a device is one per process: whoever calls eglTerminate ends it for every
+// user. NVIDIA's Vulkan driver does when the loader unloads it; FilamentEngine keeps the
+// Vulkan drivers loaded while it uses EGL (docs/environment-notes.md "NVIDIA GPUs").
+EGLDisplay OpenDisplay(std::string* description, std::string* tried) {
     auto get_platform_display = Proc<PFNEGLGETPLATFORMDISPLAYEXTPROC>("eglGetPlatformDisplayEXT");
-    const bool can_track =
-        HasToken(eglQueryString(EGL_NO_DISPLAY, EGL_EXTENSIONS), "EGL_KHR_display_reference");
-    const EGLint track[] = {EGL_TRACK_REFERENCES_KHR, EGL_TRUE, EGL_NONE};
-    for (const Candidate& c : Candidates()) {
+    const std::vector<Candidate> candidates = Candidates();
+    trying_displays = true;
+    struct Done {
+        ~Done() { trying_displays = false; }
+    } done;
+    for (const Candidate& c : candidates) {
         EGLDisplay display = EGL_NO_DISPLAY;
-        *tracked = false;
         if (c.platform == EGL_NONE) {
             display = eglGetDisplay(EGL_DEFAULT_DISPLAY);
         } else if (get_platform_display) {
-            display = get_platform_display(c.platform, c.native, can_track ? track : nullptr);
-            *tracked = can_track && display != EGL_NO_DISPLAY;
+            display = get_platform_display(c.platform, c.native, nullptr);
         }
         EGLint major = 0, minor = 0;
         if (display != EGL_NO_DISPLAY && eglInitialize(display, &major, &minor)) {
@@ -276,7 +279,7 @@ private:
 
 EglContext::EglContext() {
     std::string tried;
-    display_ = OpenDisplay(&description_, &tried, &tracked_);
+    display_ = OpenDisplay(&description_, &tried);
     if (display_ == EGL_NO_DISPLAY) {
         core::ThrowError("EGL: no display could be initialized (tried {})", tried);
     }
@@ -304,9 +307,8 @@ void EglContext::Release() {
     eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
     if (surface_ != EGL_NO_SURFACE) eglDestroySurface(display_, surface_);
     if (context_ != EGL_NO_CONTEXT) eglDestroyContext(display_, context_);
-    // A tracked display counts its initializations: this one is ours to end. An untracked
-    // one stays initialized: it is per process and another engine may still use it.
-    if (tracked_) eglTerminate(display_);
+    // The display stays initialized: EGL displays are per process and another engine (or
+    // Filament's thread of this one, until it ends) may still use it.
 }
 
 void EglContext::MakeCurrent() const {

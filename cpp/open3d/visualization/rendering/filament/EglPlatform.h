@@ -49,7 +49,6 @@ private:
     void* config_ = nullptr;
     void* context_ = nullptr;
     void* surface_ = nullptr;
-    bool tracked_ = false;  // EGL_TRACK_REFERENCES_KHR: a display of our own, counted
     std::string description_;
 };
 

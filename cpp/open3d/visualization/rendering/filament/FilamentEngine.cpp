@@ -18,6 +18,7 @@
 #include "open3d/core/WaitCallback.h"
 #include "open3d/visualization/rendering/filament/EglPlatform.h"
 #include "open3d/visualization/rendering/filament/FilamentDriverThread.h"
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/VulkanDriversLoaded.h"
 
 namespace open3d {
 namespace visualization {
@@ -117,6 +118,7 @@ FilamentEngine::FilamentEngine(GlPlatform platform) : platform_(ResolveGlPlatfor
 }
 
 void FilamentEngine::StartEgl() {
+    vulkan_drivers_ = vulkan::KeepVulkanDriversLoaded();
     egl_ = std::make_unique<EglContext>();
     gl_ = GlFunctions::Load(&EglContext::GetProcAddress);
     driver_queue_ = std::make_unique<DriverThreadQueue>();

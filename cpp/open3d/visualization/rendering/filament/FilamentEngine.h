@@ -77,6 +77,9 @@ private:
 
     GlPlatform platform_;
     GLFWwindow* window_ = nullptr;
+    // EGL: Vulkan drivers kept loaded while the EGL display lives (NVIDIA's ends it when
+    // unloaded); declared first, so it goes last.
+    std::shared_ptr<void> vulkan_drivers_;
     std::unique_ptr<EglContext> egl_;
     std::unique_ptr<DriverThreadQueue> driver_queue_;  // EGL: outlives filament_platform_
     std::unique_ptr<filament::backend::Platform> filament_platform_;  // EGL: outlives engine_

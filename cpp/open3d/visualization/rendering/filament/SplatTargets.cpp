@@ -128,10 +128,12 @@ void SplatTargets::CreateZeroCopy(GaussianSplatBackend& backend) {
 
 void SplatTargets::SetUpGpuHandover(GaussianSplatBackend& backend) {
     const GlFunctions& gl = engine_.GetGl();
+    // Opt-in: on the H100 (driver 580.159.04) the first frames with the semaphore crashed
+    // (SIGSEGV) before the cause could be found, while the host wait ran (docs/filament.md).
     const char* env = std::getenv("OPEN3D_GL_VK_SEMAPHORES");
     std::string why;
-    if (env != nullptr && std::string(env) == "0") {
-        why = "OPEN3D_GL_VK_SEMAPHORES=0";
+    if (env == nullptr || std::string(env) != "1") {
+        why = "the semaphore hand-over is opt-in (OPEN3D_GL_VK_SEMAPHORES=1)";
     } else if (!engine_.CanRunOnDriverThread()) {
         why = "GLX: Filament's own platform gives no place on its thread for the signal";
     } else if (!vulkan::QueryInteropSupport(backend).external_semaphore_fd) {

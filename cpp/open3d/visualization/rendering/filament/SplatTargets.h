@@ -94,7 +94,7 @@ public:
 
     /// GPU-side hand-over from GL to Vulkan: whether GL signals a semaphore after the mesh
     /// view that the composite waits for (zero-copy on EGL where Vulkan exports and GL
-    /// imports semaphores, unless OPEN3D_GL_VK_SEMAPHORES=0), instead of the host waiting.
+    /// imports semaphores, with OPEN3D_GL_VK_SEMAPHORES=1), instead of the host waiting.
     bool HasGpuHandover() const { return gl_mesh_drawn_ != 0; }
     /// After Filament's mesh view was issued: GL signals "mesh drawn" on Filament's thread
     /// after it, and this returns once that signal is flushed to the GPU (no wait for the GPU
