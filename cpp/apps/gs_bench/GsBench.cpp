@@ -26,6 +26,7 @@
 #include "StreamBench.h"
 #include "Throughput.h"
 #include "open3d/camera/CamerasJson.h"
+#include "open3d/core/CrashReport.h"
 #include "open3d/core/Exception.h"
 #include "open3d/core/ParallelFor.h"
 #include "open3d/core/Timer.h"
@@ -454,6 +455,7 @@ int Run(const Options& opt) {
 }  // namespace
 
 int main(int argc, char** argv) {
+    open3d::core::InstallCrashReport();
     Options opt;
     CLI::App app{
         "gs-bench: GPU time per stage against error versus the CPU reference.\n"

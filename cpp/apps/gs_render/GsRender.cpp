@@ -20,6 +20,7 @@
 #include "RenderOutputs.h"
 #include "open3d/camera/CamerasJson.h"
 #include "open3d/camera/PinholeCamera.h"
+#include "open3d/core/CrashReport.h"
 #include "open3d/core/Exception.h"
 #include "open3d/core/HostMemory.h"
 #include "open3d/core/Logging.h"
@@ -294,6 +295,7 @@ int Run(const Options& opt) {
 }  // namespace
 
 int main(int argc, char** argv) {
+    open3d::core::InstallCrashReport();
     Options opt;
     CLI::App app{
         "gs-render: render a 3D Gaussian Splatting scene to PNG.\n"
