@@ -106,6 +106,8 @@ bench() {
         -o /tmp/filament-$size-$variant.png >"$log" 2>&1
       say "gs-render --sphere --plane $size $variant: exit $?"
       grep -E "^filament render|^frame time|^presented|hands the mesh|rror" "$log" | cut -c1-400 | tee -a "$summary"
+      # A crash's call stack (core::InstallCrashReport): place the frames with addr2line here.
+      grep -A16 "fatal signal" "$log" | cut -c1-200 | tee -a "$summary"
     done
     log=$out/render-$size-placeholder.log
     timeout 120 .devbin/gs-render -i $d/playbot_125k.ply --cameras $d/cameras.json --view 0 \
