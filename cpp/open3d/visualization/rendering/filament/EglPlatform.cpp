@@ -42,13 +42,13 @@ struct Candidate {
     std::string description;
 };
 
-// EGL_KHR_debug: the driver's own words for an EGL error (which call, why), logged with the
-// calling thread, since a failed eglMakeCurrent on Filament's thread surfaces only later as
-// libepoxy's "Couldn't find current GLX or EGL context". Installed once per process.
 // Set while displays are tried one after another: their failures are expected, and the
 // one that matters is reported by the caller.
 thread_local bool trying_displays = false;
 
+// EGL_KHR_debug: the driver's own words for an EGL error (which call, why), logged with the
+// calling thread, since a failed eglMakeCurrent on Filament's thread surfaces only later as
+// libepoxy's "Couldn't find current GLX or EGL context". Installed once per process.
 void EGLAPIENTRY OnEglDebugMessage(EGLenum error, const char* command, EGLint type, EGLLabelKHR,
                                    EGLLabelKHR, const char* message) {
     if (trying_displays) return;
