@@ -1,13 +1,14 @@
 #!/usr/bin/env bash
-# The Filament layer on the GPU device machine (issue 48, docs/filament.md "On NVIDIA").
+# The Filament layer on the GPU device machine (issue 48; results in docs/perf/h100.md "The
+# Filament-integrated frame on EGL").
 # Headless by default: Filament and our OpenGL context on NVIDIA's EGL (no X server), Vulkan
 # on the same GPU. With an X server (.xroot carried, see below) the GLX platform runs too:
 # Xvfb with Mesa's swrast for its GLX extension, NVIDIA's libGLX for the clients' contexts
 # (__GLX_VENDOR_LIBRARY_NAME=nvidia), and the viewer's suite.
-# Prepare here: bash scripts/device/prepare.sh build/bin/{gs-render,gs-bench,tests_filament_rendering,tests_visualizer}
+# Prepare here: bash scripts/device/prepare.sh build/bin/{gs-render,gs-bench,tests_filament_rendering,tests_visualizer,tests_gaussian_splat_vulkan}
 # and copy those binaries into .devbin; bash scripts/device/prepare-x.sh for .xroot.
 # EGL call: carry .gl, .devlibs, .devbin, .xroot/validation.tar.xz and shared/data/playbot:
-#   bash scripts/device/filament.sh OUT [probe|suites|bench|all]
+#   bash scripts/device/filament.sh OUT [probe|suites|bench|all|quick|check]
 # GLX: .xroot (55 MB) and the binaries with a scene do not fit one call's 64 MB: carry .gl and
 # .xroot first (`... OUT probe`, unpacks into /opt/xroot, which a warm machine keeps), then
 # the rest within the warm period with OPEN3D_FILAMENT_PLATFORM=glx before the command.
@@ -109,7 +110,7 @@ bench() {
       # A crash's call stack (core::InstallCrashReport): place the frames with addr2line here.
       grep -A16 "fatal signal" "$log" | cut -c1-200 | tee -a "$summary"
     done
-    log=$out/render-$size-placeholder.log
+    log=$out/render-$size-meshes-only.log
     timeout 120 .devbin/gs-render -i $d/playbot_125k.ply --cameras $d/cameras.json --view 0 \
       --width "$w" --height "$h" --sphere --plane --frames 60 --meshes-only \
       -o /tmp/filament-mesh-$size.png >"$log" 2>&1

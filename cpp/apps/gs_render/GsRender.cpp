@@ -179,9 +179,8 @@ int Run(const Options& opt) {
         core::ThrowError("--lod '{}' is read for --lod-budget: give a budget too", opt.lod);
     }
     if (opt.lod_budget > 0 && opt.UsesFilament()) {
-        core::ThrowError(
-            "--lod-budget draws through the splat backend alone, not --filament, "
-            "--sphere or --plane");
+        core::ThrowError("--lod-budget draws through the splat backend alone, not {}",
+                         gs_render::kFilamentFlags);
     }
     rendering::vulkan::RegisterVulkanBackend();
     const auto start = std::chrono::steady_clock::now();

@@ -47,8 +47,11 @@ struct Options {
     float crf = 23.0f;                // --camera-path -o x.mp4: x264's constant rate factor
     std::string preset = "veryfast";  // and its speed preset
 
-    /// --filament, --sphere or --plane: the frame goes through Filament.
+    /// Any of kFilamentFlags: the frame goes through Filament.
     bool UsesFilament() const { return filament || sphere || plane || meshes_only; }
 };
+
+/// The flags that take the Filament path, as error messages name them.
+inline constexpr const char* kFilamentFlags = "--filament/--sphere/--plane/--meshes-only";
 
 }  // namespace gs_render

@@ -37,7 +37,7 @@ void CheckOutputs(const Options& opt) {
         const char* single = !opt.depth_output.empty()   ? "--depth-output"
                              : !opt.float_output.empty() ? "--float-output"
                              : !opt.id_output.empty()    ? "--id-output"
-                             : opt.UsesFilament()        ? "--filament/--sphere/--plane"
+                             : opt.UsesFilament()        ? kFilamentFlags
                              : opt.lod_budget > 0        ? "--lod-budget"
                              : !opt.cameras.empty()      ? "--cameras"
                              : !opt.eye.empty() || !opt.center.empty() || opt.fov
@@ -91,13 +91,13 @@ void CheckOutputs(const Options& opt) {
     }
     if (!opt.float_output.empty() && opt.UsesFilament()) {
         core::ThrowError(
-            "--float-output is not available with --filament/--sphere/--plane (the Filament "
-            "path returns 8-bit colour)");
+            "--float-output is not available with {} (the Filament path returns 8-bit colour)",
+            kFilamentFlags);
     }
     if (!opt.id_output.empty() && (opt.UsesFilament() || opt.lod_budget > 0)) {
         core::ThrowError(
             "--id-output is not available with {}: its pixels show {}, not splats of --input",
-            opt.lod_budget > 0 ? "--lod-budget" : "--filament/--sphere/--plane",
+            opt.lod_budget > 0 ? "--lod-budget" : kFilamentFlags,
             opt.lod_budget > 0 ? "merged level-of-detail nodes" : "meshes too");
     }
 }
