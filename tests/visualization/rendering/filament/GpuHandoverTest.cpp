@@ -8,7 +8,11 @@
 // checks the semaphore.
 #include <gtest/gtest.h>
 
+#include <filament/Engine.h>
+#include <filament/SwapChain.h>
+
 #include <cstring>
+#include <vector>
 
 #include "TestUtility.h"
 #include "open3d/visualization/rendering/filament/FilamentEngine.h"
@@ -80,6 +84,53 @@ TEST_F(FilamentTest, GpuHandoverGivesTheHostWaitsFrame) {
         EXPECT_TRUE(SameBytes(gpu.color[i], gpu.color[0])) << "colour frame " << i;
     }
     EXPECT_TRUE(SameBytes(gpu.depth, host.depth));
+}
+
+// Presented frames (read_screen alone, so the host reads no splat image): with the hand-over
+// the composite signals "splats drawn", the host does not wait for it and GL's compose view
+// waits on the GPU; the screens must equal the host-waited ones byte for byte, frame by frame,
+// with the camera moving so that a compose reading the previous frame's splats would differ.
+TEST_F(FilamentTest, GpuHandoverPresentsTheHostWaitsScreens) {
+    rendering::FilamentScene& scene = MakeScene();
+    AddSplatsAroundRedSphere(scene);
+    constexpr int kFrames = 3;
+    auto present = [&](const char* semaphores, bool& handover) {
+        ScopedEnvironment env("OPEN3D_GL_VK_SEMAPHORES", semaphores);
+        camera::PinholeCamera camera = MakeFilamentTestCamera(64, 48);
+        rendering::FilamentView& view = MakeView(camera, SplatSharing::kZeroCopy);
+        filament::Engine& engine = engine_->GetEngine();
+        filament::SwapChain* swap_chain = engine.createSwapChain(
+            uint32_t(camera.width), uint32_t(camera.height), filament::SwapChain::CONFIG_READABLE);
+        std::vector<t::geometry::Image> screens;
+        FrameRequest request;
+        request.read_screen = true;
+        for (int i = 0; i < kFrames; ++i) {
+            camera.world_to_camera(0, 3) = 0.05 * i;  // the view slides sideways each frame
+            view.SetCamera(camera);
+            const FrameResult result = renderer_->Draw(scene, view, request, swap_chain);
+            EXPECT_TRUE(result.splats_drawn);
+            screens.push_back(result.screen);
+        }
+        handover = view.GetSplatTargets()->HasGpuHandover();
+        engine.destroy(swap_chain);
+        engine.flushAndWait();
+        return screens;
+    };
+    bool gpu_handover = false, host_handover = true;
+    const std::vector<t::geometry::Image> gpu = present("1", gpu_handover);
+    const std::vector<t::geometry::Image> host = present("0", host_handover);
+    EXPECT_FALSE(host_handover);
+    const bool available =
+        engine_->CanRunOnDriverThread() &&
+        rendering::vulkan::QueryInteropSupport(scene.GetBackend()).external_semaphore_fd &&
+        engine_->GetGl().HasSemaphoreFd();
+    EXPECT_EQ(gpu_handover, available);
+    ASSERT_EQ(gpu.size(), host.size());
+    for (int i = 0; i < kFrames; ++i) {
+        ASSERT_FALSE(gpu[i].IsEmpty());
+        EXPECT_TRUE(SameBytes(gpu[i], host[i])) << "screen " << i;
+    }
+    EXPECT_FALSE(SameBytes(host[0], host[kFrames - 1]));  // the camera moved the picture
 }
 
 }  // namespace

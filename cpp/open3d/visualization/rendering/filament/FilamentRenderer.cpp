@@ -208,6 +208,7 @@ FrameResult FilamentRenderer::Draw(FilamentView& view, const FrameRequest& reque
         composite.read_depth = request.read_depth;
         composite.depth_near = request.depth_near;
         composite.depth_far = request.depth_far;
+        composite.presented = swap_chain_ != nullptr;
         // Another view of the same scene may have replaced this view's sorted entries.
         scene.GetSplatRenderer().EnsureGeometryStage(ViewKey(view));
         targets.Composite(scene.GetBackend(), composite, splats);
@@ -240,6 +241,11 @@ t::geometry::Image FilamentRenderer::EndFrame() {
     frame_begun_ = false;
     t::geometry::Image screen_image;
     if (swap_chain_ != nullptr && !drawn_.empty()) {
+        // GL waits on the GPU for composites the host did not wait for (SplatTargets).
+        for (ViewEntry* entry : drawn_) {
+            SplatTargets* targets = entry->view->GetSplatTargets();
+            if (targets != nullptr) targets->WaitSplatsDrawn();
+        }
         // A frame Filament wants to skip is drawn anyway: the caller asked for this one.
         renderer_->beginFrame(swap_chain_);
         std::vector<uint8_t> screen;

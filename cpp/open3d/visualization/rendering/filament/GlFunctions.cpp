@@ -51,6 +51,7 @@ GlFunctions GlFunctions::Load(ProcLoader get) {
     LoadProc(get, gl.DeleteSemaphoresEXT, "glDeleteSemaphoresEXT");
     LoadProc(get, gl.ImportSemaphoreFdEXT, "glImportSemaphoreFdEXT");
     LoadProc(get, gl.SignalSemaphoreEXT, "glSignalSemaphoreEXT");
+    LoadProc(get, gl.WaitSemaphoreEXT, "glWaitSemaphoreEXT");
     return gl;
 }
 
@@ -81,7 +82,8 @@ bool GlFunctions::HasMemoryObjectFd() const {
 
 bool GlFunctions::HasSemaphoreFd() const {
     return HasExtension("GL_EXT_semaphore") && HasExtension("GL_EXT_semaphore_fd") &&
-           GenSemaphoresEXT && DeleteSemaphoresEXT && ImportSemaphoreFdEXT && SignalSemaphoreEXT;
+           GenSemaphoresEXT && DeleteSemaphoresEXT && ImportSemaphoreFdEXT && SignalSemaphoreEXT &&
+           WaitSemaphoreEXT;
 }
 
 std::array<uint8_t, 16> GlFunctions::DeviceUuid() const {

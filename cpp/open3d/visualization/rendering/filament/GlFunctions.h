@@ -42,6 +42,7 @@ struct GlFunctions {
     PFNGLDELETESEMAPHORESEXTPROC DeleteSemaphoresEXT = nullptr;
     PFNGLIMPORTSEMAPHOREFDEXTPROC ImportSemaphoreFdEXT = nullptr;
     PFNGLSIGNALSEMAPHOREEXTPROC SignalSemaphoreEXT = nullptr;
+    PFNGLWAITSEMAPHOREEXTPROC WaitSemaphoreEXT = nullptr;
     decltype(&::glFlush) Flush = nullptr;
 
     /// glfwGetProcAddress or eglGetProcAddress.

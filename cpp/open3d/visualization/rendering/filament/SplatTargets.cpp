@@ -142,12 +142,18 @@ void SplatTargets::SetUpGpuHandover(GaussianSplatBackend& backend) {
         why = "the OpenGL driver lacks GL_EXT_semaphore_fd";
     }
     if (why.empty()) {
-        const int fd = interop_->ExportMeshDrawnSemaphore();
-        gl.GenSemaphoresEXT(1, &gl_mesh_drawn_);
-        // GL owns the descriptor after a successful import.
-        gl.ImportSemaphoreFdEXT(gl_mesh_drawn_, GL_HANDLE_TYPE_OPAQUE_FD_EXT, fd);
-        gl.CheckError("importing the mesh-drawn semaphore (glImportSemaphoreFdEXT)");
+        const int fds[2] = {interop_->ExportMeshDrawnSemaphore(),
+                            interop_->ExportSplatsDrawnSemaphore()};
+        GLuint names[2] = {0, 0};
+        gl.GenSemaphoresEXT(2, names);
+        // GL owns each descriptor after a successful import.
+        for (int i = 0; i < 2; ++i) {
+            gl.ImportSemaphoreFdEXT(names[i], GL_HANDLE_TYPE_OPAQUE_FD_EXT, fds[i]);
+        }
+        gl.CheckError("importing the hand-over semaphores (glImportSemaphoreFdEXT)");
         gl.Finish();
+        gl_mesh_drawn_ = names[0];
+        gl_splats_drawn_ = names[1];
     }
     static bool logged = false;
     if (!logged) {
@@ -177,6 +183,20 @@ bool SplatTargets::SignalMeshDrawn() {
     engine_.Flush();
     done.wait();  // Filament's thread issued what came before: host work, not GPU time
     mesh_drawn_signaled_ = true;
+    return true;
+}
+
+bool SplatTargets::WaitSplatsDrawn() {
+    if (!splats_drawn_signaled_) return false;
+    splats_drawn_signaled_ = false;
+    const GlFunctions gl = engine_.GetGl();
+    const GLuint semaphore = gl_splats_drawn_;
+    // The composite released colour and depth to GL in GENERAL layout (GaussianSplatInterop).
+    const GLuint textures[2] = {gl_color_, gl_depth_};
+    engine_.RunOnDriverThread([gl, semaphore, textures] {
+        const GLenum layouts[2] = {GL_LAYOUT_GENERAL_EXT, GL_LAYOUT_GENERAL_EXT};
+        gl.WaitSemaphoreEXT(semaphore, 0, nullptr, 2, textures, layouts);
+    });
     return true;
 }
 
@@ -216,7 +236,10 @@ SplatTargets::~SplatTargets() {
     const GLuint names[3] = {gl_color_, gl_depth_, gl_mesh_color_};
     gl.DeleteTextures(gl_mesh_color_ != 0 ? 3 : 2, names);
     if (gl_memory_[0] != 0) gl.DeleteMemoryObjectsEXT(3, gl_memory_);
-    if (gl_mesh_drawn_ != 0) gl.DeleteSemaphoresEXT(1, &gl_mesh_drawn_);
+    if (gl_mesh_drawn_ != 0) {
+        const GLuint semaphores[2] = {gl_mesh_drawn_, gl_splats_drawn_};
+        gl.DeleteSemaphoresEXT(2, semaphores);
+    }
     gl.Finish();
     interop_.reset();
 }
@@ -227,6 +250,9 @@ void SplatTargets::Composite(GaussianSplatBackend& backend, const SplatComposite
         CompositeHostCopy(backend, request, frame);
         return;
     }
+    // A signal GL never waited for (a frame that ended before its compose view) is waited
+    // for first: a binary semaphore takes one signal per wait.
+    WaitSplatsDrawn();
     vulkan::InteropCompositeRequest vk;
     vk.use_scene_depth = request.use_scene_depth;
     vk.scene_near = request.scene_near;
@@ -237,6 +263,10 @@ void SplatTargets::Composite(GaussianSplatBackend& backend, const SplatComposite
     vk.depth_far = request.depth_far;
     vk.wait_mesh_drawn = mesh_drawn_signaled_;
     mesh_drawn_signaled_ = false;  // one wait per signal
+    // GL waits for it in WaitSplatsDrawn (a presented frame's compose view).
+    vk.signal_splats_drawn = request.presented && gl_splats_drawn_ != 0 && !request.read_color &&
+                             !request.blend_over_mesh && !request.read_depth;
+    splats_drawn_signaled_ = vk.signal_splats_drawn;
     vulkan::InteropFrame out;
     vulkan::RenderCompositeToInterop(backend, *interop_, vk, out);
     frame.color = std::move(out.color);

@@ -56,6 +56,10 @@ struct SplatCompositeRequest {
     bool read_depth = false;  ///< fill SplatFrame::linear_depth / normalized_depth
     float depth_near = 0.2f;  ///< normalisation of normalized_depth
     float depth_far = 100.0f;
+    /// The frame is presented (a swap chain's compose view samples the colour) and reads
+    /// nothing back: with HasGpuHandover() Vulkan signals "splats drawn" and the host does
+    /// not wait for the composite; WaitSplatsDrawn must then come before the compose view.
+    bool presented = false;
 };
 
 struct SplatFrame {
@@ -92,8 +96,9 @@ public:
     /// Its GL texture name (0 without zero-copy), for tests that read it from GL.
     uint32_t GetMeshColorGlName() const { return gl_mesh_color_; }
 
-    /// GPU-side hand-over from GL to Vulkan: whether GL signals a semaphore after the mesh
-    /// view that the composite waits for (zero-copy on EGL where Vulkan exports and GL
+    /// GPU-side hand-over between GL and Vulkan: whether GL signals a semaphore after the mesh
+    /// view that the composite waits for, and a presented frame's composite signals one GL
+    /// waits for before its compose view (zero-copy on EGL where Vulkan exports and GL
     /// imports semaphores, with OPEN3D_GL_VK_SEMAPHORES=1), instead of the host waiting.
     bool HasGpuHandover() const { return gl_mesh_drawn_ != 0; }
     /// After Filament's mesh view was issued: GL signals "mesh drawn" on Filament's thread
@@ -101,6 +106,11 @@ public:
     /// work). The next Composite waits for it on the GPU. False, and nothing is signalled,
     /// without HasGpuHandover(): then wait for Filament on the host (flushAndWait).
     bool SignalMeshDrawn();
+
+    /// Before Filament's compose view samples the colour (EndFrame): GL waits on the GPU, on
+    /// Filament's thread, for the composite that signalled "splats drawn" (a presented frame
+    /// with HasGpuHandover()). Returns whether a wait was issued (false when none was owed).
+    bool WaitSplatsDrawn();
 
     /// Composite stage of the backend's last geometry stage into the colour image, after Filament
     /// drew the mesh view and either finished (flushAndWait) or SignalMeshDrawn.
@@ -127,9 +137,11 @@ private:
     uint32_t height_ = 0;
     std::unique_ptr<vulkan::InteropTargets> interop_;
     uint32_t gl_color_ = 0, gl_depth_ = 0, gl_mesh_color_ = 0;  // GL texture names
-    uint32_t gl_memory_[3] = {0, 0, 0};  // GL memory objects (zero-copy only)
-    uint32_t gl_mesh_drawn_ = 0;         // GL semaphore (GPU hand-over only)
-    bool mesh_drawn_signaled_ = false;   // signalled, not yet waited for by a composite
+    uint32_t gl_memory_[3] = {0, 0, 0};   // GL memory objects (zero-copy only)
+    uint32_t gl_mesh_drawn_ = 0;          // GL semaphore (GPU hand-over only)
+    bool mesh_drawn_signaled_ = false;    // signalled, not yet waited for by a composite
+    uint32_t gl_splats_drawn_ = 0;        // GL semaphore: Vulkan's composite is done
+    bool splats_drawn_signaled_ = false;  // signalled by a composite, GL has not waited yet
     filament::Texture* color_texture_ = nullptr;
     filament::Texture* depth_texture_ = nullptr;
     filament::Texture* mesh_color_texture_ = nullptr;  // zero-copy only

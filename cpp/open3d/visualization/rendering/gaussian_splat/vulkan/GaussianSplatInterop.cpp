@@ -157,7 +157,8 @@ struct InteropTargets::Impl {
     Image merged_linear, merged_normalized;
     Buffer linear_readback, normalized_readback;
     Buffer depth_upload;
-    UniqueSemaphore mesh_drawn;  // exportable; made by ExportMeshDrawnSemaphore
+    UniqueSemaphore mesh_drawn;    // exportable; made by ExportMeshDrawnSemaphore
+    UniqueSemaphore splats_drawn;  // exportable; made by ExportSplatsDrawnSemaphore
 };
 
 namespace {
@@ -176,6 +177,11 @@ public:
         if (request.wait_mesh_drawn && !targets.mesh_drawn) {
             core::ThrowError(
                 "Gaussian splat interop: a composite waits for the mesh-drawn semaphore, which "
+                "was never exported");
+        }
+        if (request.signal_splats_drawn && !targets.splats_drawn) {
+            core::ThrowError(
+                "Gaussian splat interop: a composite signals the splats-drawn semaphore, which "
                 "was never exported");
         }
         if (request.read_depth && !(request.depth_far > request.depth_near)) {
@@ -198,6 +204,16 @@ public:
         if (!request_.wait_mesh_drawn || waited_) return VK_NULL_HANDLE;
         waited_ = true;  // a binary semaphore: one wait per signal (a retried frame waits none)
         return targets_.mesh_drawn.Get();
+    }
+
+    VkSemaphore TakeSignalSemaphore() override {
+        if (!request_.signal_splats_drawn || signalled_) return VK_NULL_HANDLE;
+        signalled_ = true;  // GL waits once per signal
+        return targets_.splats_drawn.Get();
+    }
+
+    bool ReadsBack() const override {
+        return request_.read_color || request_.blend_over_mesh || request_.read_depth;
     }
 
     void AdjustParams(CompositeParams& params) const override {
@@ -361,6 +377,7 @@ private:
     InteropFrame& out_;
     SceneDepthTexture scene_;
     bool waited_ = false;
+    bool signalled_ = false;
 };
 
 }  // namespace
@@ -391,7 +408,10 @@ InteropTargets::InteropTargets(GaussianSplatBackend& backend, uint32_t width, ui
     impl_ = std::make_unique<Impl>(vulkan, width, height);
 }
 
-InteropTargets::~InteropTargets() = default;
+InteropTargets::~InteropTargets() {
+    // A composite GL waits for on the GPU may still write the images.
+    if (impl_) impl_->backend.WaitForComposite();
+}
 
 uint32_t InteropTargets::GetWidth() const { return impl_->Width(); }
 uint32_t InteropTargets::GetHeight() const { return impl_->Height(); }
@@ -411,27 +431,38 @@ ExportedImageMemory InteropTargets::ExportMeshColor() {
     return {memory.fd, memory.size, true};
 }
 
-int InteropTargets::ExportMeshDrawnSemaphore() {
-    Impl& impl = *impl_;
-    if (!impl.context.SupportsExternalSemaphoreFd()) {
+namespace {
+
+int ExportSemaphore(const VulkanContext& context, UniqueSemaphore& semaphore) {
+    if (!context.SupportsExternalSemaphoreFd()) {
         core::ThrowError(
             "Gaussian splat interop: the Vulkan device {} cannot export semaphores ({} is not "
             "enabled)",
-            impl.context.GetDeviceInfo().name, VK_KHR_EXTERNAL_SEMAPHORE_FD_EXTENSION_NAME);
+            context.GetDeviceInfo().name, VK_KHR_EXTERNAL_SEMAPHORE_FD_EXTENSION_NAME);
     }
-    if (!impl.mesh_drawn) impl.mesh_drawn = CreateBinarySemaphore(impl.context, true);
+    if (!semaphore) semaphore = CreateBinarySemaphore(context, true);
     VkSemaphoreGetFdInfoKHR info =
         MakeInfo<VkSemaphoreGetFdInfoKHR>(VK_STRUCTURE_TYPE_SEMAPHORE_GET_FD_INFO_KHR);
-    info.semaphore = impl.mesh_drawn.Get();
+    info.semaphore = semaphore.Get();
     info.handleType = VK_EXTERNAL_SEMAPHORE_HANDLE_TYPE_OPAQUE_FD_BIT;
     int fd = -1;
-    CheckVk(impl.context.GetSemaphoreFd()(impl.context.GetDevice(), &info, &fd),
-            "vkGetSemaphoreFdKHR");
+    CheckVk(context.GetSemaphoreFd()(context.GetDevice(), &info, &fd), "vkGetSemaphoreFdKHR");
     return fd;
+}
+
+}  // namespace
+
+int InteropTargets::ExportMeshDrawnSemaphore() {
+    return ExportSemaphore(impl_->context, impl_->mesh_drawn);
+}
+
+int InteropTargets::ExportSplatsDrawnSemaphore() {
+    return ExportSemaphore(impl_->context, impl_->splats_drawn);
 }
 
 void InteropTargets::UploadDepth(const float* reversed_z) {
     Impl& impl = *impl_;
+    impl.backend.WaitForComposite();  // it may still read the depth
     const VkDeviceSize bytes = VkDeviceSize(impl.Width()) * impl.Height() * 4;
     if (!impl.depth_upload) {
         impl.depth_upload =

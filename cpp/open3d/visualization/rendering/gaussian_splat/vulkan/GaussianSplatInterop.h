@@ -86,6 +86,13 @@ public:
     /// waiting for GL. Made on the first call; every call exports the same semaphore.
     /// Throws core::Open3DError when the device cannot export semaphores.
     int ExportMeshDrawnSemaphore();
+    /// A descriptor of the binary semaphore "Vulkan composited the splats": GL imports it and
+    /// waits for it (glWaitSemaphoreEXT, colour and depth in GENERAL layout) before it samples
+    /// the colour or draws into the depth again. A composite with
+    /// InteropCompositeRequest::signal_splats_drawn signals it and, when it reads nothing
+    /// back, is not waited for on the host. Made on the first call; same semaphore each call.
+    /// Throws core::Open3DError when the device cannot export semaphores.
+    int ExportSplatsDrawnSemaphore();
 
     /// Writes the depth image from the host: `reversed_z` holds width * height floats in GL
     /// row order (bottom row first), stored as given. For tests and for drivers where GL
@@ -111,6 +118,10 @@ struct InteropCompositeRequest {
     /// GL signalled once since the last composite that waited for it; without it the caller
     /// must have waited for GL on the host.
     bool wait_mesh_drawn = false;
+    /// The submission signals the "splats drawn" semaphore (ExportSplatsDrawnSemaphore), for
+    /// which GL must wait once before the next composite signals it again. Without
+    /// read_color, blend_over_mesh and read_depth the host then does not wait for the frame.
+    bool signal_splats_drawn = false;
     /// Copy the splat colour to InteropFrame::color (offscreen rendering).
     bool read_color = false;
     /// Blend the splat colour over the mesh colour image on the GPU into InteropFrame::blended

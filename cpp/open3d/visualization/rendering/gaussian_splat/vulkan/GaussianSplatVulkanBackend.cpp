@@ -87,12 +87,12 @@ GaussianSplatVulkanBackend::GaussianSplatVulkanBackend(std::unique_ptr<VulkanCon
 
 GaussianSplatVulkanBackend::~GaussianSplatVulkanBackend() {
     // Nothing may still run on buffers we are about to free.
-    if (geometry_.in_flight) Wait(*context_, geometry_stage_fence_.Get());
+    WaitForStageWork();
     WaitAllSlots();
 }
 
 void GaussianSplatVulkanBackend::ReleaseResources() {
-    if (geometry_.in_flight) Wait(*context_, geometry_stage_fence_.Get());
+    WaitForStageWork();
     SetFramesInFlight(GetFramesInFlight());  // waits for the slots and empties them
     deferred_.Clear();
     geometry_ = GeometryState{};
@@ -169,7 +169,7 @@ void GaussianSplatVulkanBackend::RenderGeometryStage(const camera::PinholeCamera
     const auto start = std::chrono::steady_clock::now();
     const SplatPrecision precision = SplatPrecisionFor(config.compact_storage);
     if (precision != geometry_stage_resources_.Layout().precision) {
-        if (geometry_.in_flight) Wait(*context_, geometry_stage_fence_.Get());
+        WaitForStageWork();
         geometry_.in_flight = false;
         UploadScene(precision);
         geometry_.valid = false;
@@ -182,7 +182,7 @@ void GaussianSplatVulkanBackend::RenderGeometryStage(const camera::PinholeCamera
         ++counters_.geometry_reuses;
         return;
     }
-    if (geometry_.in_flight) Wait(*context_, geometry_stage_fence_.Get());
+    WaitForStageWork();
     CheckViewFits(static_cast<uint32_t>(camera.width), static_cast<uint32_t>(camera.height));
     // Per-tile bins leave each tile's range in the composite's state: it must be this
     // size's before the geometry stage is recorded.
@@ -412,6 +412,19 @@ void GaussianSplatVulkanBackend::WaitForGeometry() {
     t.gpu_lod_list_ms = geometry_stage_resources_.HasLod() ? at(TimedPass::kLodCutList) : 0.0;
 }
 
+void GaussianSplatVulkanBackend::WaitForComposite() {
+    if (!composite_in_flight_) return;
+    Wait(*context_, composite_in_flight_->fence.Get());
+    const std::vector<double> ms = composite_stage_timestamps_.ReadMilliseconds();
+    last_composite_gpu_ms_ = composite_in_flight_->empty ? 0.0 : PassMs(ms, TimedPass::kComposite);
+    composite_in_flight_.reset();
+}
+
+void GaussianSplatVulkanBackend::WaitForStageWork() {
+    if (geometry_.in_flight) Wait(*context_, geometry_stage_fence_.Get());
+    WaitForComposite();
+}
+
 RenderStats GaussianSplatVulkanBackend::RenderComposite(CompositeSink& sink) {
     if (!geometry_.valid)
         core::ThrowError("Vulkan backend: a composite before RenderGeometryStage");
@@ -425,10 +438,31 @@ RenderStats GaussianSplatVulkanBackend::RenderComposite(CompositeSink& sink) {
     }
     const auto geometry_wait_start = std::chrono::steady_clock::now();
     WaitForGeometry();
+    WaitForComposite();
     const double geometry_wait_ms = core::MillisecondsSince(geometry_wait_start);
     EnsureTargets(w, h);
     shader::GaussianGeometryStageCounters gpu_counters{};
     std::memcpy(&gpu_counters, counters_readback_.GetMapped(), sizeof(gpu_counters));
+
+    // The allocation, not the config, cut this frame short: grow the entry buffers to what
+    // it asked for (plus a quarter, so a moving camera does not regrow every frame) and
+    // render it again before anything is composited (the sink's semaphores are taken by the
+    // frame that runs). Geometry stage reported the full request, so one retry suffices.
+    const uint64_t limit = MaxEntryCapacity(geometry_.config, SortMaxCount());
+    if ((gpu_counters.error_flags & kCountsClamped) &&
+        geometry_stage_resources_.EntryCapacity() < limit && !growing_) {
+        const uint64_t asked = gpu_counters.requested_entries;
+        EnsureViewBuffers(static_cast<uint32_t>(std::min<uint64_t>(limit, asked + asked / 4)));
+        ++counters_.capacity_growths;
+        growing_ = true;
+        const camera::PinholeCamera camera = geometry_.camera;
+        const RenderConfig config = geometry_.config;
+        geometry_.valid = false;
+        RenderGeometryStage(camera, config);
+        const RenderStats stats = RenderComposite(sink);
+        growing_ = false;
+        return stats;
+    }
     // Nothing to blend (everything culled or hidden): no composite dispatch, the images are
     // cleared to the background instead.
     const bool empty = gpu_counters.entry_count == 0;
@@ -519,32 +553,21 @@ RenderStats GaussianSplatVulkanBackend::RenderComposite(CompositeSink& sink) {
     UniqueFence fence = CreateFence(*context_);
     const double record_ms = core::MillisecondsSince(record_start);
     const auto submit_start = std::chrono::steady_clock::now();
+    const VkSemaphore signal = sink.TakeSignalSemaphore();
     SubmitToQueue(context_->GetQueue(), cmd, fence.Get(), sink.TakeWaitSemaphore(),
-                  VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_NULL_HANDLE);
+                  VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, signal);
     const double submit_ms = core::MillisecondsSince(submit_start);
-    const auto wait_start = std::chrono::steady_clock::now();
-    Wait(*context_, fence.Get());
-    const double wait_ms = core::MillisecondsSince(wait_start);
     ++counters_.composites;
-
-    // The allocation, not the config, cut this frame short: grow the entry buffers to what
-    // it asked for (plus a quarter, so a moving camera does not regrow every frame) and
-    // render it again. Geometry stage reported the full request, so one retry suffices.
-    const uint64_t limit = MaxEntryCapacity(geometry_.config, SortMaxCount());
-    if ((gpu_counters.error_flags & kCountsClamped) &&
-        geometry_stage_resources_.EntryCapacity() < limit && !growing_) {
-        const uint64_t asked = gpu_counters.requested_entries;
-        EnsureViewBuffers(static_cast<uint32_t>(std::min<uint64_t>(limit, asked + asked / 4)));
-        ++counters_.capacity_growths;
-        growing_ = true;
-        const camera::PinholeCamera camera = geometry_.camera;
-        const RenderConfig config = geometry_.config;
-        geometry_.valid = false;
-        RenderGeometryStage(camera, config);
-        const RenderStats stats = RenderComposite(sink);
-        growing_ = false;
-        return stats;
+    // Another API waits for the frame on the GPU and the host reads nothing: no wait here.
+    const bool waited = signal == VK_NULL_HANDLE || sink.ReadsBack();
+    const auto wait_start = std::chrono::steady_clock::now();
+    if (waited) {
+        Wait(*context_, fence.Get());
+    } else {
+        composite_in_flight_ = CompositeInFlight{std::move(cmd_buffer), std::move(fence), empty};
     }
+    const double wait_ms = core::MillisecondsSince(wait_start);
+
     WarnNewFlags(gpu_counters.error_flags);
     const auto readback_start = std::chrono::steady_clock::now();
     sink.ReadBack();
@@ -560,9 +583,13 @@ RenderStats GaussianSplatVulkanBackend::RenderComposite(CompositeSink& sink) {
     s.error_flags = gpu_counters.error_flags;
     s.geometry_reused = geometry_.reused;
     s.composite_ms = core::MillisecondsSince(start);
-    const std::vector<double> ms = composite_stage_timestamps_.ReadMilliseconds();
-    s.gpu_composite_ms = empty ? 0.0 : PassMs(ms, TimedPass::kComposite);
-    s.gpu_merge_ms = PassMs(ms, TimedPass::kDepthMerge);
+    if (waited) {
+        const std::vector<double> ms = composite_stage_timestamps_.ReadMilliseconds();
+        s.gpu_composite_ms = empty ? 0.0 : PassMs(ms, TimedPass::kComposite);
+        s.gpu_merge_ms = PassMs(ms, TimedPass::kDepthMerge);
+    } else {
+        s.gpu_composite_ms = last_composite_gpu_ms_;  // still running: the last one waited for
+    }
     s.gpu_scene_bytes = static_cast<int64_t>(geometry_stage_resources_.SceneBytes());
     // The geometry stage's recording and submission (0 when reused), then this frame's.
     s.host_record_ms += record_ms;

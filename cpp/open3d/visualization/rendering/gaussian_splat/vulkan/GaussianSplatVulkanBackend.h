@@ -83,6 +83,14 @@ public:
     /// signal, e.g. GL's), or VK_NULL_HANDLE. Asked once per submission; a binary semaphore
     /// must be handed out once per signal.
     virtual VkSemaphore TakeWaitSemaphore() { return VK_NULL_HANDLE; }
+    /// A semaphore the frame's submission signals once its commands are done (another API
+    /// waits for it before reading the targets, e.g. GL before sampling the colour), or
+    /// VK_NULL_HANDLE. Asked once per submission.
+    virtual VkSemaphore TakeSignalSemaphore() { return VK_NULL_HANDLE; }
+    /// Whether ReadBack reads what the GPU wrote. A frame that reads nothing and signals a
+    /// semaphore is not waited for: the backend waits for its fence before the next use of
+    /// what it touches (WaitForComposite).
+    virtual bool ReadsBack() const { return true; }
 };
 
 class GaussianSplatVulkanBackend final : public GaussianSplatBackend {
@@ -215,6 +223,10 @@ public:
     /// RenderCompositeToInterop); returns the frame's stats. Throws core::Open3DError when no
     /// Geometry stage ran or the sink's colour target is not the camera's size.
     RenderStats RenderComposite(CompositeSink& sink);
+    /// Waits for a composite submitted without a host wait (CompositeSink::ReadsBack false
+    /// with a signal semaphore); its GPU time becomes the next such frame's gpu_composite_ms.
+    /// Whoever frees a sink's targets calls it first.
+    void WaitForComposite();
 
 private:
     class ReadbackSink;
@@ -276,6 +288,9 @@ private:
     void EnsureTargets(uint32_t width, uint32_t height);
     void EnsureReadback(uint32_t width, uint32_t height);
     void WaitForGeometry();
+    /// The stage path's submissions (geometry and composite) complete before their buffers
+    /// change.
+    void WaitForStageWork();
 
     std::unique_ptr<VulkanContext> context_;
     CommandPool pool_;
@@ -321,6 +336,15 @@ private:
     // written into stage_params_upload_.
     CommandBuffer geometry_stage_cmd_;
     UniqueFence geometry_stage_fence_;
+    // A composite not waited for (RenderComposite): its recording and fence until
+    // WaitForComposite.
+    struct CompositeInFlight {
+        CommandBuffer cmd;
+        UniqueFence fence;
+        bool empty;
+    };
+    std::optional<CompositeInFlight> composite_in_flight_;
+    double last_composite_gpu_ms_ = 0.0;
     Buffer stage_params_upload_;
     FrameRecordingKey stage_recorded_;
     bool stage_recording_valid_ = false;

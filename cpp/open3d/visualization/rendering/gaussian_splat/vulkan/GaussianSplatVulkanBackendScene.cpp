@@ -22,7 +22,7 @@ void GaussianSplatVulkanBackend::SetScene(const t::geometry::PointCloud& cloud) 
     core::RequireHostMemory(
         static_cast<uint64_t>(cloud.NumBytes()),
         fmt::format("vulkan backend: a host copy of {} splats", cloud.NumPoints()), "fewer splats");
-    if (geometry_.in_flight) Wait(*context_, geometry_stage_fence_.Get());
+    WaitForStageWork();
     geometry_ = GeometryState{};
     cloud_ = cloud;
     pool_scene_ = false;
@@ -47,7 +47,7 @@ bool GaussianSplatVulkanBackend::SetSceneHierarchy(const t::geometry::PointCloud
     }
     const PackedLodNodes lod = PackLodNodes(hierarchy);
     t::geometry::PointCloud nodes = HierarchyNodeCloud(hierarchy, source);
-    if (geometry_.in_flight) Wait(*context_, geometry_stage_fence_.Get());
+    WaitForStageWork();
     geometry_ = GeometryState{};
     cloud_ = std::move(nodes);
     pool_scene_ = false;
@@ -74,7 +74,7 @@ void GaussianSplatVulkanBackend::SetScenePool(int64_t capacity, int sh_degree,
     PackedGaussianSplats like = PackedSplatLayout(sh_degree, SplatPrecisionFor(compact_storage));
     like.center_min = center_min;
     like.center_max = center_max;
-    if (geometry_.in_flight) Wait(*context_, geometry_stage_fence_.Get());
+    WaitForStageWork();
     geometry_ = GeometryState{};
     RetireLod();
     lod_controller_.Reset();
@@ -128,7 +128,7 @@ void GaussianSplatVulkanBackend::WriteSceneSplatRanges(
             }
         }
     }
-    if (geometry_.in_flight) Wait(*context_, geometry_stage_fence_.Get());
+    WaitForStageWork();
     geometry_.in_flight = false;
     WaitAllSlots();  // frames in flight read the buffers written here
     if (host_copy) {
@@ -179,7 +179,7 @@ void GaussianSplatVulkanBackend::SetVisibility(const std::vector<uint32_t>& mask
             "Vulkan backend: a scene drawn through its hierarchy takes no visibility mask (the "
             "level-of-detail cut is its mask)");
     }
-    if (geometry_.in_flight) Wait(*context_, geometry_stage_fence_.Get());
+    WaitForStageWork();
     geometry_.in_flight = false;
     RetireSceneBuffers(true);
     ++scene_serial_;

@@ -143,7 +143,7 @@ void GaussianSplatVulkanBackend::EnsureScenePrecision(const RenderConfig& config
             precision == SplatPrecision::kCompact ? "float32" : "half precision",
             precision == SplatPrecision::kCompact ? "true" : "false");
     }
-    if (geometry_.in_flight) Wait(*context_, geometry_stage_fence_.Get());
+    WaitForStageWork();
     geometry_.in_flight = false;
     UploadScene(precision);
     geometry_.valid = false;

@@ -1,0 +1,149 @@
+// A composite the host does not wait for (GaussianSplatVulkanBackend::RenderComposite with a
+// sink that signals a semaphore and reads nothing back, as a presented Filament frame with
+// the GL hand-over does): it must write the same picture as the read-back path, be waited for
+// before anything reuses what it touches, and report its GPU time with the next such frame.
+// Any device runs it: the semaphore here is a plain one, waited for by an empty submission
+// as GL would wait for the exported one. The fixture's validation checks the semaphore use.
+#include <gtest/gtest.h>
+
+#include <cstring>
+
+#include "TestUtility.h"
+#include "open3d/camera/CamerasJson.h"
+#include "open3d/t/io/PointCloudIO.h"
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/Commands.h"
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/GaussianSplatVulkanBackend.h"
+#include "open3d/visualization/rendering/gaussian_splat/vulkan/Image.h"
+#include "visualization/rendering/gaussian_splat/vulkan/VulkanTestFixture.h"
+
+namespace open3d {
+namespace tests {
+namespace {
+
+using namespace visualization::rendering;
+using vulkan::CompositeSink;
+
+constexpr int kWidth = 64;
+constexpr int kHeight = 48;
+
+// Composites into its own RGBA32F image (the read-back path's format, so both must agree
+// bit for bit) and signals `signal` without reading back.
+class SignallingSink final : public CompositeSink {
+public:
+    SignallingSink(const vulkan::VulkanContext& context, VkSemaphore signal)
+        : color_(context, kWidth, kHeight, VK_FORMAT_R32G32B32A32_SFLOAT,
+                 VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT |
+                     VK_IMAGE_USAGE_TRANSFER_DST_BIT),
+          signal_(signal) {}
+
+    const vulkan::Image& ColorTarget() const override { return color_; }
+    void AdjustParams(vulkan::CompositeParams&) const override {}
+    void RecordBefore(const Frame& frame) override {
+        vulkan::RecordImageBarrier(frame.cmd, color_.Get(), VK_IMAGE_ASPECT_COLOR_BIT,
+                                   VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_GENERAL,
+                                   VK_PIPELINE_STAGE_2_NONE, VK_ACCESS_2_NONE, frame.write_stage,
+                                   frame.write_access);
+    }
+    void RecordAfter(const Frame&) override {}
+    void ReadBack() override { ++read_backs; }
+    VkSemaphore TakeSignalSemaphore() override { return signal_; }
+    bool ReadsBack() const override { return false; }
+
+    // The colour image's floats, copied after everything submitted so far.
+    std::vector<float> Read(const vulkan::VulkanContext& context, vulkan::CommandPool& pool) {
+        const size_t floats = size_t(kWidth) * kHeight * 4;
+        vulkan::Buffer buffer(context, floats * sizeof(float), VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                              vulkan::MemoryUsage::kHostReadback);
+        vulkan::SubmitAndWait(context, pool, [&](VkCommandBuffer cmd) {
+            vulkan::RecordImageBarrier(
+                cmd, color_.Get(), VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_GENERAL,
+                VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT,
+                VK_ACCESS_2_MEMORY_WRITE_BIT, VK_PIPELINE_STAGE_2_COPY_BIT,
+                VK_ACCESS_2_TRANSFER_READ_BIT);
+            vulkan::RecordCopyToBuffer(cmd, color_, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+                                       buffer.Get());
+            vulkan::RecordMemoryBarrier(cmd, VK_PIPELINE_STAGE_2_COPY_BIT,
+                                        VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                                        VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT);
+        });
+        std::vector<float> values(floats);
+        std::memcpy(values.data(), buffer.GetMapped(), floats * sizeof(float));
+        return values;
+    }
+
+    int read_backs = 0;
+
+private:
+    vulkan::Image color_;
+    VkSemaphore signal_;
+};
+
+// What GL does with the "splats drawn" semaphore: one wait per signal, here an empty
+// submission that waits for it.
+void ConsumeSignal(const vulkan::VulkanContext& context, vulkan::CommandPool& pool,
+                   VkSemaphore semaphore) {
+    vulkan::CommandBuffer cmd = pool.Allocate();
+    cmd.Begin();
+    cmd.End();
+    vulkan::UniqueFence fence = vulkan::CreateFence(context);
+    vulkan::SubmitToQueue(context.GetQueue(), cmd.Get(), fence.Get(), semaphore,
+                          VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_NULL_HANDLE);
+    vulkan::Wait(context, fence.Get());
+}
+
+class DeferredComposite : public VulkanTest {};
+
+TEST_F(DeferredComposite, WritesTheReadbackPathsColourAndIsWaitedForBeforeReuse) {
+    OPEN3D_REQUIRE_DATA("playbot/playbot_31k.ply");
+    t::geometry::PointCloud cloud;
+    t::io::ReadPointCloud(DataPath("playbot/playbot_31k.ply"), cloud);
+    const auto cameras = camera::ReadCamerasJson(DataPath("playbot/cameras.json"));
+    auto backend = MakeBackend();
+    backend->SetScene(cloud);
+    RenderConfig config;
+    const vulkan::UniqueSemaphore semaphore = vulkan::CreateBinarySemaphore(Context());
+    SignallingSink sink(Context(), semaphore.Get());
+
+    // Two views, each: the deferred composite, then the read-back path of the same geometry
+    // stage (which first waits for the deferred one).
+    for (int view : {0, 8}) {
+        SCOPED_TRACE(view);
+        const camera::PinholeCamera camera = cameras.at(view).camera.Resized(kWidth, kHeight);
+        backend->RenderGeometryStage(camera, config);
+        const int64_t before = backend->GetCounters().composites;
+        const RenderStats deferred = backend->RenderComposite(sink);
+        EXPECT_EQ(backend->GetCounters().composites, before + 1);
+        EXPECT_EQ(sink.read_backs, view == 0 ? 1 : 2);  // called, reads nothing
+        EXPECT_GT(deferred.num_tile_entries, 0);
+        // The first deferred frame has no finished one before it to report.
+        if (view == 0) EXPECT_EQ(deferred.gpu_composite_ms, 0.0);
+        if (view != 0) EXPECT_GT(deferred.gpu_composite_ms, 0.0);
+        ConsumeSignal(Context(), Pool(), semaphore.Get());
+        backend->WaitForComposite();
+        const std::vector<float> colour = sink.Read(Context(), Pool());
+
+        RenderOutput readback;
+        backend->RenderCompositeStage(readback);
+        ASSERT_EQ(readback.color.NumPixels(), int64_t(kWidth) * kHeight);
+        // Same shader, inputs and format: the same floats.
+        EXPECT_EQ(
+            std::memcmp(colour.data(), readback.color.Data<float>(), colour.size() * sizeof(float)),
+            0);
+        EXPECT_GT(readback.stats.gpu_composite_ms, 0.0);
+    }
+
+    // A deferred frame left in flight is waited for by the next geometry stage (which rewrites
+    // the entries it reads) and by the backend's destruction.
+    const camera::PinholeCamera camera = cameras.at(0).camera.Resized(kWidth, kHeight);
+    backend->RenderGeometryStage(camera, config);
+    backend->RenderComposite(sink);
+    ConsumeSignal(Context(), Pool(), semaphore.Get());
+    backend->RenderGeometryStage(cameras.at(8).camera.Resized(kWidth, kHeight), config);
+    RenderOutput last;
+    backend->RenderCompositeStage(last);
+    EXPECT_GT(last.stats.num_tile_entries, 0);
+}
+
+}  // namespace
+}  // namespace tests
+}  // namespace open3d
