@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <vector>
 
 #include "TestUtility.h"
@@ -233,6 +234,33 @@ TEST_F(Interop, CompositeEqualsTheReadbackPathWithinHalfPrecision) {
     EXPECT_GT(frame.stats.gpu_composite_ms, 0.0);
     EXPECT_TRUE(frame.linear_depth.IsEmpty());  // not requested
     EXPECT_EQ(backend->GetCounters().composites, 2);
+    EXPECT_EQ(backend->GetCounters().composite_reuses, 0);
+
+    // The same request for another view: the recording (which names no camera) is submitted
+    // again and must composite that view's entries, as the readback path does.
+    const camera::PinholeCamera view8 = camera::ReadCamerasJson(DataPath("playbot/cameras.json"))
+                                            .at(8)
+                                            .camera.Resized(kWidth, kHeight);
+    backend->RenderGeometryStage(view8, config_);
+    InteropFrame again;
+    vulkan::RenderCompositeToInterop(*backend, targets, request, again);
+    EXPECT_EQ(backend->GetCounters().composite_reuses, 1);
+    EXPECT_EQ(backend->GetCounters().composites, 3);
+    RenderOutput headless8;
+    backend->RenderCompositeStage(headless8);
+    EXPECT_TRUE(CompareHalf(again.color, headless8.color).within_bound);
+    ASSERT_EQ(again.color.NumPixels(), frame.color.NumPixels());
+    EXPECT_NE(std::memcmp(again.color.Data<float>(), frame.color.Data<float>(),
+                          size_t(frame.color.NumPixels()) * 4 * sizeof(float)),
+              0);
+    backend->RenderGeometryStage(camera_, config_);
+    // Another request (depth read back too) is recorded anew.
+    InteropCompositeRequest with_depth = request;
+    with_depth.read_depth = true;
+    InteropFrame depth_frame;
+    vulkan::RenderCompositeToInterop(*backend, targets, with_depth, depth_frame);
+    EXPECT_EQ(backend->GetCounters().composite_reuses, 1);
+    EXPECT_FALSE(depth_frame.linear_depth.IsEmpty());
 
     // The overlay is premultiplied on black whatever the config's background: Filament
     // draws the background. Same geometry stage (the background does not change it).

@@ -3,7 +3,11 @@
 // Vulkan backend). Layouts and transfers: docs/vulkan.md "Zero-copy interop targets".
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/GaussianSplatInterop.h"
 
+#include <fmt/format.h>
+
+#include <atomic>
 #include <cstring>
+#include <string>
 
 #include "open3d/core/Exception.h"
 #include "open3d/core/ParallelFor.h"
@@ -159,6 +163,14 @@ struct InteropTargets::Impl {
     Buffer depth_upload;
     UniqueSemaphore mesh_drawn;    // exportable; made by ExportMeshDrawnSemaphore
     UniqueSemaphore splats_drawn;  // exportable; made by ExportSplatsDrawnSemaphore
+    // Names these targets in composite recording keys (an address could be reused).
+    const uint64_t serial = NextSerial();
+
+private:
+    static uint64_t NextSerial() {
+        static std::atomic<uint64_t> next{1};
+        return next++;
+    }
 };
 
 namespace {
@@ -210,6 +222,15 @@ public:
         if (!request_.signal_splats_drawn || signalled_) return VK_NULL_HANDLE;
         signalled_ = true;  // GL waits once per signal
         return targets_.splats_drawn.Get();
+    }
+
+    // The request and the targets name everything recorded: the images and, made once
+    // each, the readback buffers.
+    std::string RecordingKey() const override {
+        return fmt::format("interop {} depth {} {} read {} {} {} {} {}", targets_.serial,
+                           request_.use_scene_depth, request_.scene_near, request_.read_color,
+                           request_.blend_over_mesh, request_.read_depth, request_.depth_near,
+                           request_.depth_far);
     }
 
     bool ReadsBack() const override {

@@ -35,11 +35,6 @@ void ToTransferSrc(VkCommandBuffer cmd, const Image& image, VkPipelineStageFlags
                        VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_READ_BIT);
 }
 
-// A pass's milliseconds from GpuTimestamps::ReadMilliseconds; 0 when it was not recorded.
-double PassMs(const std::vector<double>& ms, TimedPass pass) {
-    return std::max(0.0, ms[static_cast<uint32_t>(pass)]);
-}
-
 }  // namespace
 
 void GaussianSplatVulkanBackend::WarnNewFlags(uint32_t flags) {
@@ -97,6 +92,7 @@ void GaussianSplatVulkanBackend::ReleaseResources() {
     deferred_.Clear();
     geometry_ = GeometryState{};
     stage_recording_valid_ = false;
+    composite_recorded_.clear();
     cloud_.reset();
     visibility_mask_.clear();
     geometry_stage_resources_ = GeometryStageResources();
@@ -115,6 +111,7 @@ void GaussianSplatVulkanBackend::EnsureViewBuffers(uint32_t entry_capacity) {
     }
     geometry_stage_resources_.AllocateView(*context_, entry_capacity);
     stage_recording_valid_ = false;  // it binds the old buffers
+    composite_recorded_.clear();
     counters_readback_ = Buffer(*context_, sizeof(shader::GaussianGeometryStageCounters),
                                 VK_BUFFER_USAGE_TRANSFER_DST_BIT, MemoryUsage::kHostReadback);
 }
@@ -130,6 +127,7 @@ void GaussianSplatVulkanBackend::EnsureTargets(uint32_t width, uint32_t height) 
     composite_state_ = Buffer(*context_, GaussianCompositeStage::StateBytes(width, height),
                               need.state_usage, MemoryUsage::kDevice);
     stage_recording_valid_ = false;  // its per-tile bins name the old state buffer
+    composite_recorded_.clear();
     width_ = width;
     height_ = height;
 }
@@ -410,196 +408,6 @@ void GaussianSplatVulkanBackend::WaitForGeometry() {
     t.gpu_tile_sort_ms = at(TimedPass::kTileSort);
     t.gpu_lod_cut_ms = geometry_stage_resources_.HasLod() ? at(TimedPass::kLodCut) : 0.0;
     t.gpu_lod_list_ms = geometry_stage_resources_.HasLod() ? at(TimedPass::kLodCutList) : 0.0;
-}
-
-void GaussianSplatVulkanBackend::WaitForComposite() {
-    if (!composite_in_flight_) return;
-    Wait(*context_, composite_in_flight_->fence.Get());
-    const std::vector<double> ms = composite_stage_timestamps_.ReadMilliseconds();
-    last_composite_gpu_ms_ = composite_in_flight_->empty ? 0.0 : PassMs(ms, TimedPass::kComposite);
-    composite_in_flight_.reset();
-}
-
-void GaussianSplatVulkanBackend::WaitForStageWork() {
-    if (geometry_.in_flight) Wait(*context_, geometry_stage_fence_.Get());
-    WaitForComposite();
-}
-
-RenderStats GaussianSplatVulkanBackend::RenderComposite(CompositeSink& sink) {
-    if (!geometry_.valid)
-        core::ThrowError("Vulkan backend: a composite before RenderGeometryStage");
-    const auto start = std::chrono::steady_clock::now();
-    const uint32_t w = static_cast<uint32_t>(geometry_.camera.width);
-    const uint32_t h = static_cast<uint32_t>(geometry_.camera.height);
-    const Image& color = sink.ColorTarget();
-    if (color.GetWidth() != w || color.GetHeight() != h) {
-        core::ThrowError("Vulkan backend: the composite targets are {}x{}, the camera is {}x{}",
-                         color.GetWidth(), color.GetHeight(), w, h);
-    }
-    const auto geometry_wait_start = std::chrono::steady_clock::now();
-    WaitForGeometry();
-    WaitForComposite();
-    const double geometry_wait_ms = core::MillisecondsSince(geometry_wait_start);
-    EnsureTargets(w, h);
-    shader::GaussianGeometryStageCounters gpu_counters{};
-    std::memcpy(&gpu_counters, counters_readback_.GetMapped(), sizeof(gpu_counters));
-
-    // The allocation, not the config, cut this frame short: grow the entry buffers to what
-    // it asked for (plus a quarter, so a moving camera does not regrow every frame) and
-    // render it again before anything is composited (the sink's semaphores are taken by the
-    // frame that runs). Geometry stage reported the full request, so one retry suffices.
-    const uint64_t limit = MaxEntryCapacity(geometry_.config, SortMaxCount());
-    if ((gpu_counters.error_flags & kCountsClamped) &&
-        geometry_stage_resources_.EntryCapacity() < limit && !growing_) {
-        const uint64_t asked = gpu_counters.requested_entries;
-        EnsureViewBuffers(static_cast<uint32_t>(std::min<uint64_t>(limit, asked + asked / 4)));
-        ++counters_.capacity_growths;
-        growing_ = true;
-        const camera::PinholeCamera camera = geometry_.camera;
-        const RenderConfig config = geometry_.config;
-        geometry_.valid = false;
-        RenderGeometryStage(camera, config);
-        const RenderStats stats = RenderComposite(sink);
-        growing_ = false;
-        return stats;
-    }
-    // Nothing to blend (everything culled or hidden): no composite dispatch, the images are
-    // cleared to the background instead.
-    const bool empty = gpu_counters.entry_count == 0;
-
-    CompositeParams params;
-    for (int c = 0; c < 3; ++c)
-        params.background[c] = static_cast<float>(geometry_.config.background[c]);
-    sink.AdjustParams(params);
-
-    const auto record_start = std::chrono::steady_clock::now();
-    CommandBuffer cmd_buffer = pool_.Allocate();
-    VkCommandBuffer cmd = cmd_buffer.Get();
-    cmd_buffer.Begin();
-    composite_stage_timestamps_.RecordReset(cmd);
-    // Geometry stage's results (a previous submission, ordered by the fence wait) to compute reads.
-    RecordMemoryBarrier(cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_MEMORY_WRITE_BIT,
-                        VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_COPY_BIT,
-                        VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_TRANSFER_READ_BIT);
-    CompositeSink::Frame frame;
-    frame.cmd = cmd;
-    frame.empty = empty;
-    frame.write_stage =
-        empty ? VK_PIPELINE_STAGE_2_CLEAR_BIT : VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT;
-    frame.write_access =
-        empty ? VK_ACCESS_2_TRANSFER_WRITE_BIT : VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT;
-    frame.depth = &depth_;
-    frame.alpha = &alpha_;
-    frame.median = &median_;
-    frame.splat_id = params.splat_id ? &splat_id_ : nullptr;
-    if (params.splat_id && !splat_id_) {
-        core::ThrowError(
-            "Vulkan backend: this composite's sink asks for an ID image it has none of");
-    }
-    frame.composite_stage = &composite_stage_;
-    frame.timestamps = &composite_stage_timestamps_;
-    // The last frame copied these (readback) or read them in a depth merge.
-    const std::array<const Image*, 4> written{&depth_, &alpha_, &median_, frame.splat_id};
-    for (const Image* image : written) {
-        if (image == nullptr) continue;
-        RecordImageBarrier(cmd, image->Get(), VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
-                           VK_IMAGE_LAYOUT_GENERAL,
-                           VK_PIPELINE_STAGE_2_COPY_BIT | VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
-                           VK_ACCESS_2_TRANSFER_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_READ_BIT,
-                           frame.write_stage, frame.write_access);
-    }
-    sink.RecordBefore(frame);
-    if (empty) {
-        const VkImageSubresourceRange all{VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
-        VkClearColorValue background{};
-        for (int c = 0; c < 3; ++c) background.float32[c] = params.background[c];
-        const VkClearColorValue zero{};
-        vkCmdClearColorImage(cmd, color.Get(), VK_IMAGE_LAYOUT_GENERAL, &background, 1, &all);
-        for (const Image* image : {&depth_, &alpha_, &median_}) {
-            vkCmdClearColorImage(cmd, image->Get(), VK_IMAGE_LAYOUT_GENERAL, &zero, 1, &all);
-        }
-        if (frame.splat_id) {
-            VkClearColorValue none{};
-            none.uint32[0] = kNoSplatId;
-            vkCmdClearColorImage(cmd, splat_id_.Get(), VK_IMAGE_LAYOUT_GENERAL, &none, 1, &all);
-        }
-        ++counters_.skipped_composites;
-    } else {
-        CompositeStageInputs inputs;
-        inputs.projected = geometry_stage_resources_.ViewResources().projected.Range();
-        inputs.entry_keys = geometry_stage_resources_.ViewResources().entry_keys.Range();
-        inputs.entry_values = geometry_stage_resources_.ViewResources().entry_values.Range();
-        inputs.entry_count = geometry_stage_resources_.ViewResources().counters.Range(
-            offsetof(shader::GaussianGeometryStageCounters, entry_count), sizeof(uint32_t));
-        inputs.entry_capacity = geometry_stage_resources_.EntryCapacity();
-        inputs.ranges_written = geometry_.config.sort_mode == SortMode::kExactTileBins;
-        CompositeStageTargets targets;
-        targets.width = w;
-        targets.height = h;
-        targets.color_format = color.GetFormat() == ToVkFormat(CompositeColorFormat::kRgba16f)
-                                   ? CompositeColorFormat::kRgba16f
-                                   : CompositeColorFormat::kRgba32f;
-        targets.color = color.GetView();
-        targets.depth = depth_.GetView();
-        targets.alpha = alpha_.GetView();
-        targets.median_depth = median_.GetView();
-        targets.splat_id = frame.splat_id ? splat_id_.GetView() : VK_NULL_HANDLE;
-        composite_stage_timestamps_.RecordBegin(cmd, TimedPass::kComposite);
-        composite_stage_.RecordComposite(cmd, inputs, targets, composite_state_.Range(), params);
-        composite_stage_timestamps_.RecordEnd(cmd, TimedPass::kComposite);
-    }
-    sink.RecordAfter(frame);
-    cmd_buffer.End();
-    UniqueFence fence = CreateFence(*context_);
-    const double record_ms = core::MillisecondsSince(record_start);
-    const auto submit_start = std::chrono::steady_clock::now();
-    const VkSemaphore signal = sink.TakeSignalSemaphore();
-    SubmitToQueue(context_->GetQueue(), cmd, fence.Get(), sink.TakeWaitSemaphore(),
-                  VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, signal);
-    const double submit_ms = core::MillisecondsSince(submit_start);
-    ++counters_.composites;
-    // Another API waits for the frame on the GPU and the host reads nothing: no wait here.
-    const bool waited = signal == VK_NULL_HANDLE || sink.ReadsBack();
-    const auto wait_start = std::chrono::steady_clock::now();
-    if (waited) {
-        Wait(*context_, fence.Get());
-    } else {
-        composite_in_flight_ = CompositeInFlight{std::move(cmd_buffer), std::move(fence), empty};
-    }
-    const double wait_ms = core::MillisecondsSince(wait_start);
-
-    WarnNewFlags(gpu_counters.error_flags);
-    const auto readback_start = std::chrono::steady_clock::now();
-    sink.ReadBack();
-
-    // A reused geometry stage did no work this frame: its times stay 0.
-    RenderStats s = geometry_.reused ? RenderStats{} : geometry_.times;
-    s.num_splats = geometry_stage_resources_.Layout().num_splats;
-    s.num_visible = gpu_counters.visible_count;
-    s.lod_cut_nodes = geometry_stage_resources_.HasLod() ? gpu_counters.lod_cut_nodes : 0;
-    s.lod_walk_visited = geometry_stage_resources_.HasLod() ? gpu_counters.lod_walk_visited : 0;
-    s.lod_walks = geometry_stage_resources_.HasLod() ? int(gpu_counters.lod_walks) : 0;
-    s.num_tile_entries = gpu_counters.entry_count;
-    s.error_flags = gpu_counters.error_flags;
-    s.geometry_reused = geometry_.reused;
-    s.composite_ms = core::MillisecondsSince(start);
-    if (waited) {
-        const std::vector<double> ms = composite_stage_timestamps_.ReadMilliseconds();
-        s.gpu_composite_ms = empty ? 0.0 : PassMs(ms, TimedPass::kComposite);
-        s.gpu_merge_ms = PassMs(ms, TimedPass::kDepthMerge);
-    } else {
-        s.gpu_composite_ms = last_composite_gpu_ms_;  // still running: the last one waited for
-    }
-    s.gpu_scene_bytes = static_cast<int64_t>(geometry_stage_resources_.SceneBytes());
-    // The geometry stage's recording and submission (0 when reused), then this frame's.
-    s.host_record_ms += record_ms;
-    s.host_submit_ms += submit_ms;
-    s.host_wait_ms = geometry_wait_ms + wait_ms;
-    s.host_readback_ms = core::MillisecondsSince(readback_start);
-    if (!geometry_.reused) {
-        ObserveLodFrame(geometry_.config, s.gpu_project_ms + s.gpu_sort_ms + s.gpu_composite_ms);
-    }
-    return s;
 }
 
 RenderConfig GaussianSplatVulkanBackend::WithLodTarget(const RenderConfig& config) {

@@ -14,6 +14,7 @@
 
 #include <memory>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "open3d/camera/PinholeCamera.h"
@@ -87,6 +88,10 @@ public:
     /// waits for it before reading the targets, e.g. GL before sampling the colour), or
     /// VK_NULL_HANDLE. Asked once per submission.
     virtual VkSemaphore TakeSignalSemaphore() { return VK_NULL_HANDLE; }
+    /// Everything RecordBefore, RecordAfter and AdjustParams depend on, as text: while it (and
+    /// what the backend records) stays the same, the last recording is submitted again.
+    /// Empty, the default: recorded every frame.
+    virtual std::string RecordingKey() const { return {}; }
     /// Whether ReadBack reads what the GPU wrote. A frame that reads nothing and signals a
     /// semaphore is not waited for: the backend waits for its fence before the next use of
     /// what it touches (WaitForComposite).
@@ -207,7 +212,8 @@ public:
         int64_t scene_uploads = 0;         ///< packs + uploads of the scene
         int64_t geometry_runs = 0;         ///< geometry stage recorded
         int64_t geometry_reuses = 0;       ///< geometry stage skipped (nothing changed)
-        int64_t composites = 0;            ///< composite stage recorded
+        int64_t composites = 0;            ///< composite stage submitted
+        int64_t composite_reuses = 0;      ///< of those, submitted again without recording
         int64_t capacity_growths = 0;      ///< frames re-rendered with larger entry buffers
         int64_t skipped_composites = 0;    ///< frames with no tile entry: images cleared instead
         int64_t submissions = 0;           ///< submission path: command buffers submitted
@@ -288,6 +294,10 @@ private:
     void EnsureTargets(uint32_t width, uint32_t height);
     void EnsureReadback(uint32_t width, uint32_t height);
     void WaitForGeometry();
+    /// The composite's commands for `sink` into `cmd` (begun): barriers, the sink's hooks, the
+    /// composite or, for an empty frame, the clears.
+    void RecordCompositeFrame(CompositeSink& sink, VkCommandBuffer cmd,
+                              const CompositeParams& params, bool empty);
     /// The stage path's submissions (geometry and composite) complete before their buffers
     /// change.
     void WaitForStageWork();
@@ -336,14 +346,13 @@ private:
     // written into stage_params_upload_.
     CommandBuffer geometry_stage_cmd_;
     UniqueFence geometry_stage_fence_;
-    // A composite not waited for (RenderComposite): its recording and fence until
-    // WaitForComposite.
-    struct CompositeInFlight {
-        CommandBuffer cmd;
-        UniqueFence fence;
-        bool empty;
-    };
-    std::optional<CompositeInFlight> composite_in_flight_;
+    // The last composite's recording (submitted again while its key stays), its fence, and
+    // whether it is in flight without a host wait (until WaitForComposite).
+    CommandBuffer composite_cmd_;
+    UniqueFence composite_fence_;
+    std::string composite_recorded_;  ///< its key; empty: never reused
+    bool composite_in_flight_ = false;
+    bool composite_in_flight_empty_ = false;
     double last_composite_gpu_ms_ = 0.0;
     Buffer stage_params_upload_;
     FrameRecordingKey stage_recorded_;

@@ -67,6 +67,11 @@ private:
     UniqueQueryPool pool_;
 };
 
+/// A pass's milliseconds from GpuTimestamps::ReadMilliseconds; 0 when it was not recorded.
+inline double PassMs(const std::vector<double>& ms, TimedPass pass) {
+    return ms[static_cast<uint32_t>(pass)] > 0.0 ? ms[static_cast<uint32_t>(pass)] : 0.0;
+}
+
 }  // namespace vulkan
 }  // namespace rendering
 }  // namespace visualization
