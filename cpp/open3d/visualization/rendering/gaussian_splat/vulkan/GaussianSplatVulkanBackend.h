@@ -301,6 +301,9 @@ private:
     /// The stage path's submissions (geometry and composite) complete before their buffers
     /// change.
     void WaitForStageWork();
+    /// A frame's counts and flags from its geometry stage's counters, and the scene's bytes.
+    void FillCounterStats(const shader::GaussianGeometryStageCounters& counters,
+                          RenderStats& stats) const;
 
     std::unique_ptr<VulkanContext> context_;
     CommandPool pool_;

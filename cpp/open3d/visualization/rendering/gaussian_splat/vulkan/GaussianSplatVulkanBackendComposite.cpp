@@ -29,6 +29,19 @@ void GaussianSplatVulkanBackend::WaitForComposite() {
     composite_in_flight_ = false;
 }
 
+void GaussianSplatVulkanBackend::FillCounterStats(const shader::GaussianGeometryStageCounters& c,
+                                                  RenderStats& s) const {
+    const bool lod = geometry_stage_resources_.HasLod();
+    s.num_splats = geometry_stage_resources_.Layout().num_splats;
+    s.num_visible = c.visible_count;
+    s.lod_cut_nodes = lod ? c.lod_cut_nodes : 0;
+    s.lod_walk_visited = lod ? c.lod_walk_visited : 0;
+    s.lod_walks = lod ? int(c.lod_walks) : 0;
+    s.num_tile_entries = c.entry_count;
+    s.error_flags = c.error_flags;
+    s.gpu_scene_bytes = static_cast<int64_t>(geometry_stage_resources_.SceneBytes());
+}
+
 void GaussianSplatVulkanBackend::WaitForStageWork() {
     if (geometry_.in_flight) Wait(*context_, geometry_stage_fence_.Get());
     WaitForComposite();
@@ -224,13 +237,7 @@ RenderStats GaussianSplatVulkanBackend::RenderComposite(CompositeSink& sink) {
 
     // A reused geometry stage did no work this frame: its times stay 0.
     RenderStats s = geometry_.reused ? RenderStats{} : geometry_.times;
-    s.num_splats = geometry_stage_resources_.Layout().num_splats;
-    s.num_visible = gpu_counters.visible_count;
-    s.lod_cut_nodes = geometry_stage_resources_.HasLod() ? gpu_counters.lod_cut_nodes : 0;
-    s.lod_walk_visited = geometry_stage_resources_.HasLod() ? gpu_counters.lod_walk_visited : 0;
-    s.lod_walks = geometry_stage_resources_.HasLod() ? int(gpu_counters.lod_walks) : 0;
-    s.num_tile_entries = gpu_counters.entry_count;
-    s.error_flags = gpu_counters.error_flags;
+    FillCounterStats(gpu_counters, s);
     s.geometry_reused = geometry_.reused;
     s.composite_ms = core::MillisecondsSince(start);
     if (waited) {
@@ -240,7 +247,6 @@ RenderStats GaussianSplatVulkanBackend::RenderComposite(CompositeSink& sink) {
     } else {
         s.gpu_composite_ms = last_composite_gpu_ms_;  // still running: the last one waited for
     }
-    s.gpu_scene_bytes = static_cast<int64_t>(geometry_stage_resources_.SceneBytes());
     // The geometry stage's recording and submission (0 when reused), then this frame's.
     s.host_record_ms += record_ms;
     s.host_submit_ms += submit_ms;

@@ -235,14 +235,7 @@ std::vector<RenderOutput> GaussianSplatVulkanBackend::WaitBatch(uint64_t ticket)
     for (size_t i = 0; i < views; ++i) {
         const GaussianGeometryStageCounters c = counters_of(i);
         RenderStats& s = outputs[i].stats;
-        s.num_splats = geometry_stage_resources_.Layout().num_splats;
-        s.num_visible = c.visible_count;
-        s.lod_cut_nodes = geometry_stage_resources_.HasLod() ? c.lod_cut_nodes : 0;
-        s.lod_walk_visited = geometry_stage_resources_.HasLod() ? c.lod_walk_visited : 0;
-        s.lod_walks = geometry_stage_resources_.HasLod() ? int(c.lod_walks) : 0;
-        s.num_tile_entries = c.entry_count;
-        s.error_flags = c.error_flags;
-        s.gpu_scene_bytes = static_cast<int64_t>(geometry_stage_resources_.SceneBytes());
+        FillCounterStats(c, s);
         flags |= c.error_flags;
     }
     if (slot.options.read_back) {
