@@ -128,8 +128,9 @@ void SplatTargets::CreateZeroCopy(GaussianSplatBackend& backend) {
 
 void SplatTargets::SetUpGpuHandover(GaussianSplatBackend& backend) {
     const GlFunctions& gl = engine_.GetGl();
-    // Opt-in: on the H100 (driver 580.159.04) the first frames with the semaphore crashed
-    // (SIGSEGV) before the cause could be found, while the host wait ran (docs/filament.md).
+    // Opt-in: on the H100 (driver 580.159.04) the first frame with the semaphores crashes in
+    // Filament's createFenceS under RunOnDriverThread, while the host wait runs
+    // (docs/filament.md "Synchronisation").
     const char* env = std::getenv("OPEN3D_GL_VK_SEMAPHORES");
     std::string why;
     if (env == nullptr || std::string(env) != "1") {
