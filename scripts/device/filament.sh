@@ -66,7 +66,8 @@ probe() {
 }
 
 if [ -e $xr/validation.done ]; then
-  export VK_LAYER_PATH=$xr/validation
+  # The suites run with the Khronos validation layer, as scripts/test.sh runs them here.
+  export VK_LAYER_PATH=$xr/validation OPEN3D_VULKAN_VALIDATION=${OPEN3D_VULKAN_VALIDATION:-1}
 else
   export OPEN3D_VULKAN_VALIDATION=0
 fi
@@ -79,9 +80,11 @@ suites() {
     [ -x ".devbin/$name" ] || { say "$name: not carried"; continue; }
     local filter='*'
     [ "$name" = tests_gaussian_splat_vulkan ] && filter='Interop.*'
-    timeout "${SUITE_TIMEOUT:-300}" ".devbin/$name" --gtest_brief=1 --gtest_filter="$filter" \
-      >"$out/$name.log" 2>&1
-    say "$name: exit $?"
+    timeout "${SUITE_TIMEOUT:-300}" ".devbin/$name" --gtest_filter="$filter" >"$out/$name.log" 2>&1
+    local rc=$?
+    say "$name: exit $rc"
+    # A crash or a hang names no test: the last one started is where it stopped.
+    [ $rc -eq 0 ] || grep "^\[ RUN" "$out/$name.log" | tail -1 | tee -a "$summary"
     grep -E "^\[  (PASSED|FAILED|SKIPPED) |^\[==========\]|Splat images|hands the mesh|Vulkan device|rror" \
       "$out/$name.log" | sort | uniq -c | sort -rn | head -12 | cut -c1-400 | tee -a "$summary"
   done

@@ -1,7 +1,7 @@
-// FilamentEngine::RunOnDriverThread (FilamentDriverThread.h): on EGL an action runs on
-// Filament's driver thread with a GL context current, at its place in Filament's command
-// stream: after a texture upload issued before it (it reads the uploaded bytes back), and
-// before an action issued after it. On GLX nothing runs and the call says so.
+// FilamentEngine::RunOnDriverThread (FilamentDriverThread.h): on EGL and on GLX an action
+// runs on Filament's driver thread with a GL context current, at its place in Filament's
+// command stream: after a texture upload issued before it (it reads the uploaded bytes back),
+// and before an action issued after it.
 #include <gtest/gtest.h>
 
 #include <filament/Engine.h>
@@ -9,10 +9,12 @@
 
 #include <array>
 #include <cstdint>
+#include <cstring>
 #include <thread>
 #include <vector>
 
 #include "TestUtility.h"
+#include "open3d/visualization/rendering/filament/FilamentDriverThread.h"
 #include "open3d/visualization/rendering/filament/FilamentEngine.h"
 #include "open3d/visualization/rendering/gaussian_splat/GaussianSplatBackend.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/VulkanBackendRegistry.h"
@@ -23,10 +25,11 @@ namespace {
 
 namespace rendering = visualization::rendering;
 
-TEST(FilamentDriverThread, ActionsRunInStreamOrderOnFilamentsThread) {
-    const std::string reason = rendering::FilamentUnavailableReason(rendering::GlPlatform::kEgl);
+void CheckActionsRunInStreamOrder(rendering::GlPlatform platform) {
+    const std::string reason = rendering::FilamentUnavailableReason(platform);
     if (!reason.empty()) OPEN3D_SKIP_OR_FAIL_WHEN_UNAVAILABLE(reason);
-    rendering::FilamentEngine engine(rendering::GlPlatform::kEgl);
+    rendering::FilamentEngine engine(platform);
+    ASSERT_TRUE(engine.CanRunOnDriverThread()) << engine.DriverThreadUnavailableReason();
     const rendering::GlFunctions& gl = engine.GetGl();
     filament::Engine& e = engine.GetEngine();
 
@@ -97,6 +100,10 @@ TEST(FilamentDriverThread, ActionsRunInStreamOrderOnFilamentsThread) {
     gl.DeleteTextures(1, &id);
 }
 
+TEST(FilamentDriverThread, ActionsRunInStreamOrderOnFilamentsThreadOnEgl) {
+    CheckActionsRunInStreamOrder(rendering::GlPlatform::kEgl);
+}
+
 // NVIDIA's Vulkan driver ends the GPU's EGL display when the loader unloads it, i.e. when the
 // process's last Vulkan instance goes (docs/environment-notes.md "NVIDIA GPUs"); the engine
 // keeps the drivers loaded. A Vulkan backend made and destroyed after the engine must leave
@@ -118,19 +125,35 @@ TEST(FilamentDriverThread, EglContextsOutliveAVulkanBackend) {
     EXPECT_TRUE(ran) << "Filament's thread lost its context";
 }
 
-TEST(FilamentDriverThread, GlxRunsNothing) {
+TEST(FilamentDriverThread, ActionsRunInStreamOrderOnFilamentsThreadOnGlx) {
     // The suite's headless run (filament.egl_headless, no DISPLAY) is about EGL; the run with
     // an X server checks GLX (and fails in CI where that server is missing).
     if (rendering::ResolveGlPlatform(rendering::GlPlatform::kAuto) != rendering::GlPlatform::kGlx) {
         return;
     }
-    const std::string reason = rendering::FilamentUnavailableReason(rendering::GlPlatform::kGlx);
-    if (!reason.empty()) OPEN3D_SKIP_OR_FAIL_WHEN_UNAVAILABLE(reason);
-    rendering::FilamentEngine engine(rendering::GlPlatform::kGlx);
-    bool ran = false;
-    EXPECT_FALSE(engine.RunOnDriverThread([&] { ran = true; }));
-    engine.FlushAndWait();
-    EXPECT_FALSE(ran);
+    CheckActionsRunInStreamOrder(rendering::GlPlatform::kGlx);
+}
+
+// The hook reads Filament's private engine; where what it finds is not an OpenGL driver's
+// command stream it must refuse rather than queue into arbitrary memory.
+TEST(FilamentDriverThread, HookRefusesWhatIsNotFilamentsCommandStream) {
+    struct NotADriver {
+        virtual ~NotADriver() = default;
+    };
+    NotADriver not_a_driver;
+    alignas(16) std::array<unsigned char, 4096> fake_engine{};
+    auto& engine = *reinterpret_cast<filament::Engine*>(fake_engine.data());
+    const rendering::DriverThreadHook empty(engine);
+    EXPECT_FALSE(empty.Available());
+    EXPECT_NE(empty.Why().find("no driver"), std::string::npos) << empty.Why();
+
+    void* driver = &not_a_driver;
+    std::memcpy(fake_engine.data() + 0xa50, &driver, sizeof(driver));
+    const rendering::DriverThreadHook wrong(engine);
+    EXPECT_FALSE(wrong.Available());
+    EXPECT_NE(wrong.Why().find("not Filament 1.9.25's OpenGL driver"), std::string::npos)
+        << wrong.Why();
+    EXPECT_FALSE(wrong.Run([] {}));
 }
 
 }  // namespace

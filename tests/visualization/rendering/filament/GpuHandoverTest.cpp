@@ -1,7 +1,7 @@
 // The hand-over from GL's mesh view to Vulkan's composite (SplatTargets::SignalMeshDrawn):
-// where Vulkan exports and GL imports semaphores and Filament's thread can be reached (EGL),
-// GL signals a semaphore after the mesh view and the composite waits for it on the GPU;
-// elsewhere the host waits for GL. The semaphore is opt-in (OPEN3D_GL_VK_SEMAPHORES=1, set here).
+// where Vulkan exports and GL imports semaphores and Filament's thread can be reached, GL
+// signals a semaphore after the mesh view and the composite waits for it on the GPU;
+// elsewhere, and with OPEN3D_GL_VK_SEMAPHORES=0 (set here for the reference), the host waits.
 // Both must give the same frame, byte for byte, over several
 // frames (a binary semaphore signalled and waited once per frame), colour and depth. On
 // llvmpipe and lavapipe (no semaphore export) both frames take the host wait; on NVIDIA this

@@ -11,7 +11,6 @@
 
 #include "open3d/core/Exception.h"
 #include "open3d/core/Logging.h"
-#include "open3d/visualization/rendering/filament/FilamentDriverThread.h"
 #include "open3d/visualization/rendering/filament/FilamentOpenGLPlatform.h"
 
 namespace open3d {
@@ -171,11 +170,10 @@ EGLSurface CreatePbuffer(EGLDisplay display, EGLConfig config, uint32_t width, u
 // context createDriver makes.
 class EglFilamentPlatform final : public filament::backend::OpenGLPlatform {
 public:
-    EglFilamentPlatform(const EglContext& shared, DriverThreadQueue& queue)
+    explicit EglFilamentPlatform(const EglContext& shared)
         : display_(shared.NativeDisplay()),
           config_(shared.NativeConfig()),
-          shared_(shared.NativeContext()),
-          queue_(queue) {}
+          shared_(shared.NativeContext()) {}
 
     int getOSVersion() const noexcept override { return 0; }
 
@@ -234,13 +232,11 @@ public:
     }
     void setPresentationTime(int64_t) noexcept override {}
 
-    // Filament asks for a platform fence only for the hard fences RunOnDriverThread makes
-    // (FilamentDriverThread.h): each runs the next queued action, here on the driver thread
-    // at its place in the stream. No fence is made: nobody waits for these.
-    Fence* createFence() noexcept override {
-        queue_.RunNext();
-        return nullptr;
-    }
+    // Filament asks for a platform fence only for a hard fence (FEngine's private
+    // createFence), which neither Filament's public API nor Open3D makes; without
+    // canCreateFence its timer queries stay off platform fences.
+    bool canCreateFence() noexcept override { return false; }
+    Fence* createFence() noexcept override { return nullptr; }
     void destroyFence(Fence*) noexcept override {}
     filament::backend::FenceStatus waitFence(Fence*, uint64_t) noexcept override {
         return filament::backend::FenceStatus::ERROR;
@@ -272,7 +268,6 @@ private:
     EGLContext shared_;
     EGLContext context_ = EGL_NO_CONTEXT;
     EGLSurface pbuffer_ = EGL_NO_SURFACE;
-    DriverThreadQueue& queue_;
 };
 
 }  // namespace
@@ -326,9 +321,8 @@ void* EglContext::GetProcAddress(const char* name) {
     return reinterpret_cast<void*>(eglGetProcAddress(name));
 }
 
-std::unique_ptr<filament::backend::Platform> CreateEglFilamentPlatform(const EglContext& context,
-                                                                       DriverThreadQueue& queue) {
-    return std::make_unique<EglFilamentPlatform>(context, queue);
+std::unique_ptr<filament::backend::Platform> CreateEglFilamentPlatform(const EglContext& context) {
+    return std::make_unique<EglFilamentPlatform>(context);
 }
 
 std::string EglUnavailableReason() {

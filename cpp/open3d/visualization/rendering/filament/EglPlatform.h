@@ -52,15 +52,10 @@ private:
     std::string description_;
 };
 
-class DriverThreadQueue;
-
 /// Filament's OpenGL platform on `context`'s display: its driver thread gets a context that
 /// shares objects with `context` and a 1x1 pbuffer; headless swap chains are pbuffers; a
-/// window's swap chain is refused (an error in the log and no swap chain). Each platform
-/// fence Filament asks for runs the next action of `queue` (FilamentDriverThread.h), which
-/// must outlive the platform.
-std::unique_ptr<filament::backend::Platform> CreateEglFilamentPlatform(const EglContext& context,
-                                                                       DriverThreadQueue& queue);
+/// window's swap chain is refused (an error in the log and no swap chain).
+std::unique_ptr<filament::backend::Platform> CreateEglFilamentPlatform(const EglContext& context);
 
 /// Why no EGL display with an OpenGL 4.5 core context can be opened here, or "".
 std::string EglUnavailableReason();

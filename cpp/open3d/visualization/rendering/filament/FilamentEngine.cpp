@@ -115,14 +115,14 @@ FilamentEngine::FilamentEngine(GlPlatform platform) : platform_(ResolveGlPlatfor
     } else {
         StartGlx();
     }
+    driver_hook_ = std::make_unique<DriverThreadHook>(*engine_);
 }
 
 void FilamentEngine::StartEgl() {
     vulkan_drivers_ = vulkan::KeepVulkanDriversLoaded();
     egl_ = std::make_unique<EglContext>();
     gl_ = GlFunctions::Load(&EglContext::GetProcAddress);
-    driver_queue_ = std::make_unique<DriverThreadQueue>();
-    filament_platform_ = CreateEglFilamentPlatform(*egl_, *driver_queue_);
+    filament_platform_ = CreateEglFilamentPlatform(*egl_);
     engine_ = filament::Engine::create(filament::Engine::Backend::OPENGL, filament_platform_.get(),
                                        egl_->NativeContext());
     if (engine_ == nullptr) {
@@ -210,10 +210,12 @@ void FilamentEngine::Flush() const {
 }
 
 bool FilamentEngine::RunOnDriverThread(std::function<void()> action) const {
-    if (!driver_queue_) return false;
-    rendering::RunOnDriverThread(*engine_, *driver_queue_, std::move(action));
-    return true;
+    return driver_hook_->Run(std::move(action));
 }
+
+bool FilamentEngine::CanRunOnDriverThread() const { return driver_hook_->Available(); }
+
+std::string FilamentEngine::DriverThreadUnavailableReason() const { return driver_hook_->Why(); }
 
 void FilamentEngine::FlushAndWait() const {
     if (core::HasWaitCallback()) {

@@ -26,7 +26,7 @@ namespace visualization {
 namespace rendering {
 
 class EglContext;
-class DriverThreadQueue;
+class DriverThreadHook;
 
 /// How the OpenGL contexts are made. kGlx: an X server (GLFW windows, the viewer); kEgl:
 /// headless, offscreen only; kAuto: kGlx where DISPLAY is set, else kEgl. The environment
@@ -55,11 +55,13 @@ public:
     /// Hands the commands issued so far to Filament's thread without waiting for them.
     void Flush() const;
     /// Runs `action` on Filament's driver thread, its GL context current, after the commands
-    /// issued so far and before later ones (FilamentDriverThread.h), once flushed. Only on
-    /// EGL, whose platform is Open3D's: on GLX it returns false and nothing runs.
+    /// issued so far and before later ones (FilamentDriverThread.h), once flushed. False, and
+    /// nothing runs, where Filament's command stream could not be located.
     bool RunOnDriverThread(std::function<void()> action) const;
-    /// Whether RunOnDriverThread runs actions (EGL) or refuses them (GLX).
-    bool CanRunOnDriverThread() const { return driver_queue_ != nullptr; }
+    /// Whether RunOnDriverThread runs actions.
+    bool CanRunOnDriverThread() const;
+    /// Why RunOnDriverThread cannot run actions ("" when it can).
+    std::string DriverThreadUnavailableReason() const;
     /// The hidden window whose context shares objects with Filament's (null on EGL).
     GLFWwindow* GetSharedContextWindow() const { return window_; }
     /// kGlx or kEgl.
@@ -81,9 +83,9 @@ private:
     // unloaded); declared first, so it goes last.
     std::shared_ptr<void> vulkan_drivers_;
     std::unique_ptr<EglContext> egl_;
-    std::unique_ptr<DriverThreadQueue> driver_queue_;  // EGL: outlives filament_platform_
     std::unique_ptr<filament::backend::Platform> filament_platform_;  // EGL: outlives engine_
     filament::Engine* engine_ = nullptr;
+    std::unique_ptr<DriverThreadHook> driver_hook_;
     GlFunctions gl_;
 };
 

@@ -128,15 +128,14 @@ void SplatTargets::CreateZeroCopy(GaussianSplatBackend& backend) {
 
 void SplatTargets::SetUpGpuHandover(GaussianSplatBackend& backend) {
     const GlFunctions& gl = engine_.GetGl();
-    // Opt-in: on the H100 (driver 580.159.04) the first frame with the semaphores crashes in
-    // Filament's createFenceS under RunOnDriverThread, while the host wait runs
+    // On by default where both drivers can; OPEN3D_GL_VK_SEMAPHORES=0 keeps the host waits
     // (docs/filament.md "Synchronisation").
     const char* env = std::getenv("OPEN3D_GL_VK_SEMAPHORES");
     std::string why;
-    if (env == nullptr || std::string(env) != "1") {
-        why = "the semaphore hand-over is opt-in (OPEN3D_GL_VK_SEMAPHORES=1)";
+    if (env != nullptr && std::string(env) == "0") {
+        why = "OPEN3D_GL_VK_SEMAPHORES=0";
     } else if (!engine_.CanRunOnDriverThread()) {
-        why = "GLX: Filament's own platform gives no place on its thread for the signal";
+        why = engine_.DriverThreadUnavailableReason();
     } else if (!vulkan::QueryInteropSupport(backend).external_semaphore_fd) {
         why = "the Vulkan device cannot export semaphores (VK_KHR_external_semaphore_fd)";
     } else if (!gl.HasSemaphoreFd()) {

@@ -98,8 +98,8 @@ public:
 
     /// GPU-side hand-over between GL and Vulkan: whether GL signals a semaphore after the mesh
     /// view that the composite waits for, and a presented frame's composite signals one GL
-    /// waits for before its compose view (zero-copy on EGL where Vulkan exports and GL
-    /// imports semaphores, with OPEN3D_GL_VK_SEMAPHORES=1), instead of the host waiting.
+    /// waits for before its compose view (zero-copy where Vulkan exports and GL imports
+    /// semaphores, unless OPEN3D_GL_VK_SEMAPHORES=0), instead of the host waiting.
     bool HasGpuHandover() const { return gl_mesh_drawn_ != 0; }
     /// After Filament's mesh view was issued: GL signals "mesh drawn" on Filament's thread
     /// after it, and this returns once that signal is flushed to the GPU (no wait for the GPU
