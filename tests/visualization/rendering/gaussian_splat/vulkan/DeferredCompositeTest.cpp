@@ -47,7 +47,15 @@ public:
     void RecordAfter(const Frame&) override {}
     void ReadBack() override { ++read_backs; }
     VkSemaphore TakeSignalSemaphore() override { return signal_; }
+    VkSemaphore TakeWaitSemaphore() override {
+        const VkSemaphore wait = wait_;
+        wait_ = VK_NULL_HANDLE;  // one wait per signal
+        return wait;
+    }
     bool ReadsBack() const override { return false; }
+    bool SubmitsBehindGeometry() const override { return behind_geometry; }
+    // The next submission waits for `semaphore` (signalled once, as GL signals "mesh drawn").
+    void WaitNextFor(VkSemaphore semaphore) { wait_ = semaphore; }
 
     // The colour image's floats, copied after everything submitted so far.
     std::vector<float> Read(const vulkan::VulkanContext& context, vulkan::CommandPool& pool) {
@@ -72,11 +80,26 @@ public:
     }
 
     int read_backs = 0;
+    bool behind_geometry = false;
 
 private:
     vulkan::Image color_;
     VkSemaphore signal_;
+    VkSemaphore wait_ = VK_NULL_HANDLE;
 };
+
+// What GL does with the "mesh drawn" semaphore: signals it once, here from an empty
+// submission.
+void Signal(const vulkan::VulkanContext& context, vulkan::CommandPool& pool,
+            VkSemaphore semaphore) {
+    vulkan::CommandBuffer cmd = pool.Allocate();
+    cmd.Begin();
+    cmd.End();
+    vulkan::UniqueFence fence = vulkan::CreateFence(context);
+    vulkan::SubmitToQueue(context.GetQueue(), cmd.Get(), fence.Get(), VK_NULL_HANDLE,
+                          VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, semaphore);
+    vulkan::Wait(context, fence.Get());
+}
 
 // What GL does with the "splats drawn" semaphore: one wait per signal, here an empty
 // submission that waits for it.
@@ -142,6 +165,49 @@ TEST_F(DeferredComposite, WritesTheReadbackPathsColourAndIsWaitedForBeforeReuse)
     RenderOutput last;
     backend->RenderCompositeStage(last);
     EXPECT_GT(last.stats.num_tile_entries, 0);
+}
+
+// Frames as the GL hand-over runs them: GL's "mesh drawn" signal, then the composite that
+// waits for it, submitted behind its geometry stage and not waited for. From the second
+// frame on, the geometry stage is held and submitted by the composite behind that semaphore
+// (so a frame's Vulkan work runs as one block after GL's). Each frame must equal the
+// read-back path's frame of its camera, float for float, while the camera moves.
+TEST_F(DeferredComposite, GeometryStagesHeldBehindGlsSemaphoreDrawEveryFrame) {
+    OPEN3D_REQUIRE_DATA("playbot/playbot_31k.ply");
+    t::geometry::PointCloud cloud;
+    t::io::ReadPointCloud(DataPath("playbot/playbot_31k.ply"), cloud);
+    const auto cameras = camera::ReadCamerasJson(DataPath("playbot/cameras.json"));
+    auto backend = MakeBackend();
+    backend->SetScene(cloud);
+    auto reference = MakeBackend();
+    reference->SetScene(cloud);
+    const vulkan::UniqueSemaphore mesh_drawn = vulkan::CreateBinarySemaphore(Context());
+    const vulkan::UniqueSemaphore splats_drawn = vulkan::CreateBinarySemaphore(Context());
+    SignallingSink sink(Context(), splats_drawn.Get());
+    sink.behind_geometry = true;
+    const std::vector<int> views = {0, 3, 8, 11};
+    for (size_t i = 0; i < views.size(); ++i) {
+        SCOPED_TRACE(views[i]);
+        const camera::PinholeCamera camera = cameras.at(views[i]).camera.Resized(kWidth, kHeight);
+        backend->RenderGeometryStage(camera, {});
+        Signal(Context(), Pool(), mesh_drawn.Get());
+        sink.WaitNextFor(mesh_drawn.Get());
+        backend->RenderComposite(sink);
+        EXPECT_EQ(backend->GetCounters().held_geometry_stages, int64_t(i));
+        ConsumeSignal(Context(), Pool(), splats_drawn.Get());
+        backend->WaitForComposite();
+        const std::vector<float> colour = sink.Read(Context(), Pool());
+
+        reference->RenderGeometryStage(camera, {});
+        RenderOutput expected;
+        reference->RenderCompositeStage(expected);
+        ASSERT_EQ(expected.color.NumPixels(), int64_t(kWidth) * kHeight);
+        EXPECT_EQ(
+            std::memcmp(colour.data(), expected.color.Data<float>(), colour.size() * sizeof(float)),
+            0);
+    }
+    // The first frame's counters were read before its composite, the later ones after.
+    EXPECT_EQ(backend->GetCounters().capacity_growths, 0);
 }
 
 }  // namespace

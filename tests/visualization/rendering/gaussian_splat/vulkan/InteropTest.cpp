@@ -452,6 +452,45 @@ TEST_F(Interop, EntryBuffersGrowAsInTheReadbackPath) {
     EXPECT_TRUE(CompareHalf(grown.color, reference.color).within_bound);
 }
 
+// The interop composite is submitted behind its geometry stage once the last counters left
+// the buffers a quarter free, and reads this frame's counters only after the composite: a
+// frame whose entries then outgrew the buffers (the camera zoomed in) is rendered again with
+// room, so it still equals the readback path's frame.
+TEST_F(Interop, ACompositeBehindItsGeometryStageThatOverflowsIsRenderedAgain) {
+    const t::geometry::PointCloud cloud = CreateDefaultGaussianSplatScene();
+    const camera::PinholeCamera near = GetDefaultSceneCamera().Resized(320, 240);
+    camera::PinholeCamera far = near;
+    far.fx *= 0.25;  // the splats cover a sixteenth of the area: far fewer tile entries
+    far.fy *= 0.25;
+    auto ample = MakeBackend();
+    ample->SetScene(cloud);
+    const RenderOutput far_reference = ample->Render(far, {});
+    const RenderOutput near_reference = ample->Render(near, {});
+    const uint32_t capacity = static_cast<uint32_t>(far_reference.stats.num_tile_entries * 2);
+    ASSERT_LT(uint64_t(capacity), near_reference.stats.num_tile_entries);
+
+    auto small = MakeBackend(capacity);
+    small->SetScene(cloud);
+    InteropTargets targets(*small, 320, 240);
+    InteropCompositeRequest request;
+    request.read_color = true;
+    InteropFrame first;
+    small->RenderGeometryStage(far, {});
+    vulkan::RenderCompositeToInterop(*small, targets, request, first);
+    EXPECT_TRUE(CompareHalf(first.color, far_reference.color).within_bound);
+    EXPECT_EQ(small->GetCounters().capacity_growths, 0);
+
+    InteropFrame second;
+    small->RenderGeometryStage(near, {});
+    vulkan::RenderCompositeToInterop(*small, targets, request, second);
+    EXPECT_EQ(small->GetCounters().capacity_growths, 1);
+    // Behind the geometry stage, then again with room.
+    EXPECT_EQ(small->GetCounters().composites, 3);
+    EXPECT_EQ(second.stats.error_flags, 0u);
+    EXPECT_EQ(second.stats.num_tile_entries, near_reference.stats.num_tile_entries);
+    EXPECT_TRUE(CompareHalf(second.color, near_reference.color).within_bound);
+}
+
 }  // namespace
 }  // namespace tests
 }  // namespace open3d

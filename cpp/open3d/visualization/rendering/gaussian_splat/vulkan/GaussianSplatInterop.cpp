@@ -233,6 +233,10 @@ public:
                            request_.depth_far);
     }
 
+    // GL's frame waits for this composite (semaphore or host wait), never for the geometry
+    // stage before it.
+    bool SubmitsBehindGeometry() const override { return true; }
+
     bool ReadsBack() const override {
         return request_.read_color || request_.blend_over_mesh || request_.read_depth;
     }

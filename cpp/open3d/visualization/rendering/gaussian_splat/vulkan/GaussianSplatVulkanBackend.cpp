@@ -149,6 +149,7 @@ void GaussianSplatVulkanBackend::EnsureReadback(uint32_t width, uint32_t height)
 
 bool GaussianSplatVulkanBackend::WaitGeometryStage(double timeout_ms) {
     if (!geometry_.in_flight) return true;
+    SubmitHeldGeometry(VK_NULL_HANDLE);
     // The fence stays signalled: the composite stage's own wait returns at once.
     VkFence fence = geometry_stage_fence_.Get();
     const VkResult result = vkWaitForFences(context_->GetDevice(), 1, &fence, VK_TRUE,
@@ -242,8 +243,13 @@ void GaussianSplatVulkanBackend::RenderGeometryStage(const camera::PinholeCamera
     }
     const double record_ms = reuse ? 0.0 : core::MillisecondsSince(record_start);
     const auto submit_start = std::chrono::steady_clock::now();
-    // Fire and forget: composite stage (or the next geometry stage) waits on the fence.
-    Submit(*context_, cmd, geometry_stage_fence_.Get());
+    // Fire and forget: composite stage (or the next geometry stage) waits on the fence. Held
+    // for the composite where that waits for GL (hold_geometry_submit_).
+    if (hold_geometry_submit_) {
+        geometry_held_ = true;
+    } else {
+        Submit(*context_, cmd, geometry_stage_fence_.Get());
+    }
     const double submit_ms = core::MillisecondsSince(submit_start);
     ++counters_.geometry_runs;
     geometry_.camera = camera;
@@ -396,6 +402,7 @@ void GaussianSplatVulkanBackend::RenderCompositeStage(RenderOutput& output,
 
 void GaussianSplatVulkanBackend::WaitForGeometry() {
     if (!geometry_.in_flight) return;
+    SubmitHeldGeometry(VK_NULL_HANDLE);
     Wait(*context_, geometry_stage_fence_.Get());
     geometry_.in_flight = false;
     const std::vector<double> ms = geometry_stage_timestamps_.ReadMilliseconds();

@@ -96,6 +96,12 @@ public:
     /// semaphore is not waited for: the backend waits for its fence before the next use of
     /// what it touches (WaitForComposite).
     virtual bool ReadsBack() const { return true; }
+    /// Whether the composite may be submitted behind a geometry stage still running, with no
+    /// host wait between them (queue order and the composite's first barrier order them): its
+    /// counters are read after the composite's fence, so the frame is not skipped when empty
+    /// and entries that outgrow the buffers are found afterwards (a waited frame is then
+    /// rendered again, a deferred one grows the buffers for the next frame).
+    virtual bool SubmitsBehindGeometry() const { return false; }
 };
 
 class GaussianSplatVulkanBackend final : public GaussianSplatBackend {
@@ -214,6 +220,7 @@ public:
         int64_t geometry_reuses = 0;       ///< geometry stage skipped (nothing changed)
         int64_t composites = 0;            ///< composite stage submitted
         int64_t composite_reuses = 0;      ///< of those, submitted again without recording
+        int64_t held_geometry_stages = 0;  ///< geometry stages submitted behind GL's semaphore
         int64_t capacity_growths = 0;      ///< frames re-rendered with larger entry buffers
         int64_t skipped_composites = 0;    ///< frames with no tile entry: images cleared instead
         int64_t submissions = 0;           ///< submission path: command buffers submitted
@@ -301,9 +308,23 @@ private:
     /// The stage path's submissions (geometry and composite) complete before their buffers
     /// change.
     void WaitForStageWork();
+    /// Submits a geometry stage held for the next composite (geometry_held_), waiting for
+    /// `wait` (VK_NULL_HANDLE: nothing) before it runs.
+    void SubmitHeldGeometry(VkSemaphore wait);
     /// A frame's counts and flags from its geometry stage's counters, and the scene's bytes.
     void FillCounterStats(const shader::GaussianGeometryStageCounters& counters,
                           RenderStats& stats) const;
+    /// The finished geometry stage's counters (keeps them as last_counters_ and whether they
+    /// left room for a composite behind the next geometry stage).
+    shader::GaussianGeometryStageCounters ReadStageCounters();
+    /// Whether the allocation, not the config, cut the frame of `counters` short and the
+    /// entry buffers may grow.
+    bool EntriesOutgrewBuffers(const shader::GaussianGeometryStageCounters& counters) const;
+    /// Grows the entry buffers to the request of `counters` plus a quarter (so a moving
+    /// camera does not regrow every frame) and renders the last geometry stage and `sink`'s
+    /// composite again; returns that frame's stats.
+    RenderStats RenderAgainWithGrownBuffers(CompositeSink& sink,
+                                            const shader::GaussianGeometryStageCounters& counters);
 
     std::unique_ptr<VulkanContext> context_;
     CommandPool pool_;
@@ -356,7 +377,21 @@ private:
     std::string composite_recorded_;  ///< its key; empty: never reused
     bool composite_in_flight_ = false;
     bool composite_in_flight_empty_ = false;
+    /// The composite in flight was submitted behind its geometry stage: its counters are read
+    /// once its fence is waited for.
+    bool composite_counters_pending_ = false;
     double last_composite_gpu_ms_ = 0.0;
+    /// The last counters read, and whether they left a quarter of the entry buffers free
+    /// (a composite may then be submitted behind the next geometry stage).
+    shader::GaussianGeometryStageCounters last_counters_{};
+    bool entries_have_room_ = false;
+    /// The last composite waited for another API's semaphore (GL's "mesh drawn"): the next
+    /// geometry stage is recorded but held (geometry_held_) and submitted by the composite,
+    /// behind that semaphore, so that a frame's Vulkan work runs on the GPU as one block
+    /// after GL's and the GPU switches between the APIs once each way per frame. Any wait
+    /// for the geometry stage submits it first.
+    bool hold_geometry_submit_ = false;
+    bool geometry_held_ = false;
     Buffer stage_params_upload_;
     FrameRecordingKey stage_recorded_;
     bool stage_recording_valid_ = false;

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "open3d/core/Exception.h"
+#include "open3d/core/Logging.h"
 #include "open3d/core/Timer.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/GaussianSplatVulkanBackend.h"
 
@@ -27,6 +28,60 @@ void GaussianSplatVulkanBackend::WaitForComposite() {
     const std::vector<double> ms = composite_stage_timestamps_.ReadMilliseconds();
     last_composite_gpu_ms_ = composite_in_flight_empty_ ? 0.0 : PassMs(ms, TimedPass::kComposite);
     composite_in_flight_ = false;
+    if (!composite_counters_pending_) return;
+    composite_counters_pending_ = false;
+    // The geometry stage ran before the composite: its fence is signalled.
+    WaitForGeometry();
+    const shader::GaussianGeometryStageCounters counters = ReadStageCounters();
+    const bool outgrew = EntriesOutgrewBuffers(counters);
+    WarnNewFlags(outgrew ? counters.error_flags & ~kCountsClamped : counters.error_flags);
+    const RenderStats& g = geometry_.times;
+    ObserveLodFrame(geometry_.config, g.gpu_project_ms + g.gpu_sort_ms + last_composite_gpu_ms_);
+    if (outgrew) {
+        // The frame was handed on before its counters were known: the next one gets room.
+        const uint64_t limit = MaxEntryCapacity(geometry_.config, SortMaxCount());
+        const uint64_t asked = counters.requested_entries;
+        initial_entry_capacity_ = static_cast<uint32_t>(std::max<uint64_t>(
+            initial_entry_capacity_, std::min<uint64_t>(limit, asked + asked / 4)));
+        ++counters_.capacity_growths;
+        core::LogWarning(
+            "Vulkan backend: a frame handed to another API asked for {} tile entries, more "
+            "than the {} its buffers held, and lost the rest; the next frame has room",
+            asked, geometry_stage_resources_.EntryCapacity());
+    }
+}
+
+shader::GaussianGeometryStageCounters GaussianSplatVulkanBackend::ReadStageCounters() {
+    shader::GaussianGeometryStageCounters c{};
+    std::memcpy(&c, counters_readback_.GetMapped(), sizeof(c));
+    last_counters_ = c;
+    const uint64_t capacity = geometry_stage_resources_.EntryCapacity();
+    entries_have_room_ =
+        (c.error_flags & kCountsClamped) == 0 && uint64_t(c.requested_entries) * 4 <= capacity * 3;
+    return c;
+}
+
+bool GaussianSplatVulkanBackend::EntriesOutgrewBuffers(
+    const shader::GaussianGeometryStageCounters& counters) const {
+    return (counters.error_flags & kCountsClamped) != 0 && !growing_ &&
+           geometry_stage_resources_.EntryCapacity() <
+               MaxEntryCapacity(geometry_.config, SortMaxCount());
+}
+
+RenderStats GaussianSplatVulkanBackend::RenderAgainWithGrownBuffers(
+    CompositeSink& sink, const shader::GaussianGeometryStageCounters& counters) {
+    const uint64_t limit = MaxEntryCapacity(geometry_.config, SortMaxCount());
+    const uint64_t asked = counters.requested_entries;
+    EnsureViewBuffers(static_cast<uint32_t>(std::min<uint64_t>(limit, asked + asked / 4)));
+    ++counters_.capacity_growths;
+    growing_ = true;
+    const camera::PinholeCamera camera = geometry_.camera;
+    const RenderConfig config = geometry_.config;
+    geometry_.valid = false;
+    RenderGeometryStage(camera, config);
+    const RenderStats stats = RenderComposite(sink);
+    growing_ = false;
+    return stats;
 }
 
 void GaussianSplatVulkanBackend::FillCounterStats(const shader::GaussianGeometryStageCounters& c,
@@ -43,8 +98,18 @@ void GaussianSplatVulkanBackend::FillCounterStats(const shader::GaussianGeometry
 }
 
 void GaussianSplatVulkanBackend::WaitForStageWork() {
-    if (geometry_.in_flight) Wait(*context_, geometry_stage_fence_.Get());
+    if (geometry_.in_flight) {
+        SubmitHeldGeometry(VK_NULL_HANDLE);
+        Wait(*context_, geometry_stage_fence_.Get());
+    }
     WaitForComposite();
+}
+
+void GaussianSplatVulkanBackend::SubmitHeldGeometry(VkSemaphore wait) {
+    if (!geometry_held_) return;
+    geometry_held_ = false;
+    SubmitToQueue(context_->GetQueue(), geometry_stage_cmd_.Get(), geometry_stage_fence_.Get(),
+                  wait, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_NULL_HANDLE);
 }
 
 void GaussianSplatVulkanBackend::RecordCompositeFrame(CompositeSink& sink, VkCommandBuffer cmd,
@@ -53,10 +118,13 @@ void GaussianSplatVulkanBackend::RecordCompositeFrame(CompositeSink& sink, VkCom
     const uint32_t h = static_cast<uint32_t>(geometry_.camera.height);
     const Image& color = sink.ColorTarget();
     composite_stage_timestamps_.RecordReset(cmd);
-    // Geometry stage's results (a previous submission, ordered by the fence wait) to compute reads.
+    // Geometry stage's results (an earlier submission to this queue, maybe still running) to
+    // the composite's reads, and to its writes of the state buffer the tile bins wrote.
     RecordMemoryBarrier(cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_MEMORY_WRITE_BIT,
-                        VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_COPY_BIT,
-                        VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_TRANSFER_READ_BIT);
+                        VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_COPY_BIT |
+                            VK_PIPELINE_STAGE_2_CLEAR_BIT,
+                        VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT |
+                            VK_ACCESS_2_TRANSFER_READ_BIT | VK_ACCESS_2_TRANSFER_WRITE_BIT);
     CompositeSink::Frame frame;
     frame.cmd = cmd;
     frame.empty = empty;
@@ -138,36 +206,38 @@ RenderStats GaussianSplatVulkanBackend::RenderComposite(CompositeSink& sink) {
         core::ThrowError("Vulkan backend: the composite targets are {}x{}, the camera is {}x{}",
                          color.GetWidth(), color.GetHeight(), w, h);
     }
+    // Another API's signal: a held geometry stage waits for it, else the composite does.
+    VkSemaphore wait = sink.TakeWaitSemaphore();
+    hold_geometry_submit_ = wait != VK_NULL_HANDLE;
+    if (geometry_held_) {
+        SubmitHeldGeometry(wait);
+        if (wait != VK_NULL_HANDLE) ++counters_.held_geometry_stages;
+        wait = VK_NULL_HANDLE;
+    }
+    // Behind the geometry stage, no host wait between them, where the sink allows it and the
+    // last counters left the entry buffers a quarter free (an overflow is then unlikely and
+    // is found after the composite); otherwise the counters come first.
+    const bool behind =
+        sink.SubmitsBehindGeometry() && geometry_.in_flight && entries_have_room_ && !growing_;
     const auto geometry_wait_start = std::chrono::steady_clock::now();
-    WaitForGeometry();
+    if (!behind) WaitForGeometry();
     WaitForComposite();
     const double geometry_wait_ms = core::MillisecondsSince(geometry_wait_start);
     EnsureTargets(w, h);
     shader::GaussianGeometryStageCounters gpu_counters{};
-    std::memcpy(&gpu_counters, counters_readback_.GetMapped(), sizeof(gpu_counters));
-
-    // The allocation, not the config, cut this frame short: grow the entry buffers to what
-    // it asked for (plus a quarter, so a moving camera does not regrow every frame) and
-    // render it again before anything is composited (the sink's semaphores are taken by the
-    // frame that runs). Geometry stage reported the full request, so one retry suffices.
-    const uint64_t limit = MaxEntryCapacity(geometry_.config, SortMaxCount());
-    if ((gpu_counters.error_flags & kCountsClamped) &&
-        geometry_stage_resources_.EntryCapacity() < limit && !growing_) {
-        const uint64_t asked = gpu_counters.requested_entries;
-        EnsureViewBuffers(static_cast<uint32_t>(std::min<uint64_t>(limit, asked + asked / 4)));
-        ++counters_.capacity_growths;
-        growing_ = true;
-        const camera::PinholeCamera camera = geometry_.camera;
-        const RenderConfig config = geometry_.config;
-        geometry_.valid = false;
-        RenderGeometryStage(camera, config);
-        const RenderStats stats = RenderComposite(sink);
-        growing_ = false;
-        return stats;
+    bool empty = false;
+    if (!behind) {
+        gpu_counters = ReadStageCounters();
+        // The allocation, not the config, cut this frame short: render it again with room
+        // before anything is composited (the sink's semaphores are taken by the frame that
+        // runs). Geometry stage reported the full request, so one retry suffices.
+        if (EntriesOutgrewBuffers(gpu_counters)) {
+            return RenderAgainWithGrownBuffers(sink, gpu_counters);
+        }
+        // Nothing to blend (everything culled or hidden): no composite dispatch, the images
+        // are cleared to the background instead.
+        empty = gpu_counters.entry_count == 0;
     }
-    // Nothing to blend (everything culled or hidden): no composite dispatch, the images are
-    // cleared to the background instead.
-    const bool empty = gpu_counters.entry_count == 0;
 
     CompositeParams params;
     for (int c = 0; c < 3; ++c)
@@ -216,7 +286,7 @@ RenderStats GaussianSplatVulkanBackend::RenderComposite(CompositeSink& sink) {
     const double record_ms = core::MillisecondsSince(record_start);
     const auto submit_start = std::chrono::steady_clock::now();
     const VkSemaphore signal = sink.TakeSignalSemaphore();
-    SubmitToQueue(context_->GetQueue(), cmd, composite_fence_.Get(), sink.TakeWaitSemaphore(),
+    SubmitToQueue(context_->GetQueue(), cmd, composite_fence_.Get(), wait,
                   VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, signal);
     const double submit_ms = core::MillisecondsSince(submit_start);
     ++counters_.composites;
@@ -225,13 +295,24 @@ RenderStats GaussianSplatVulkanBackend::RenderComposite(CompositeSink& sink) {
     const auto wait_start = std::chrono::steady_clock::now();
     if (waited) {
         Wait(*context_, composite_fence_.Get());
+        if (behind) {
+            WaitForGeometry();  // signalled: it ran before the composite
+            gpu_counters = ReadStageCounters();
+            if (EntriesOutgrewBuffers(gpu_counters)) {
+                return RenderAgainWithGrownBuffers(sink, gpu_counters);
+            }
+        }
     } else {
         composite_in_flight_ = true;
         composite_in_flight_empty_ = empty;
+        composite_counters_pending_ = behind;
     }
     const double wait_ms = core::MillisecondsSince(wait_start);
-
-    WarnNewFlags(gpu_counters.error_flags);
+    // Not waited for and behind: this frame's counters come with its fence, the stats give
+    // the last ones read (as its GPU times give the last composite's).
+    const bool counted = waited || !behind;
+    if (!counted) gpu_counters = last_counters_;
+    if (counted) WarnNewFlags(gpu_counters.error_flags);
     const auto readback_start = std::chrono::steady_clock::now();
     sink.ReadBack();
 
@@ -252,7 +333,7 @@ RenderStats GaussianSplatVulkanBackend::RenderComposite(CompositeSink& sink) {
     s.host_submit_ms += submit_ms;
     s.host_wait_ms = geometry_wait_ms + wait_ms;
     s.host_readback_ms = core::MillisecondsSince(readback_start);
-    if (!geometry_.reused) {
+    if (!geometry_.reused && counted) {
         ObserveLodFrame(geometry_.config, s.gpu_project_ms + s.gpu_sort_ms + s.gpu_composite_ms);
     }
     return s;
