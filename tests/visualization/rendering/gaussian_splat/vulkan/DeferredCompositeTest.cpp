@@ -88,41 +88,51 @@ private:
     VkSemaphore wait_ = VK_NULL_HANDLE;
 };
 
-// What GL does with the "mesh drawn" semaphore: signals it once, here from an empty
-// submission.
-void Signal(const vulkan::VulkanContext& context, vulkan::CommandPool& pool,
-            VkSemaphore semaphore) {
+// An empty submission that waits for `wait` and signals `signal` (either may be null), waited
+// for on the host: what GL does with the exported semaphores.
+void SubmitEmpty(const vulkan::VulkanContext& context, vulkan::CommandPool& pool, VkSemaphore wait,
+                 VkSemaphore signal) {
     vulkan::CommandBuffer cmd = pool.Allocate();
     cmd.Begin();
     cmd.End();
     vulkan::UniqueFence fence = vulkan::CreateFence(context);
-    vulkan::SubmitToQueue(context.GetQueue(), cmd.Get(), fence.Get(), VK_NULL_HANDLE,
-                          VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, semaphore);
+    vulkan::SubmitToQueue(context.GetQueue(), cmd.Get(), fence.Get(), wait,
+                          VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, signal);
     vulkan::Wait(context, fence.Get());
 }
 
-// What GL does with the "splats drawn" semaphore: one wait per signal, here an empty
-// submission that waits for it.
+// GL's wait for "splats drawn": one wait per signal.
 void ConsumeSignal(const vulkan::VulkanContext& context, vulkan::CommandPool& pool,
                    VkSemaphore semaphore) {
-    vulkan::CommandBuffer cmd = pool.Allocate();
-    cmd.Begin();
-    cmd.End();
-    vulkan::UniqueFence fence = vulkan::CreateFence(context);
-    vulkan::SubmitToQueue(context.GetQueue(), cmd.Get(), fence.Get(), semaphore,
-                          VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_NULL_HANDLE);
-    vulkan::Wait(context, fence.Get());
+    SubmitEmpty(context, pool, semaphore, VK_NULL_HANDLE);
 }
 
-class DeferredComposite : public VulkanTest {};
+// GL's "mesh drawn" signal, once per frame.
+void Signal(const vulkan::VulkanContext& context, vulkan::CommandPool& pool,
+            VkSemaphore semaphore) {
+    SubmitEmpty(context, pool, VK_NULL_HANDLE, semaphore);
+}
+
+class DeferredComposite : public VulkanTest {
+protected:
+    // A backend holding playbot_31k (read once; its cameras into cameras_).
+    auto PlaybotBackend() {
+        if (cameras_.empty()) {
+            t::io::ReadPointCloud(DataPath("playbot/playbot_31k.ply"), cloud_);
+            cameras_ = camera::ReadCamerasJson(DataPath("playbot/cameras.json"));
+        }
+        auto backend = MakeBackend();
+        backend->SetScene(cloud_);
+        return backend;
+    }
+    t::geometry::PointCloud cloud_;
+    std::vector<camera::CameraView> cameras_;
+};
 
 TEST_F(DeferredComposite, WritesTheReadbackPathsColourAndIsWaitedForBeforeReuse) {
     OPEN3D_REQUIRE_DATA("playbot/playbot_31k.ply");
-    t::geometry::PointCloud cloud;
-    t::io::ReadPointCloud(DataPath("playbot/playbot_31k.ply"), cloud);
-    const auto cameras = camera::ReadCamerasJson(DataPath("playbot/cameras.json"));
-    auto backend = MakeBackend();
-    backend->SetScene(cloud);
+    auto backend = PlaybotBackend();
+    const auto& cameras = cameras_;
     RenderConfig config;
     const vulkan::UniqueSemaphore semaphore = vulkan::CreateBinarySemaphore(Context());
     SignallingSink sink(Context(), semaphore.Get());
@@ -174,13 +184,9 @@ TEST_F(DeferredComposite, WritesTheReadbackPathsColourAndIsWaitedForBeforeReuse)
 // read-back path's frame of its camera, float for float, while the camera moves.
 TEST_F(DeferredComposite, GeometryStagesHeldBehindGlsSemaphoreDrawEveryFrame) {
     OPEN3D_REQUIRE_DATA("playbot/playbot_31k.ply");
-    t::geometry::PointCloud cloud;
-    t::io::ReadPointCloud(DataPath("playbot/playbot_31k.ply"), cloud);
-    const auto cameras = camera::ReadCamerasJson(DataPath("playbot/cameras.json"));
-    auto backend = MakeBackend();
-    backend->SetScene(cloud);
-    auto reference = MakeBackend();
-    reference->SetScene(cloud);
+    auto backend = PlaybotBackend();
+    const auto& cameras = cameras_;
+    auto reference = PlaybotBackend();
     const vulkan::UniqueSemaphore mesh_drawn = vulkan::CreateBinarySemaphore(Context());
     const vulkan::UniqueSemaphore splats_drawn = vulkan::CreateBinarySemaphore(Context());
     SignallingSink sink(Context(), splats_drawn.Get());
