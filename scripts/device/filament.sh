@@ -9,6 +9,9 @@
 # and copy those binaries into .devbin; bash scripts/device/prepare-x.sh for .xroot.
 # EGL call: carry .gl, .devlibs, .devbin, .xroot/validation.tar.xz and shared/data/playbot:
 #   bash scripts/device/filament.sh OUT [probe|suites|bench|all|quick|check]
+# bench takes VARIANTS (default "zero-copy zero-copy-hostwait host-copy"), TAG (a name for
+# this run's logs, e.g. an environment variable being compared) and BASELINES=0 (skip the
+# meshes-only frame and gs-bench).
 # GLX: .xroot (55 MB) and the binaries with a scene do not fit one call's 64 MB: carry .gl and
 # .xroot first (`... OUT probe`, unpacks into /opt/xroot, which a warm machine keeps), then
 # the rest within the warm period with OPEN3D_FILAMENT_PLATFORM=glx before the command.
@@ -99,20 +102,21 @@ bench() {
     # composite, the offscreen read and blend), zero-copy and host copies; then Filament's own
     # frame (--meshes-only: no splats) and the splats alone (gs-bench, GPU and in flight).
     # zero-copy-hostwait: zero-copy with the host waiting for GL instead of the semaphore.
-    for variant in zero-copy zero-copy-hostwait host-copy; do
+    for variant in ${VARIANTS:-zero-copy zero-copy-hostwait host-copy}; do
       sharing=${variant%-hostwait}
       semaphores=1
       [ "$variant" = zero-copy-hostwait ] && semaphores=0
-      log=$out/render-$size-$variant.log
+      log=$out/render-$size-$variant${TAG:+-$TAG}.log
       OPEN3D_SPLAT_SHARING=$sharing OPEN3D_GL_VK_SEMAPHORES=$semaphores timeout 120 \
         .devbin/gs-render -i $d/playbot_125k.ply \
         --cameras $d/cameras.json --view 0 --width "$w" --height "$h" --sphere --plane --frames 60 \
         -o /tmp/filament-$size-$variant.png >"$log" 2>&1
-      say "gs-render --sphere --plane $size $variant: exit $?"
+      say "gs-render --sphere --plane $size $variant${TAG:+ ($TAG)}: exit $?"
       grep -E "^filament render|^frame time|^presented|hands the mesh|rror" "$log" | cut -c1-400 | tee -a "$summary"
       # A crash's call stack (core::InstallCrashReport): place the frames with addr2line here.
       grep -A16 "fatal signal" "$log" | cut -c1-200 | tee -a "$summary"
     done
+    [ "${BASELINES:-1}" = 1 ] || continue
     log=$out/render-$size-meshes-only.log
     timeout 120 .devbin/gs-render -i $d/playbot_125k.ply --cameras $d/cameras.json --view 0 \
       --width "$w" --height "$h" --sphere --plane --frames 60 --meshes-only \
@@ -121,7 +125,7 @@ bench() {
     grep -E "^frame time|^presented|rror" "$log" | cut -c1-400 | tee -a "$summary"
   done
   cp /tmp/filament-1920x1080-zero-copy.png "$out/" 2>/dev/null
-  [ -x .devbin/gs-bench ] || return
+  [ -x .devbin/gs-bench ] && [ "${BASELINES:-1}" = 1 ] || return
   timeout 120 .devbin/gs-bench -i $d/playbot_125k.ply --cameras $d/cameras.json --views 0 \
     --knobs default --resolution 1920x1080 --resolution 3840x2160 --repeat 30 --warm-up 1 \
     --reference-max-splats 0 >"$out/gs-bench.log" 2>&1

@@ -15,6 +15,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "open3d/camera/PinholeCamera.h"
@@ -311,6 +312,11 @@ private:
     /// Submits a geometry stage held for the next composite (geometry_held_), waiting for
     /// `wait` (VK_NULL_HANDLE: nothing) before it runs.
     void SubmitHeldGeometry(VkSemaphore wait);
+    /// RenderGeometryStage's work: waits for the last stage-path work, records (or reuses)
+    /// and submits or holds.
+    void RunGeometryStage(const camera::PinholeCamera& camera, const RenderConfig& requested);
+    /// Runs a geometry stage RenderGeometryStage left for the composite (pending_geometry_).
+    void RunPendingGeometry();
     /// A frame's counts and flags from its geometry stage's counters, and the scene's bytes.
     void FillCounterStats(const shader::GaussianGeometryStageCounters& counters,
                           RenderStats& stats) const;
@@ -392,6 +398,11 @@ private:
     /// for the geometry stage submits it first.
     bool hold_geometry_submit_ = false;
     bool geometry_held_ = false;
+    /// How a geometry stage is held (OPEN3D_VULKAN_HOLD_GEOMETRY, for measurements): 0 never,
+    /// 1 recorded by RenderGeometryStage, 2 (default) recorded only when the composite comes,
+    /// so that RenderGeometryStage waits for nothing while the last frame's composite runs.
+    int hold_geometry_mode_ = 2;
+    std::optional<std::pair<camera::PinholeCamera, RenderConfig>> pending_geometry_;
     Buffer stage_params_upload_;
     FrameRecordingKey stage_recorded_;
     bool stage_recording_valid_ = false;
