@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <utility>
 
+#include "GlGpuTimeline.h"
 #include "open3d/core/Timer.h"
 #include "open3d/t/geometry/TriangleMesh.h"
 #include "open3d/visualization/rendering/filament/FilamentEngine.h"
@@ -57,7 +58,21 @@ void PresentFrames(rendering::FilamentEngine& engine, rendering::FilamentRendere
     rendering::FrameTimes sum;
     double record_ms = 0.0, wait_ms = 0.0;  // the splat stages' host recording and fence waits
     std::chrono::steady_clock::time_point start;
+    // GL timestamps at three places of each frame (the views of one frame are one here).
+    GlGpuTimeline timeline(engine);
+    int frame = 0;
+    renderer.SetFrameEventListener(
+        [&](rendering::FrameEvent event, const rendering::FilamentView*) {
+            if (event == rendering::FrameEvent::kBeginFrame) {
+                timeline.Mark(frame, GlGpuTimeline::kFrameBegin);
+            } else if (event == rendering::FrameEvent::kFilamentDraw) {
+                timeline.Mark(frame, GlGpuTimeline::kMeshDone);
+            } else if (event == rendering::FrameEvent::kOverlay) {
+                timeline.Mark(frame, GlGpuTimeline::kComposeDone);
+            }
+        });
     for (int i = 0; i < frames; ++i) {
+        frame = i;
         if (i == 1) {
             engine.FlushAndWait();
             start = std::chrono::steady_clock::now();
@@ -85,6 +100,8 @@ void PresentFrames(rendering::FilamentEngine& engine, rendering::FilamentRendere
         "%.3f\n",
         n, wall_ms, 1000.0 / wall_ms, sum.geometry_stage_ms / n, sum.filament_ms / n,
         sum.composite_stage_ms / n, sum.compose_ms / n, record_ms / n, wait_ms / n);
+    renderer.SetFrameEventListener(nullptr);
+    std::printf("%s\n", timeline.Describe(1).c_str());
     renderer.RemoveView(scene.GetView());
     scene.GetView().SetPresentSize(0, 0);
 }

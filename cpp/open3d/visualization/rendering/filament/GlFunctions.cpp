@@ -40,6 +40,10 @@ GlFunctions GlFunctions::Load(ProcLoader get) {
     LoadRequired(get, gl.TextureSubImage2D, "glTextureSubImage2D");
     LoadRequired(get, gl.GetTextureImage, "glGetTextureImage");
     LoadRequired(get, gl.PixelStorei, "glPixelStorei");
+    LoadRequired(get, gl.GenQueries, "glGenQueries");
+    LoadRequired(get, gl.DeleteQueries, "glDeleteQueries");
+    LoadRequired(get, gl.QueryCounter, "glQueryCounter");
+    LoadRequired(get, gl.GetQueryObjectui64v, "glGetQueryObjectui64v");
     LoadProc(get, gl.CreateMemoryObjectsEXT, "glCreateMemoryObjectsEXT");
     LoadProc(get, gl.DeleteMemoryObjectsEXT, "glDeleteMemoryObjectsEXT");
     LoadProc(get, gl.MemoryObjectParameterivEXT, "glMemoryObjectParameterivEXT");

@@ -44,6 +44,11 @@ struct GlFunctions {
     PFNGLSIGNALSEMAPHOREEXTPROC SignalSemaphoreEXT = nullptr;
     PFNGLWAITSEMAPHOREEXTPROC WaitSemaphoreEXT = nullptr;
     decltype(&::glFlush) Flush = nullptr;
+    // Timer queries (core 3.3), for GPU timelines of Filament's frames.
+    PFNGLGENQUERIESPROC GenQueries = nullptr;
+    PFNGLDELETEQUERIESPROC DeleteQueries = nullptr;
+    PFNGLQUERYCOUNTERPROC QueryCounter = nullptr;
+    PFNGLGETQUERYOBJECTUI64VPROC GetQueryObjectui64v = nullptr;
 
     /// glfwGetProcAddress or eglGetProcAddress.
     using ProcLoader = void* (*)(const char* name);
