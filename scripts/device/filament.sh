@@ -112,7 +112,7 @@ bench() {
         --cameras $d/cameras.json --view 0 --width "$w" --height "$h" --sphere --plane --frames 60 \
         -o /tmp/filament-$size-$variant.png >"$log" 2>&1
       say "gs-render --sphere --plane $size $variant${TAG:+ ($TAG)}: exit $?"
-      grep -E "^filament render|^frame time|^presented|hands the mesh|rror" "$log" | cut -c1-400 | tee -a "$summary"
+      grep -E "^filament render|^frame time|^presented|^GL GPU timeline|hands the mesh|rror" "$log" | cut -c1-400 | tee -a "$summary"
       # A crash's call stack (core::InstallCrashReport): place the frames with addr2line here.
       grep -A16 "fatal signal" "$log" | cut -c1-200 | tee -a "$summary"
     done
@@ -122,7 +122,7 @@ bench() {
       --width "$w" --height "$h" --sphere --plane --frames 60 --meshes-only \
       -o /tmp/filament-mesh-$size.png >"$log" 2>&1
     say "gs-render --sphere --plane $size, meshes only: exit $?"
-    grep -E "^frame time|^presented|rror" "$log" | cut -c1-400 | tee -a "$summary"
+    grep -E "^frame time|^presented|^GL GPU timeline|rror" "$log" | cut -c1-400 | tee -a "$summary"
   done
   cp /tmp/filament-1920x1080-zero-copy.png "$out/" 2>/dev/null
   [ -x .devbin/gs-bench ] && [ "${BASELINES:-1}" = 1 ] || return
