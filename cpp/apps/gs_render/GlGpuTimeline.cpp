@@ -31,6 +31,9 @@ void GlGpuTimeline::Mark(int frame, Point point) {
         }
         gl.QueryCounter((*queries)[frame][point], GL_TIMESTAMP);
     });
+    // Flushed at once, so that the timestamp is not taken late because Filament's stream
+    // waited on the host for its next flush.
+    engine_.Flush();
 }
 
 std::string GlGpuTimeline::Describe(int first) {

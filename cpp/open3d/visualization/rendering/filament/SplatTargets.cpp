@@ -128,11 +128,17 @@ void SplatTargets::CreateZeroCopy(GaussianSplatBackend& backend) {
 
 void SplatTargets::SetUpGpuHandover(GaussianSplatBackend& backend) {
     const GlFunctions& gl = engine_.GetGl();
-    // On by default where both drivers can; OPEN3D_GL_VK_SEMAPHORES=0 keeps the host waits
-    // (docs/filament.md "Synchronisation").
+    // On by default where both drivers can; OPEN3D_GL_VK_SEMAPHORES=0 keeps the host waits,
+    // =mesh the GL-to-Vulkan one alone, the host waiting for the composite before GL's
+    // compose view (docs/filament.md "Synchronisation").
     const char* env = std::getenv("OPEN3D_GL_VK_SEMAPHORES");
+    const std::string mode = env != nullptr ? env : "1";
+    if (mode != "0" && mode != "1" && mode != "mesh") {
+        core::ThrowError("OPEN3D_GL_VK_SEMAPHORES is '{}': 0, 1 or mesh", mode);
+    }
+    splats_drawn_handover_ = mode == "1";
     std::string why;
-    if (env != nullptr && std::string(env) == "0") {
+    if (mode == "0") {
         why = "OPEN3D_GL_VK_SEMAPHORES=0";
     } else if (!engine_.CanRunOnDriverThread()) {
         why = engine_.DriverThreadUnavailableReason();
@@ -264,8 +270,8 @@ void SplatTargets::Composite(GaussianSplatBackend& backend, const SplatComposite
     vk.wait_mesh_drawn = mesh_drawn_signaled_;
     mesh_drawn_signaled_ = false;  // one wait per signal
     // GL waits for it in WaitSplatsDrawn (a presented frame's compose view).
-    vk.signal_splats_drawn = request.presented && gl_splats_drawn_ != 0 && !request.read_color &&
-                             !request.blend_over_mesh && !request.read_depth;
+    vk.signal_splats_drawn = request.presented && splats_drawn_handover_ && gl_splats_drawn_ != 0 &&
+                             !request.read_color && !request.blend_over_mesh && !request.read_depth;
     splats_drawn_signaled_ = vk.signal_splats_drawn;
     vulkan::InteropFrame out;
     vulkan::RenderCompositeToInterop(backend, *interop_, vk, out);

@@ -140,6 +140,7 @@ private:
     uint32_t gl_memory_[3] = {0, 0, 0};   // GL memory objects (zero-copy only)
     uint32_t gl_mesh_drawn_ = 0;          // GL semaphore (GPU hand-over only)
     bool mesh_drawn_signaled_ = false;    // signalled, not yet waited for by a composite
+    bool splats_drawn_handover_ = true;   // OPEN3D_GL_VK_SEMAPHORES is not "mesh"
     uint32_t gl_splats_drawn_ = 0;        // GL semaphore: Vulkan's composite is done
     bool splats_drawn_signaled_ = false;  // signalled by a composite, GL has not waited yet
     filament::Texture* color_texture_ = nullptr;
