@@ -9,7 +9,8 @@
 # and copy those binaries into .devbin; bash scripts/device/prepare-x.sh for .xroot.
 # EGL call: carry .gl, .devlibs, .devbin, .xroot/validation.tar.xz and shared/data/playbot:
 #   bash scripts/device/filament.sh OUT [probe|suites|bench|all|quick|check]
-# bench takes VARIANTS (default "zero-copy zero-copy-hostwait host-copy"), TAG (a name for
+# bench takes VARIANTS (default "zero-copy zero-copy-hostwait host-copy"), SEMAPHORES (the
+# OPEN3D_GL_VK_SEMAPHORES of the variants that are not -hostwait, default 1), TAG (a name for
 # this run's logs, e.g. an environment variable being compared) and BASELINES=0 (skip the
 # meshes-only frame and gs-bench).
 # GLX: .xroot (55 MB) and the binaries with a scene do not fit one call's 64 MB: carry .gl and
@@ -104,7 +105,7 @@ bench() {
     # zero-copy-hostwait: zero-copy with the host waiting for GL instead of the semaphore.
     for variant in ${VARIANTS:-zero-copy zero-copy-hostwait host-copy}; do
       sharing=${variant%-hostwait}
-      semaphores=1
+      semaphores=${SEMAPHORES:-1}
       [ "$variant" = zero-copy-hostwait ] && semaphores=0
       log=$out/render-$size-$variant${TAG:+-$TAG}.log
       OPEN3D_SPLAT_SHARING=$sharing OPEN3D_GL_VK_SEMAPHORES=$semaphores timeout 120 \
