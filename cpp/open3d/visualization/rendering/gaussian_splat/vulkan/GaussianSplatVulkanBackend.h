@@ -399,9 +399,10 @@ private:
     bool hold_geometry_submit_ = false;
     bool geometry_held_ = false;
     /// How a geometry stage is held (OPEN3D_VULKAN_HOLD_GEOMETRY, for measurements): 0 never,
-    /// 1 recorded by RenderGeometryStage, 2 (default) recorded only when the composite comes,
-    /// so that RenderGeometryStage waits for nothing while the last frame's composite runs.
-    int hold_geometry_mode_ = 2;
+    /// 1 (default) recorded by RenderGeometryStage, 2 recorded only when the composite comes,
+    /// so that RenderGeometryStage waits for nothing while the last frame's composite runs
+    /// (measured slower than 1 on the H200, docs/perf/h200.md).
+    int hold_geometry_mode_ = 1;
     std::optional<std::pair<camera::PinholeCamera, RenderConfig>> pending_geometry_;
     Buffer stage_params_upload_;
     FrameRecordingKey stage_recorded_;
