@@ -128,18 +128,23 @@ void SplatTargets::CreateZeroCopy(GaussianSplatBackend& backend) {
 
 void SplatTargets::SetUpGpuHandover(GaussianSplatBackend& backend) {
     const GlFunctions& gl = engine_.GetGl();
-    // On by default where both drivers can; OPEN3D_GL_VK_SEMAPHORES=0 keeps the host waits,
-    // =mesh the GL-to-Vulkan one alone, the host waiting for the composite before GL's
+    // On EGL by default where both drivers can (run on NVIDIA's); on GLX only when asked
+    // (OPEN3D_GL_VK_SEMAPHORES=1): it has not run there with NVIDIA's GL. =0 keeps the host
+    // waits, =mesh the GL-to-Vulkan one alone, the host waiting for the composite before GL's
     // compose view (docs/filament.md "Synchronisation").
     const char* env = std::getenv("OPEN3D_GL_VK_SEMAPHORES");
-    const std::string mode = env != nullptr ? env : "1";
+    const bool glx = engine_.GetPlatform() == GlPlatform::kGlx;
+    const std::string mode = env != nullptr && *env != '\0' ? env : (glx ? "0" : "1");
     if (mode != "0" && mode != "1" && mode != "mesh") {
         core::ThrowError("OPEN3D_GL_VK_SEMAPHORES is '{}': 0, 1 or mesh", mode);
     }
     splats_drawn_handover_ = mode == "1";
     std::string why;
     if (mode == "0") {
-        why = "OPEN3D_GL_VK_SEMAPHORES=0";
+        why = env != nullptr && *env != '\0'
+                  ? "OPEN3D_GL_VK_SEMAPHORES=0"
+                  : "on GLX it is opt-in (OPEN3D_GL_VK_SEMAPHORES=1): it has not run there "
+                    "on a GPU yet";
     } else if (!engine_.CanRunOnDriverThread()) {
         why = engine_.DriverThreadUnavailableReason();
     } else if (!vulkan::QueryInteropSupport(backend).external_semaphore_fd) {
