@@ -118,12 +118,16 @@ bench() {
       grep -A16 "fatal signal" "$log" | cut -c1-200 | tee -a "$summary"
     done
     [ "${BASELINES:-1}" = 1 ] || continue
-    log=$out/render-$size-meshes-only.log
-    timeout 120 .devbin/gs-render -i $d/playbot_125k.ply --cameras $d/cameras.json --view 0 \
-      --width "$w" --height "$h" --sphere --plane --frames 60 --meshes-only \
-      -o /tmp/filament-mesh-$size.png >"$log" 2>&1
-    say "gs-render --sphere --plane $size, meshes only: exit $?"
-    grep -E "^frame time|^presented|^GL GPU timeline|rror" "$log" | cut -c1-400 | tee -a "$summary"
+    # Filament's own frame, its targets in imported Vulkan memory (zero-copy) and in GL's own
+    # textures (host-copy): whether the imported memory slows GL's drawing.
+    for sharing in zero-copy host-copy; do
+      log=$out/render-$size-meshes-only-$sharing.log
+      OPEN3D_SPLAT_SHARING=$sharing timeout 120 .devbin/gs-render -i $d/playbot_125k.ply \
+        --cameras $d/cameras.json --view 0 --width "$w" --height "$h" --sphere --plane \
+        --frames 60 --meshes-only -o /tmp/filament-mesh-$size.png >"$log" 2>&1
+      say "gs-render --sphere --plane $size, meshes only, $sharing targets: exit $?"
+      grep -E "^frame time|^presented|^GL GPU timeline|rror" "$log" | cut -c1-400 | tee -a "$summary"
+    done
   done
   cp /tmp/filament-1920x1080-zero-copy.png "$out/" 2>/dev/null
   [ -x .devbin/gs-bench ] && [ "${BASELINES:-1}" = 1 ] || return
