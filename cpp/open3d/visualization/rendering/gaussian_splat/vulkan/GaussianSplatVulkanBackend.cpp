@@ -83,22 +83,20 @@ GaussianSplatVulkanBackend::GaussianSplatVulkanBackend(std::unique_ptr<VulkanCon
     if (const char* env = std::getenv("OPEN3D_VULKAN_HOLD_GEOMETRY");
         env != nullptr && *env != '\0') {
         const std::string mode(env);
-        if (mode != "0" && mode != "1" && mode != "2") {
-            core::ThrowError("OPEN3D_VULKAN_HOLD_GEOMETRY is '{}': 0, 1 or 2", mode);
+        if (mode != "0" && mode != "1") {
+            core::ThrowError("OPEN3D_VULKAN_HOLD_GEOMETRY is '{}': 0 or 1", mode);
         }
-        hold_geometry_mode_ = std::stoi(mode);
+        hold_geometry_enabled_ = mode == "1";
     }
 }
 
 GaussianSplatVulkanBackend::~GaussianSplatVulkanBackend() {
-    // Nothing may still run on buffers we are about to free; nothing pending is recorded.
-    pending_geometry_.reset();
+    // Nothing may still run on buffers we are about to free.
     WaitForStageWork();
     WaitAllSlots();
 }
 
 void GaussianSplatVulkanBackend::ReleaseResources() {
-    pending_geometry_.reset();
     WaitForStageWork();
     SetFramesInFlight(GetFramesInFlight());  // waits for the slots and empties them
     deferred_.Clear();
@@ -160,7 +158,6 @@ void GaussianSplatVulkanBackend::EnsureReadback(uint32_t width, uint32_t height)
 }
 
 bool GaussianSplatVulkanBackend::WaitGeometryStage(double timeout_ms) {
-    RunPendingGeometry();
     if (!geometry_.in_flight) return true;
     SubmitHeldGeometry(VK_NULL_HANDLE);
     // The fence stays signalled: the composite stage's own wait returns at once.
@@ -177,25 +174,6 @@ void GaussianSplatVulkanBackend::RenderGeometryStage(const camera::PinholeCamera
     if (!cloud_) core::ThrowError("Vulkan backend: RenderGeometryStage before SetScene");
     camera.Validate();
     requested.Validate();
-    // Held for GL's semaphore anyway: recorded when the composite comes, so that this call
-    // does not wait for the last frame's composite (GL can draw the next mesh view meanwhile).
-    if (hold_geometry_submit_ && hold_geometry_mode_ == 2) {
-        pending_geometry_.emplace(camera, requested);
-        return;
-    }
-    pending_geometry_.reset();
-    RunGeometryStage(camera, requested);
-}
-
-void GaussianSplatVulkanBackend::RunPendingGeometry() {
-    if (!pending_geometry_) return;
-    const auto [camera, config] = std::move(*pending_geometry_);
-    pending_geometry_.reset();
-    RunGeometryStage(camera, config);
-}
-
-void GaussianSplatVulkanBackend::RunGeometryStage(const camera::PinholeCamera& camera,
-                                                  const RenderConfig& requested) {
     const RenderConfig config = WithLodTarget(requested);
     const auto start = std::chrono::steady_clock::now();
     const SplatPrecision precision = SplatPrecisionFor(config.compact_storage);
@@ -277,7 +255,7 @@ void GaussianSplatVulkanBackend::RunGeometryStage(const camera::PinholeCamera& c
     const auto submit_start = std::chrono::steady_clock::now();
     // Fire and forget: composite stage (or the next geometry stage) waits on the fence. Held
     // for the composite where that waits for GL (hold_geometry_submit_).
-    if (hold_geometry_submit_ && hold_geometry_mode_ > 0) {
+    if (hold_geometry_submit_ && hold_geometry_enabled_) {
         geometry_held_ = true;
     } else {
         Submit(*context_, cmd, geometry_stage_fence_.Get());

@@ -15,7 +15,6 @@
 #include <memory>
 #include <optional>
 #include <string>
-#include <utility>
 #include <vector>
 
 #include "open3d/camera/PinholeCamera.h"
@@ -312,11 +311,6 @@ private:
     /// Submits a geometry stage held for the next composite (geometry_held_), waiting for
     /// `wait` (VK_NULL_HANDLE: nothing) before it runs.
     void SubmitHeldGeometry(VkSemaphore wait);
-    /// RenderGeometryStage's work: waits for the last stage-path work, records (or reuses)
-    /// and submits or holds.
-    void RunGeometryStage(const camera::PinholeCamera& camera, const RenderConfig& requested);
-    /// Runs a geometry stage RenderGeometryStage left for the composite (pending_geometry_).
-    void RunPendingGeometry();
     /// A frame's counts and flags from its geometry stage's counters, and the scene's bytes.
     void FillCounterStats(const shader::GaussianGeometryStageCounters& counters,
                           RenderStats& stats) const;
@@ -398,12 +392,8 @@ private:
     /// for the geometry stage submits it first.
     bool hold_geometry_submit_ = false;
     bool geometry_held_ = false;
-    /// How a geometry stage is held (OPEN3D_VULKAN_HOLD_GEOMETRY, for measurements): 0 never,
-    /// 1 (default) recorded by RenderGeometryStage, 2 recorded only when the composite comes,
-    /// so that RenderGeometryStage waits for nothing while the last frame's composite runs
-    /// (measured slower than 1 on the H200, docs/perf/h200.md).
-    int hold_geometry_mode_ = 1;
-    std::optional<std::pair<camera::PinholeCamera, RenderConfig>> pending_geometry_;
+    /// OPEN3D_VULKAN_HOLD_GEOMETRY=0 submits every geometry stage at once, for measurements.
+    bool hold_geometry_enabled_ = true;
     Buffer stage_params_upload_;
     FrameRecordingKey stage_recorded_;
     bool stage_recording_valid_ = false;

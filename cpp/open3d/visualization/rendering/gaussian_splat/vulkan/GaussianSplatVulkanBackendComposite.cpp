@@ -98,7 +98,6 @@ void GaussianSplatVulkanBackend::FillCounterStats(const shader::GaussianGeometry
 }
 
 void GaussianSplatVulkanBackend::WaitForStageWork() {
-    RunPendingGeometry();  // recorded with what it was asked for, before anything changes
     if (geometry_.in_flight) {
         SubmitHeldGeometry(VK_NULL_HANDLE);
         Wait(*context_, geometry_stage_fence_.Get());
@@ -197,7 +196,6 @@ void GaussianSplatVulkanBackend::RecordCompositeFrame(CompositeSink& sink, VkCom
 }
 
 RenderStats GaussianSplatVulkanBackend::RenderComposite(CompositeSink& sink) {
-    RunPendingGeometry();
     if (!geometry_.valid)
         core::ThrowError("Vulkan backend: a composite before RenderGeometryStage");
     const auto start = std::chrono::steady_clock::now();
