@@ -320,9 +320,11 @@ private:
     /// Whether the allocation, not the config, cut the frame of `counters` short and the
     /// entry buffers may grow.
     bool EntriesOutgrewBuffers(const shader::GaussianGeometryStageCounters& counters) const;
-    /// Grows the entry buffers to the request of `counters` plus a quarter (so a moving
-    /// camera does not regrow every frame) and renders the last geometry stage and `sink`'s
-    /// composite again; returns that frame's stats.
+    /// The entry capacity for the request of `counters` plus a quarter (so a moving camera
+    /// does not regrow every frame), within what the config and the sort allow.
+    uint32_t GrownEntryCapacity(const shader::GaussianGeometryStageCounters& counters) const;
+    /// Grows the entry buffers to GrownEntryCapacity(counters) and renders the last geometry
+    /// stage and `sink`'s composite again; returns that frame's stats.
     RenderStats RenderAgainWithGrownBuffers(CompositeSink& sink,
                                             const shader::GaussianGeometryStageCounters& counters);
 

@@ -39,15 +39,12 @@ void GaussianSplatVulkanBackend::WaitForComposite() {
     ObserveLodFrame(geometry_.config, g.gpu_project_ms + g.gpu_sort_ms + last_composite_gpu_ms_);
     if (outgrew) {
         // The frame was handed on before its counters were known: the next one gets room.
-        const uint64_t limit = MaxEntryCapacity(geometry_.config, SortMaxCount());
-        const uint64_t asked = counters.requested_entries;
-        initial_entry_capacity_ = static_cast<uint32_t>(std::max<uint64_t>(
-            initial_entry_capacity_, std::min<uint64_t>(limit, asked + asked / 4)));
+        initial_entry_capacity_ = std::max(initial_entry_capacity_, GrownEntryCapacity(counters));
         ++counters_.capacity_growths;
         core::LogWarning(
             "Vulkan backend: a frame handed to another API asked for {} tile entries, more "
             "than the {} its buffers held, and lost the rest; the next frame has room",
-            asked, geometry_stage_resources_.EntryCapacity());
+            counters.requested_entries, geometry_stage_resources_.EntryCapacity());
     }
 }
 
@@ -68,11 +65,16 @@ bool GaussianSplatVulkanBackend::EntriesOutgrewBuffers(
                MaxEntryCapacity(geometry_.config, SortMaxCount());
 }
 
-RenderStats GaussianSplatVulkanBackend::RenderAgainWithGrownBuffers(
-    CompositeSink& sink, const shader::GaussianGeometryStageCounters& counters) {
+uint32_t GaussianSplatVulkanBackend::GrownEntryCapacity(
+    const shader::GaussianGeometryStageCounters& counters) const {
     const uint64_t limit = MaxEntryCapacity(geometry_.config, SortMaxCount());
     const uint64_t asked = counters.requested_entries;
-    EnsureViewBuffers(static_cast<uint32_t>(std::min<uint64_t>(limit, asked + asked / 4)));
+    return static_cast<uint32_t>(std::min<uint64_t>(limit, asked + asked / 4));
+}
+
+RenderStats GaussianSplatVulkanBackend::RenderAgainWithGrownBuffers(
+    CompositeSink& sink, const shader::GaussianGeometryStageCounters& counters) {
+    EnsureViewBuffers(GrownEntryCapacity(counters));
     ++counters_.capacity_growths;
     growing_ = true;
     const camera::PinholeCamera camera = geometry_.camera;

@@ -6,6 +6,7 @@
 
 #include <vulkan/vulkan.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <vector>
 
@@ -69,7 +70,7 @@ private:
 
 /// A pass's milliseconds from GpuTimestamps::ReadMilliseconds; 0 when it was not recorded.
 inline double PassMs(const std::vector<double>& ms, TimedPass pass) {
-    return ms[static_cast<uint32_t>(pass)] > 0.0 ? ms[static_cast<uint32_t>(pass)] : 0.0;
+    return std::max(0.0, ms[static_cast<uint32_t>(pass)]);
 }
 
 }  // namespace vulkan
