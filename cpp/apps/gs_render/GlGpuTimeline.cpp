@@ -7,15 +7,13 @@ namespace gs_render {
 namespace rendering = open3d::visualization::rendering;
 
 GlGpuTimeline::GlGpuTimeline(const rendering::FilamentEngine& engine)
-    : engine_(engine),
-      queries_(std::make_shared<std::vector<std::array<uint32_t, 3>>>()),
-      times_ns_(std::make_shared<std::vector<std::array<uint64_t, 3>>>()) {}
+    : engine_(engine), queries_(std::make_shared<std::vector<std::array<uint32_t, kPoints>>>()) {}
 
 GlGpuTimeline::~GlGpuTimeline() {
     const rendering::GlFunctions gl = engine_.GetGl();
     auto queries = queries_;
     engine_.RunOnDriverThread([gl, queries] {
-        for (auto& frame : *queries) gl.DeleteQueries(3, frame.data());
+        for (auto& frame : *queries) gl.DeleteQueries(kPoints, frame.data());
     });
     engine_.FlushAndWait();
 }
@@ -25,8 +23,8 @@ void GlGpuTimeline::Mark(int frame, Point point) {
     auto queries = queries_;
     engine_.RunOnDriverThread([gl, queries, frame, point] {
         while (int(queries->size()) <= frame) {
-            std::array<uint32_t, 3> names{};
-            gl.GenQueries(3, names.data());
+            std::array<uint32_t, kPoints> names{};
+            gl.GenQueries(kPoints, names.data());
             queries->push_back(names);
         }
         gl.QueryCounter((*queries)[frame][point], GL_TIMESTAMP);
@@ -42,11 +40,11 @@ std::string GlGpuTimeline::Describe(int first) {
     }
     const rendering::GlFunctions gl = engine_.GetGl();
     auto queries = queries_;
-    auto times = times_ns_;
+    auto times = std::make_shared<std::vector<std::array<uint64_t, kPoints>>>();
     engine_.RunOnDriverThread([gl, queries, times] {
         times->assign(queries->size(), {});
         for (size_t f = 0; f < queries->size(); ++f) {
-            for (int p = 0; p < 3; ++p) {
+            for (int p = 0; p < kPoints; ++p) {
                 GLuint64 ns = 0;
                 gl.GetQueryObjectui64v((*queries)[f][p], GL_QUERY_RESULT, &ns);
                 (*times)[f][p] = ns;

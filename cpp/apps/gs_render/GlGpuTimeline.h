@@ -16,7 +16,7 @@ namespace gs_render {
 
 class GlGpuTimeline {
 public:
-    enum Point { kFrameBegin = 0, kMeshDone = 1, kComposeDone = 2 };
+    enum Point { kFrameBegin = 0, kMeshDone = 1, kComposeDone = 2, kPoints = 3 };
 
     /// Inactive (Mark does nothing, Describe says why) where RunOnDriverThread cannot run.
     explicit GlGpuTimeline(const open3d::visualization::rendering::FilamentEngine& engine);
@@ -31,8 +31,7 @@ public:
 private:
     const open3d::visualization::rendering::FilamentEngine& engine_;
     // Written and read on Filament's driver thread only (query objects are per context).
-    std::shared_ptr<std::vector<std::array<uint32_t, 3>>> queries_;
-    std::shared_ptr<std::vector<std::array<uint64_t, 3>>> times_ns_;
+    std::shared_ptr<std::vector<std::array<uint32_t, kPoints>>> queries_;
 };
 
 }  // namespace gs_render

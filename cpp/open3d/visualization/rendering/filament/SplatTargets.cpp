@@ -133,18 +133,18 @@ void SplatTargets::SetUpGpuHandover(GaussianSplatBackend& backend) {
     // waits, =mesh the GL-to-Vulkan one alone, the host waiting for the composite before GL's
     // compose view (docs/filament.md "Synchronisation").
     const char* env = std::getenv("OPEN3D_GL_VK_SEMAPHORES");
+    const bool asked = env != nullptr && *env != '\0';
     const bool glx = engine_.GetPlatform() == GlPlatform::kGlx;
-    const std::string mode = env != nullptr && *env != '\0' ? env : (glx ? "0" : "1");
+    const std::string mode = asked ? env : (glx ? "0" : "1");
     if (mode != "0" && mode != "1" && mode != "mesh") {
         core::ThrowError("OPEN3D_GL_VK_SEMAPHORES is '{}': 0, 1 or mesh", mode);
     }
     splats_drawn_handover_ = mode == "1";
     std::string why;
     if (mode == "0") {
-        why = env != nullptr && *env != '\0'
-                  ? "OPEN3D_GL_VK_SEMAPHORES=0"
-                  : "on GLX it is opt-in (OPEN3D_GL_VK_SEMAPHORES=1): it has not run there "
-                    "on a GPU yet";
+        why = asked ? "OPEN3D_GL_VK_SEMAPHORES=0"
+                    : "on GLX it is opt-in (OPEN3D_GL_VK_SEMAPHORES=1): it has not run there "
+                      "on a GPU yet";
     } else if (!engine_.CanRunOnDriverThread()) {
         why = engine_.DriverThreadUnavailableReason();
     } else if (!vulkan::QueryInteropSupport(backend).external_semaphore_fd) {
