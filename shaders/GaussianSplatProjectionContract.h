@@ -66,7 +66,12 @@ OPEN3D_SHADER_CONST uint kGeometryStageTileCountsBinding = 9u;   // uint[N]: til
 // The composite's state (GaussianCompositeState, then uvec2 [begin, end) per tile): the
 // per-tile bins' counts, cursors and finally the ranges the composite reads.
 OPEN3D_SHADER_CONST uint kGeometryStageTileRangesBinding = 10u;
-OPEN3D_SHADER_CONST uint kGeometryStageNumBindings = 11u;
+// The tile sort's RadixSweepState and the sorts' look-back status words (the histogram
+// scratch), where the chained emit counts the tile sort's digits and zeroes its first
+// pass's status rows in place of the sort's histogram dispatch.
+OPEN3D_SHADER_CONST uint kGeometryStageTileSortStateBinding = 11u;
+OPEN3D_SHADER_CONST uint kGeometryStageSortStatusBinding = 12u;
+OPEN3D_SHADER_CONST uint kGeometryStageNumBindings = 13u;
 
 // The buffers a splat count can grow past the range one storage binding reaches
 // (maxStorageBufferRange: 4 GiB on NVIDIA, 128 MiB on lavapipe; 98M splats of degree 3 have

@@ -38,6 +38,17 @@ OPEN3D_SHADER_CONST uint kEmitPackedKeys = 1u;  // packed option: key = PackedSo
 OPEN3D_SHADER_CONST uint kEmitUnpackKeys = 2u;  // after the packed sort: key >>= depth bits
 OPEN3D_SHADER_CONST uint kEmitBinned = 3u;  // per-tile bins: (depth key, slot) at the tile's cursor
 
+// ---- The chained emit (gaussian_emit_chained.comp, the exact order on GPUs) ----
+// The scan of the tile counts, the capacity cut and the emit in one dispatch: a workgroup
+// per block of kEmitWorkgroupSize list slots finds the entries of the blocks before it by
+// decoupled look-back, with the one-sweep sort's status words (kRadixSweepFlagAggregate /
+// kRadixSweepFlagInclusive | value, 0 = not published). They live in the scan buffer, which
+// this path does not otherwise use: word kEmitChainedTicketWord hands out block indices in
+// the order workgroups start (so a look-back only waits for started blocks), block b's
+// status word is kEmitChainedStatusBase + b. The recorder zeroes those words each frame.
+OPEN3D_SHADER_CONST uint kEmitChainedTicketWord = 0u;
+OPEN3D_SHADER_CONST uint kEmitChainedStatusBase = 1u;
+
 // ---- Per-tile bins (SortMode::kExactTileBins) ----
 // project (counts per tile) -> gaussian_bin_scan (one workgroup: each tile's begin, the
 // entries that fit) -> emit (kEmitBinned: (depth key, slot) at an atomic cursor of each tile)

@@ -55,6 +55,8 @@ layout(std430, set = 0, binding = kGeometryStageEntryValuesBinding) writeonly bu
     uint entry_values[];
 };
 
+#include "gaussian_emit_entries.glsl"
+
 // Sorted packed keys -> tile indices. Dispatched with the emit pass's indirect size (one
 // invocation per visible splat, rounded up), so it strides over the entries.
 void UnpackKeys() {
@@ -112,56 +114,6 @@ void main() {
     uint begin = ScanOffset(k);
     uint end = k + 1u < visible ? ScanOffset(k + 1u) : counters.requested_entries;
     if (end > view.entry_capacity || end == begin) return;
-    uint splat = ListValueSplat(splat_indices[k], view.num_splats);
-    uint64_t projected = DeviceAddress(addresses.projected_lo, addresses.projected_hi);
-    // Only the words of the members used are loaded: the rest of an unpacked record is dead.
-    GaussianProjectedSplat record = LoadProjected(projected, splat);
-    uint rect_min = record.rect_min, rect_max = record.rect_max;
-    uint min_x = rect_min & 0xFFFFu, min_y = rect_min >> 16u;
-    uint max_x = rect_max & 0xFFFFu, max_y = rect_max >> 16u;
-    uint tiles_x = view.tiles_x;
-    // The same float32 view depth the exact order sorts by (the projection's output).
-    float norm_depth = kEmitMode == kEmitPackedKeys
-                           ? PackedSortKeyDepth(record.depth,
-                                                view.near_plane, view.packed_depth_scale)
-                           : 0.0;
-    uint tile_bits = view.tile_bits;
-    // When the count equals the rectangle's area the projection kept every tile of it (a
-    // row's span is at most its width): every row is whole, no span is recomputed and the
-    // record's centre and conic, the other half of its 64 bytes, are not read. The grid's
-    // splats mostly cover one or two tiles.
-    bool whole_rect = end - begin == (max_x - min_x) * (max_y - min_y);
-    vec2 center = vec2(0.0);
-    vec3 conic = vec3(0.0);
-    float cull_t = 0.0;
-    float det_q = 0.0;
-    if (!whole_rect) {
-        GaussianProjectedSplat shape = LoadProjected(projected, splat);  // loaded here only
-        center = vec2(shape.center_x, shape.center_y);
-        conic = shape.conic;
-        cull_t = shape.cull_threshold;
-        det_q = shape.det_q;
-    }
-    uint out_index = begin;
-    for (uint ty = min_y; ty < max_y && out_index < end; ++ty) {
-        uint span = whole_rect ? min_x | (max_x << 16u)
-                               : TileRowSpan(center.x, center.y, conic.x, conic.y, conic.z,
-                                             det_q, cull_t, ty, min_x, max_x);
-        uint last = min(span >> 16u, (span & 0xFFFFu) + (end - out_index));
-        for (uint tx = span & 0xFFFFu; tx < last; ++tx) {
-            uint tile = ty * tiles_x + tx;
-            entry_keys[out_index] =
-                kEmitMode == kEmitPackedKeys ? PackedSortKey(tile, norm_depth, tile_bits) : tile;
-            entry_values[out_index] = splat;
-            ++out_index;
-        }
-    }
-    // The projection counted these spans from the same stored values with the same
-    // `precise` code, so this never runs; should a driver still round differently, the
-    // slots get a key past every tile (tile bits cover tiles_x * tiles_y + 1 values), which
-    // sorts last and is never composited, instead of leaving stale entries.
-    for (; out_index < end; ++out_index) {
-        entry_keys[out_index] = 0xFFFFFFFFu;
-        entry_values[out_index] = splat;
-    }
+    EmitEntries(ListValueSplat(splat_indices[k], view.num_splats), begin, end,
+                kEmitMode == kEmitPackedKeys);
 }

@@ -12,6 +12,9 @@
 # (quick: the suites, then playbot_125k and its first splat only, for a short lease)
 # (suites, then other work, then bench: the frames are timed only where the one-sweep suites
 # passed).
+# VAR and VALUES compare another switch the same way, e.g. VAR=OPEN3D_CHAINED_EMIT VALUES="0 1"
+# (the geometry stage's separate scan, cut and emit passes against the chained one); the
+# default is VAR=OPEN3D_RADIX_SORT VALUES="multipass onesweep".
 set -uo pipefail
 out=${1:?usage: bash scripts/device/sort-ab.sh OUT_DIR [all | suites | bench]}
 what=${2:-all}
@@ -40,14 +43,16 @@ if [[ $(cat "$out/suites.rc" 2>/dev/null) == 124 ]] || grep -q 'FAILED.*OneSweep
 fi
 
 d=shared/data
-bench() {  # NAME ARGS...: one gs-bench run per algorithm
+var=${VAR:-OPEN3D_RADIX_SORT}
+values=${VALUES:-multipass onesweep}
+bench() {  # NAME ARGS...: one gs-bench run per value of $var
   local name=$1
   shift
-  for algo in multipass onesweep; do
-    OPEN3D_RADIX_SORT=$algo timeout 90 .devbin/gs-bench "$@" --knobs default --repeat 50 \
-      --warm-up 2 --reference-max-splats 0 --json "$out/$name-$algo.json" >"$out/$name-$algo.log" 2>&1
-    echo "== $name $algo (exit $?)"
-    grep -E "^default|dispatches" "$out/$name-$algo.log"
+  for value in $values; do
+    env "$var=$value" timeout 90 .devbin/gs-bench "$@" --knobs default --repeat 50 \
+      --warm-up 2 --reference-max-splats 0 --json "$out/$name-$value.json" >"$out/$name-$value.log" 2>&1
+    echo "== $name $var=$value (exit $?)"
+    grep -E "^default|dispatches" "$out/$name-$value.log"
   done
 }
 hd=(--resolution 1920x1080 --resolution 3840x2160)
@@ -59,6 +64,9 @@ bench playbot -i $d/playbot/playbot_125k.ply --cameras $d/playbot/cameras.json "
 bench chair -i $d/chair/chair.splat --cameras $d/chair/cameras.json "${hd[@]}"
 bench biker -i $d/biker/biker_152k.ply --cameras $d/biker/cameras.json "${hd[@]}"
 bench first1 -i $d/playbot/playbot_125k.ply --cameras $d/playbot/cameras.json --first 1 "${hd[@]}"
-bench grid7 -i $d/playbot/playbot_125k.ply --cameras $d/playbot/cameras.json --grid 7 --resolution 1920x1080
+bench first1000 -i $d/playbot/playbot_125k.ply --cameras $d/playbot/cameras.json --first 1000 "${hd[@]}"
+bench grid7 -i $d/playbot/playbot_125k.ply --cameras $d/playbot/cameras.json --grid 7 "${hd[@]}"
 bench batch -i $d/playbot/playbot_125k.ply --cameras $d/playbot/cameras.json --resolution 800x800 --batch 24
 nvidia-smi --query-gpu=clocks.sm --format=csv | tee -a "$out/gpu.txt"
+# At most 8 files come back from a device call: the logs and JSON travel as one archive.
+(cd "$out" && tar -czf runs.tar.gz ./*.log ./*.json 2>/dev/null && rm -f ./*.log ./*.json)

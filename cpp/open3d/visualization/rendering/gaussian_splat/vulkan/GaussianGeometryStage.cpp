@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <array>
 #include <bit>
+#include <cstdlib>
+#include <string>
 #include <utility>
 
 #include "open3d/core/Exception.h"
@@ -38,10 +40,22 @@ void ComputeBarrier(VkCommandBuffer cmd) { RecordComputeToComputeAndIndirect(cmd
 // frame-start writes, or a ComputeBarrier after the pass that wrote it): storage only.
 void StorageBarrier(VkCommandBuffer cmd) { RecordComputeToCompute(cmd); }
 
+// OPEN3D_CHAINED_EMIT: unset or 1 lets the geometry stage chain its scan, cut and emit
+// where it can (UsesChainedEmit); 0 keeps the separate passes, to measure them.
+bool ChainedEmitAllowed() {
+    const char* env = std::getenv("OPEN3D_CHAINED_EMIT");
+    if (env == nullptr || *env == '\0') return true;
+    const std::string value = env;
+    if (value == "1") return true;
+    if (value == "0") return false;
+    core::ThrowError("OPEN3D_CHAINED_EMIT is '{}': use 1 or 0 (or unset it)", value);
+}
+
 }  // namespace
 
 GaussianGeometryStage::GaussianGeometryStage(const VulkanContext& context)
     : context_(context), sort_(context), lod_cut_(context) {
+    chained_emit_allowed_ = ChainedEmitAllowed();
     set_layout_ = CreateStorageBufferPushLayout(context, kGeometryStageNumBindings);
     // The scan's or the dispatch-args pass's constants, then the device addresses.
     static_assert(sizeof(GaussianScanPushConstants) <= kGeometryAddressesPushOffset &&
@@ -72,6 +86,8 @@ GaussianGeometryStage::GaussianGeometryStage(const VulkanContext& context)
     const VkSpecializationInfo binned_info{1, &emit_entry, sizeof(uint32_t), &binned_mode};
     emit_binned_ = CreateComputePipeline(context, layout, spirv::kGaussianEmit,
                                          "gaussian_emit (bins)", &binned_info);
+    emit_chained_ = CreateComputePipeline(context, layout, spirv::kGaussianEmitChained,
+                                          "gaussian_emit_chained");
     bin_scan_ =
         CreateComputePipeline(context, layout, spirv::kGaussianBinScan, "gaussian_bin_scan");
     // A tile sorts in shared memory up to 8-byte pairs filling 32 KiB where the device has
@@ -110,11 +126,20 @@ GeometryStageStorageRequirements GaussianGeometryStage::GetStorageRequirements(
         if (count <= kScanBlockSize) break;
         count = DivCeil(count, kScanBlockSize);
     }
+    // The chained emit keeps its ticket and one look-back word per block of list slots there.
+    words = std::max<uint64_t>(
+        words, kEmitChainedStatusBase + DivCeil(std::max(num_splats, 1u), kEmitWorkgroupSize));
     r.scan_bytes = Words(words);
     r.entry_keys_bytes = Words(entry_capacity);
     r.entry_values_bytes = Words(entry_capacity);
     r.sort = RadixSort::GetStorageRequirements(std::max(num_splats, entry_capacity));
     return r;
+}
+
+bool GaussianGeometryStage::UsesChainedEmit(const GeometryStageChoices& choices) const {
+    return chained_emit_allowed_ && !choices.packed_key && !choices.binned &&
+           sort_.GetAlgorithm() == RadixSort::Algorithm::kOneSweep &&
+           choices.entry_capacity_allocated < kRadixSweepValueMask;
 }
 
 VkPipeline GaussianGeometryStage::GetProjectPipeline(uint32_t sh_degree, bool antialias,
@@ -158,15 +183,18 @@ void GaussianGeometryStage::PushBindings(VkCommandBuffer cmd,
         &buffers.entry_values,
         &buffers.sort_scratch.params,
         &buffers.tile_counts,
-        tile_ranges};
-    static_assert(kGeometryStageViewBinding == 0 && kGeometryStageVisibilityBinding == 1 &&
-                      kGeometryStageCountersBinding == 2 && kGeometryStageDepthKeysBinding == 3 &&
-                      kGeometryStageSplatIndexBinding == 4 && kGeometryStageScanBinding == 5 &&
-                      kGeometryStageEntryKeysBinding == 6 &&
-                      kGeometryStageEntryValuesBinding == 7 &&
-                      kGeometryStageSortParamsBinding == 8 &&
-                      kGeometryStageTileCountsBinding == 9 && kGeometryStageTileRangesBinding == 10,
-                  "ranges above are listed in binding order");
+        tile_ranges,
+        &buffers.tile_sort_sweep_state,
+        &buffers.sort_scratch.histogram};
+    static_assert(
+        kGeometryStageViewBinding == 0 && kGeometryStageVisibilityBinding == 1 &&
+            kGeometryStageCountersBinding == 2 && kGeometryStageDepthKeysBinding == 3 &&
+            kGeometryStageSplatIndexBinding == 4 && kGeometryStageScanBinding == 5 &&
+            kGeometryStageEntryKeysBinding == 6 && kGeometryStageEntryValuesBinding == 7 &&
+            kGeometryStageSortParamsBinding == 8 && kGeometryStageTileCountsBinding == 9 &&
+            kGeometryStageTileRangesBinding == 10 && kGeometryStageTileSortStateBinding == 11 &&
+            kGeometryStageSortStatusBinding == 12,
+        "ranges above are listed in binding order");
     std::array<VkDescriptorBufferInfo, kGeometryStageNumBindings> infos{};
     std::array<VkWriteDescriptorSet, kGeometryStageNumBindings> writes{};
     for (uint32_t i = 0; i < kGeometryStageNumBindings; ++i) {
@@ -262,6 +290,14 @@ void GaussianGeometryStage::Record(VkCommandBuffer cmd, const GeometryStageScene
                           buffers.sort_scratch.params.offset, sizeof(depth_sort), &depth_sort);
     }
     vkCmdUpdateBuffer(cmd, counters, counters_offset, sizeof(initial_counters), &initial_counters);
+    // The chained emit (the exact order where the sorts run the one sweep) scans, cuts and
+    // emits in one dispatch; its ticket and look-back words start at zero.
+    const bool chained = UsesChainedEmit(choices);
+    const uint32_t chained_blocks = DivCeil(std::max(n, 1u), kEmitWorkgroupSize);
+    if (chained) {
+        vkCmdFillBuffer(cmd, buffers.scan.buffer, buffers.scan.offset,
+                        4 * VkDeviceSize(kEmitChainedStatusBase + chained_blocks), 0u);
+    }
     // Both sorts' one-sweep states start at zero (the multi-pass sort reads neither).
     RadixSortScratch depth_sort_scratch = buffers.sort_scratch;
     RadixSortScratch tile_sort_scratch = buffers.sort_scratch;
@@ -386,51 +422,61 @@ void GaussianGeometryStage::Record(VkCommandBuffer cmd, const GeometryStageScene
         end(TimedPass::kDepthSort);
     }
     begin(TimedPass::kScanEmit);
-
-    // 4. Exclusive scan of the tile counts in depth order, up the block levels (readers add
-    // the levels above a slot themselves: ScanOffset in gaussian_scan_offset.glsl).
-    PushBindings(cmd, scene, buffers);  // the sorts bound their own layout
-    GaussianScanPushConstants scan{};
-    for (uint32_t level = 0; level < need.num_scan_levels; ++level) {
-        vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE,
-                          level == 0 ? scan_gather_.Get() : scan_.Get());
-        scan.level = level;
-        scan.base = need.scan_level_base[level];
-        scan.sums_base = level + 1 < need.num_scan_levels ? need.scan_level_base[level + 1] : 0u;
-        scan.write_total = level + 1 == need.num_scan_levels ? 1u : 0u;
-        vkCmdPushConstants(cmd, layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(scan), &scan);
-        RecordDispatchIndirect(cmd, counters,
-                               counters_offset +
-                                   offsetof(GaussianGeometryStageCounters, scan_levels) +
-                                   level * sizeof(GaussianScanLevel));
-        // The next level's size sits in the counters this level writes to (its total, error
-        // flags): the validation layer tracks a bound buffer as one range, so it wants the
-        // indirect access in the barrier although the words differ.
-        ComputeBarrier(cmd);
-    }
-
-    // 5. How many entries fit (whole splats, front to back) -> entry_count, error flags.
-    args.mode = kDispatchArgsAfterScan;
-    args.sort_max_count = std::max(capacity, 1u);
-    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, dispatch_args_.Get());
-    vkCmdPushConstants(cmd, layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(args), &args);
-    RecordDispatch(cmd, 1, 1, 1);
-    ComputeBarrier(cmd);  // the emit's size is in the counters written here (see above)
-
-    // 6. Emit (tile, splat) entries in list order at the scanned offsets: tile keys in
-    // depth order, or packed (tile, truncated depth) keys.
     const VkDeviceSize emit_args =
         counters_offset + offsetof(GaussianGeometryStageCounters, emit_dispatch_x);
-    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE,
-                      packed_key ? emit_packed_.Get() : emit_.Get());
-    RecordDispatchIndirect(cmd, counters, emit_args);
-    ComputeBarrier(cmd);
+    args.sort_max_count = std::max(capacity, 1u);
+    PushBindings(cmd, scene, buffers);  // the sorts bound their own layout
+    if (chained) {
+        // 4-6 in one dispatch: a workgroup per block of list slots finds its entries' offset
+        // by look-back, cuts at the capacity and emits (gaussian_emit_chained.comp).
+        vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, emit_chained_.Get());
+        vkCmdPushConstants(cmd, layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(args), &args);
+        const uvec4 grid = DispatchGridFor(chained_blocks, max_groups_x);
+        RecordDispatch(cmd, grid.x, grid.y, 1);
+        ComputeBarrier(cmd);
+    } else {
+        // 4. Exclusive scan of the tile counts in depth order, up the block levels (readers
+        // add the levels above a slot themselves: ScanOffset in gaussian_scan_offset.glsl).
+        GaussianScanPushConstants scan{};
+        for (uint32_t level = 0; level < need.num_scan_levels; ++level) {
+            vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE,
+                              level == 0 ? scan_gather_.Get() : scan_.Get());
+            scan.level = level;
+            scan.base = need.scan_level_base[level];
+            scan.sums_base =
+                level + 1 < need.num_scan_levels ? need.scan_level_base[level + 1] : 0u;
+            scan.write_total = level + 1 == need.num_scan_levels ? 1u : 0u;
+            vkCmdPushConstants(cmd, layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(scan), &scan);
+            RecordDispatchIndirect(cmd, counters,
+                                   counters_offset +
+                                       offsetof(GaussianGeometryStageCounters, scan_levels) +
+                                       level * sizeof(GaussianScanLevel));
+            // The next level's size sits in the counters this level writes to (its total,
+            // error flags): the validation layer tracks a bound buffer as one range, so it
+            // wants the indirect access in the barrier although the words differ.
+            ComputeBarrier(cmd);
+        }
 
+        // 5. How many entries fit (whole splats, front to back) -> entry_count, error flags.
+        args.mode = kDispatchArgsAfterScan;
+        vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, dispatch_args_.Get());
+        vkCmdPushConstants(cmd, layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(args), &args);
+        RecordDispatch(cmd, 1, 1, 1);
+        ComputeBarrier(cmd);  // the emit's size is in the counters written here (see above)
+
+        // 6. Emit (tile, splat) entries in list order at the scanned offsets: tile keys in
+        // depth order, or packed (tile, truncated depth) keys.
+        vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE,
+                          packed_key ? emit_packed_.Get() : emit_.Get());
+        RecordDispatchIndirect(cmd, counters, emit_args);
+        ComputeBarrier(cmd);
+    }
     end(TimedPass::kScanEmit);
 
     // 7. Stable sort by tile index only: each tile keeps the depth order of step 3. The
     // packed key sorts all 32 bits (4 passes, as the seed), then shifts back to tiles.
     begin(TimedPass::kTileSort);
+    tile_sort_scratch.sweep_histogram_written = chained;  // the chained emit counted the digits
     sort_.Record(cmd, buffers.entry_keys, buffers.entry_values, tile_sort_scratch,
                  counter_range(kCounterEntriesIndex), std::max(capacity, 1u),
                  packed_key ? kSortKeyBits : choices.tile_bits,

@@ -160,19 +160,27 @@ private:
     void RecordBins(VkCommandBuffer cmd, const PackedView& view, const GpuTimestamps* timestamps);
     void PushBindings(VkCommandBuffer cmd, const GeometryStageSceneBuffers& scene,
                       const GeometryStageViewBuffers& buffers) const;
+    /// Whether the scan, the capacity cut and the emit run as one chained dispatch
+    /// (gaussian_emit_chained.comp): in the exact order (neither the packed key nor the
+    /// bins), where the sorts run the one sweep (the look-back needs the device's forward
+    /// progress), for a capacity below the look-back words' value range, unless
+    /// OPEN3D_CHAINED_EMIT=0 asks for the separate passes (to measure them).
+    bool UsesChainedEmit(const GeometryStageChoices& choices) const;
 
     const VulkanContext& context_;
     RadixSort sort_;
     GaussianLodCut lod_cut_;
+    bool chained_emit_allowed_ = true;  // OPEN3D_CHAINED_EMIT is not 0
     UniqueDescriptorSetLayout set_layout_;
     UniquePipelineLayout pipeline_layout_;
     UniquePipeline scan_;
     UniquePipeline scan_gather_;
     UniquePipeline dispatch_args_;
     UniquePipeline emit_;
-    UniquePipeline emit_packed_;  // kEmitPackedKeys
-    UniquePipeline unpack_keys_;  // kEmitUnpackKeys
-    UniquePipeline emit_binned_;  // kEmitBinned
+    UniquePipeline emit_packed_;   // kEmitPackedKeys
+    UniquePipeline unpack_keys_;   // kEmitUnpackKeys
+    UniquePipeline emit_binned_;   // kEmitBinned
+    UniquePipeline emit_chained_;  // gaussian_emit_chained.comp: scan, cut and emit in one
     UniquePipeline bin_scan_;
     UniquePipeline bin_sort_;
     std::map<uint32_t, UniquePipeline> project_;  // key: degree | antialias << 2 | precision << 3 |

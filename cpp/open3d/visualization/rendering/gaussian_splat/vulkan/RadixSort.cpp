@@ -267,6 +267,9 @@ void RadixSort::Record(VkCommandBuffer cmd, const BufferRange& keys, const Buffe
         RecordOneSweep(cmd, keys, values, scratch, count, max_count, num_bits, params, drop,
                        output);
     } else {
+        if (scratch.sweep_histogram_written) {
+            core::ThrowError("RadixSort: a producer-written histogram needs the one-sweep sort");
+        }
         RecordMultiPass(cmd, keys, values, scratch, count, max_count, num_bits, params, drop,
                         pass_count, output);
     }

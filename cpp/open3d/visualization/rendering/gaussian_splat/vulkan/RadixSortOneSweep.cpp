@@ -6,6 +6,7 @@
 #include <cstddef>
 
 #include "GaussianSplatRadixSortContract.h"
+#include "open3d/core/Exception.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/CommandTally.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/Commands.h"
 #include "open3d/visualization/rendering/gaussian_splat/vulkan/RadixSort.h"
@@ -57,13 +58,23 @@ void RadixSort::RecordOneSweep(VkCommandBuffer cmd, const BufferRange& keys,
     }
     if (max_count == 0) return;  // params now say count 0; nothing to move
 
-    // Every pass's digit counts (of the kept keys) and the first pass's status rows.
-    BindBuffers(cmd, scratch, count, max_count, keys, values, scratch.keys_alt, scratch.values_alt);
-    push.drop_max_keys = drop ? 1u : 0u;
-    dispatch(sweep_histogram_.Get(), offsetof(RadixSortParams, sweep_histogram_grid));
-    // From here every dispatch takes its size from the params made visible above (or by the
-    // producer), so the barriers between the passes wait for storage only.
-    RecordComputeToCompute(cmd);
+    // Every pass's digit counts (of the kept keys) and the first pass's status rows, unless
+    // the producer counted them.
+    if (scratch.sweep_histogram_written) {
+        if (params != Params::kWrittenByProducer || drop != nullptr) {
+            core::ThrowError(
+                "RadixSort: a producer-written histogram needs producer-written parameters "
+                "and no dropped keys");
+        }
+    } else {
+        BindBuffers(cmd, scratch, count, max_count, keys, values, scratch.keys_alt,
+                    scratch.values_alt);
+        push.drop_max_keys = drop ? 1u : 0u;
+        dispatch(sweep_histogram_.Get(), offsetof(RadixSortParams, sweep_histogram_grid));
+        // From here every dispatch takes its size from the params made visible above (or by
+        // the producer), so the barriers between the passes wait for storage only.
+        RecordComputeToCompute(cmd);
+    }
 
     for (uint32_t pass = 0; pass < num_passes; ++pass) {
         // Ping-pong: even passes read the caller's buffers, odd passes the scratch.
