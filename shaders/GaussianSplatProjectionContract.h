@@ -46,6 +46,11 @@ OPEN3D_SHADER_CONST uint kSpecCutList = 4u;
 // 1 (per-tile bins, SortMode::kExact): a visible splat also adds 1 to the count of every
 // tile it will emit into, in the tile ranges binding (GaussianSplatTileListContract.h).
 OPEN3D_SHADER_CONST uint kSpecBinTiles = 5u;
+// 1 (the exact order where the sorts run the one sweep, with the chained emit): the
+// projection also adds the digits of every visible depth key to the depth sort's one-sweep
+// histogram and zeroes its first pass's status rows, in place of the sort's histogram
+// dispatch (RadixSortScratch::sweep_histogram_written).
+OPEN3D_SHADER_CONST uint kSpecDepthDigits = 6u;
 
 // Descriptor set 0 of every geometry stage projection pipeline (one push-descriptor layout; each
 // shader declares only the bindings it uses). The positions, the shape and SH words and the
@@ -71,7 +76,9 @@ OPEN3D_SHADER_CONST uint kGeometryStageTileRangesBinding = 10u;
 // pass's status rows in place of the sort's histogram dispatch.
 OPEN3D_SHADER_CONST uint kGeometryStageTileSortStateBinding = 11u;
 OPEN3D_SHADER_CONST uint kGeometryStageSortStatusBinding = 12u;
-OPEN3D_SHADER_CONST uint kGeometryStageNumBindings = 13u;
+// The depth sort's RadixSweepState, where the projection counts its digits (kSpecDepthDigits).
+OPEN3D_SHADER_CONST uint kGeometryStageDepthSortStateBinding = 13u;
+OPEN3D_SHADER_CONST uint kGeometryStageNumBindings = 14u;
 
 // The buffers a splat count can grow past the range one storage binding reaches
 // (maxStorageBufferRange: 4 GiB on NVIDIA, 128 MiB on lavapipe; 98M splats of degree 3 have

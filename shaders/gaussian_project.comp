@@ -25,6 +25,7 @@ layout(constant_id = kSpecPrecision) const uint kPrecision = kPrecisionExact;
 layout(constant_id = kSpecIndexedList) const uint kIndexedList = 1u;
 layout(constant_id = kSpecCutList) const uint kCutList = 0u;
 layout(constant_id = kSpecBinTiles) const uint kBinTiles = 0u;
+layout(constant_id = kSpecDepthDigits) const uint kDepthDigits = 0u;
 
 layout(std430, set = 0, binding = kGeometryStageViewBinding) readonly buffer ViewBlock {
     GaussianViewParams view;
@@ -68,6 +69,20 @@ layout(std430, set = 0, binding = kGeometryStageTileCountsBinding) writeonly buf
 layout(std430, set = 0, binding = kGeometryStageTileRangesBinding) buffer TileRangesBlock {
     uint tile_bins[];
 };
+
+// kDepthDigits: the depth sort's one-sweep histogram, its parameters (written by the
+// recorder: the block count) and its look-back status words.
+layout(std430, set = 0, binding = kGeometryStageDepthSortStateBinding) buffer DepthSortStateBlock {
+    RadixSweepState depth_sort_state;
+};
+layout(std430, set = 0, binding = kGeometryStageSortParamsBinding) readonly buffer SortParamsBlock {
+    RadixSortParams depth_sort_params;
+};
+layout(std430, set = 0, binding = kGeometryStageSortStatusBinding) writeonly buffer SortStatusBlock {
+    uint sort_status[];
+};
+// This workgroup's digit counts of its visible depth keys, pass-major (kDepthDigits only).
+shared uint s_depth_digits[kRadixSortMaxPasses * kRadixSortBins];
 
 const float kSH_C0 = 0.28209479177387814;
 const float kSH_C1 = 0.4886025119029199;
@@ -342,6 +357,12 @@ bool Project(uint i, uint slot, out float depth, out uint entries) {
 
 void main() {
     uint i = FlatWorkGroupIndex() * kProjectWorkgroupSize + gl_LocalInvocationIndex;
+    if (kDepthDigits != 0u) {
+        for (uint p = 0u; p < kRadixSortMaxPasses; ++p) {
+            s_depth_digits[p * kRadixSortBins + gl_LocalInvocationIndex] = 0u;
+        }
+        barrier();
+    }
     float depth = 0.0;
     uint entries = 0u;
     // Slot i holds splat i, or the cut's node list[i] (its slots past the cut's size are
@@ -370,5 +391,30 @@ void main() {
         // depth > near plane > 0, so the float bits order like the depths.
         depth_keys[base + rank] = floatBitsToUint(depth);
         splat_indices[base + rank] = value;
+    }
+    if (kDepthDigits != 0u) {
+        // What radix_sort_sweep_histogram.comp would do for the depth sort's kept keys (the
+        // visible ones; 32 bits, four passes): count every digit, one atomic per non-zero bin
+        // and workgroup, and zero the first pass's status row of block FlatWorkGroupIndex()
+        // (the sort's blocks hold at least a workgroup's worth of slots, so every block has
+        // a projection workgroup).
+        if (visible) {
+            uint key = floatBitsToUint(depth);
+            [[unroll]] for (uint p = 0u; p < kRadixSortMaxPasses; ++p) {
+                atomicAdd(s_depth_digits[p * kRadixSortBins + ((key >> (8u * p)) & 0xFFu)], 1u);
+            }
+        }
+        uint block = FlatWorkGroupIndex();
+        if (block < depth_sort_params.num_blocks) {
+            sort_status[block * kRadixSortBins + gl_LocalInvocationIndex] = 0u;
+        }
+        barrier();
+        [[unroll]] for (uint p = 0u; p < kRadixSortMaxPasses; ++p) {
+            uint c = s_depth_digits[p * kRadixSortBins + gl_LocalInvocationIndex];
+            if (c != 0u) {
+                atomicAdd(depth_sort_state.histogram[p * kRadixSortBins + gl_LocalInvocationIndex],
+                          c);
+            }
+        }
     }
 }

@@ -144,23 +144,26 @@ bool GaussianGeometryStage::UsesChainedEmit(const GeometryStageChoices& choices)
 
 VkPipeline GaussianGeometryStage::GetProjectPipeline(uint32_t sh_degree, bool antialias,
                                                      SplatPrecision precision, bool indexed_list,
-                                                     bool cut_list, bool bin_tiles) {
+                                                     bool cut_list, bool bin_tiles,
+                                                     bool depth_digits) {
     const uint32_t precision_value =
         precision == SplatPrecision::kExact ? kPrecisionExact : kPrecisionCompact;
     const uint32_t key = sh_degree | (antialias ? 4u : 0u) | (precision_value << 3) |
-                         (indexed_list ? 16u : 0u) | (cut_list ? 32u : 0u) | (bin_tiles ? 64u : 0u);
+                         (indexed_list ? 16u : 0u) | (cut_list ? 32u : 0u) |
+                         (bin_tiles ? 64u : 0u) | (depth_digits ? 128u : 0u);
     auto it = project_.find(key);
     if (it != project_.end()) return it->second.Get();
-    const std::array<uint32_t, 6> values{sh_degree,          antialias ? 1u : 0u,
-                                         precision_value,    indexed_list ? 1u : 0u,
-                                         cut_list ? 1u : 0u, bin_tiles ? 1u : 0u};
-    const std::array<VkSpecializationMapEntry, 6> entries{{{kSpecShDegree, 0, 4},
+    const std::array<uint32_t, 7> values{
+        sh_degree,          antialias ? 1u : 0u, precision_value,       indexed_list ? 1u : 0u,
+        cut_list ? 1u : 0u, bin_tiles ? 1u : 0u, depth_digits ? 1u : 0u};
+    const std::array<VkSpecializationMapEntry, 7> entries{{{kSpecShDegree, 0, 4},
                                                            {kSpecAntialias, 4, 4},
                                                            {kSpecPrecision, 8, 4},
                                                            {kSpecIndexedList, 12, 4},
                                                            {kSpecCutList, 16, 4},
-                                                           {kSpecBinTiles, 20, 4}}};
-    const VkSpecializationInfo info{6, entries.data(), sizeof(values), values.data()};
+                                                           {kSpecBinTiles, 20, 4},
+                                                           {kSpecDepthDigits, 24, 4}}};
+    const VkSpecializationInfo info{7, entries.data(), sizeof(values), values.data()};
     UniquePipeline pipeline = CreateComputePipeline(
         context_, pipeline_layout_.Get(), spirv::kGaussianProject, "gaussian_project", &info);
     return project_.emplace(key, std::move(pipeline)).first->second.Get();
@@ -185,7 +188,8 @@ void GaussianGeometryStage::PushBindings(VkCommandBuffer cmd,
         &buffers.tile_counts,
         tile_ranges,
         &buffers.tile_sort_sweep_state,
-        &buffers.sort_scratch.histogram};
+        &buffers.sort_scratch.histogram,
+        &buffers.sort_scratch.sweep_state};
     static_assert(
         kGeometryStageViewBinding == 0 && kGeometryStageVisibilityBinding == 1 &&
             kGeometryStageCountersBinding == 2 && kGeometryStageDepthKeysBinding == 3 &&
@@ -193,7 +197,7 @@ void GaussianGeometryStage::PushBindings(VkCommandBuffer cmd,
             kGeometryStageEntryKeysBinding == 6 && kGeometryStageEntryValuesBinding == 7 &&
             kGeometryStageSortParamsBinding == 8 && kGeometryStageTileCountsBinding == 9 &&
             kGeometryStageTileRangesBinding == 10 && kGeometryStageTileSortStateBinding == 11 &&
-            kGeometryStageSortStatusBinding == 12,
+            kGeometryStageSortStatusBinding == 12 && kGeometryStageDepthSortStateBinding == 13,
         "ranges above are listed in binding order");
     std::array<VkDescriptorBufferInfo, kGeometryStageNumBindings> infos{};
     std::array<VkWriteDescriptorSet, kGeometryStageNumBindings> writes{};
@@ -306,6 +310,8 @@ void GaussianGeometryStage::Record(VkCommandBuffer cmd, const GeometryStageScene
         RadixSort::RecordClearSweepState(cmd, depth_sort_scratch.sweep_state);
         RadixSort::RecordClearSweepState(cmd, tile_sort_scratch.sweep_state);
         depth_sort_scratch.sweep_state_cleared = true;
+        // With the chained emit the projection counts the depth sort's digits (kSpecDepthDigits).
+        depth_sort_scratch.sweep_histogram_written = chained;
         tile_sort_scratch.sweep_state_cleared = true;
     }
     if (choices.binned) {
@@ -364,7 +370,7 @@ void GaussianGeometryStage::Record(VkCommandBuffer cmd, const GeometryStageScene
     PushBindings(cmd, scene, buffers);
     vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE,
                       GetProjectPipeline(choices.sh_degree, choices.antialias, scene.precision,
-                                         !packed_key, scene.lod, choices.binned));
+                                         !packed_key, scene.lod, choices.binned, chained));
     if (n > 0) {
         const uvec4 grid = DispatchGridFor(DivCeil(n, kProjectWorkgroupSize), max_groups_x);
         RecordDispatch(cmd, grid.x, grid.y, 1);

@@ -154,7 +154,8 @@ public:
 private:
     /// `cut_list`: slot i projects the node the cut's list holds (shader::kSpecCutList).
     VkPipeline GetProjectPipeline(uint32_t sh_degree, bool antialias, SplatPrecision precision,
-                                  bool indexed_list, bool cut_list, bool bin_tiles);
+                                  bool indexed_list, bool cut_list, bool bin_tiles,
+                                  bool depth_digits);
     /// The per-tile bins' passes after the projection (RenderConfig SortMode::kExact).
     /// Bindings and push constants are the projection's, still bound.
     void RecordBins(VkCommandBuffer cmd, const PackedView& view, const GpuTimestamps* timestamps);

@@ -65,10 +65,11 @@ struct RadixSortScratch {
     /// COMPUTE_SHADER reads and writes, e.g. with its other transfers at the start of a
     /// frame. false: a one-sweep Record clears it itself, behind a barrier of its own.
     bool sweep_state_cleared = false;
-    /// true (one sweep only, with params kWrittenByProducer and no DropMaxKeys): the producer
-    /// also added every pass's digit counts of the `count` pairs to sweep_state's histogram
-    /// and zeroed the first pass's status rows (words [0, num_blocks * 256) of `histogram`),
-    /// as the sort's histogram dispatch would, so Record skips that dispatch.
+    /// true (one sweep only, with params kWrittenByProducer): the producer also added every
+    /// pass's digit counts of the kept pairs (all `count` of them, or those a DropMaxKeys
+    /// keeps) to sweep_state's histogram and zeroed the first pass's status rows (words
+    /// [0, num_blocks * 256) of `histogram`), as the sort's histogram dispatch would, so
+    /// Record skips that dispatch.
     bool sweep_histogram_written = false;
 };
 

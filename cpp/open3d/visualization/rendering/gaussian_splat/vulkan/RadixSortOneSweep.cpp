@@ -61,10 +61,9 @@ void RadixSort::RecordOneSweep(VkCommandBuffer cmd, const BufferRange& keys,
     // Every pass's digit counts (of the kept keys) and the first pass's status rows, unless
     // the producer counted them.
     if (scratch.sweep_histogram_written) {
-        if (params != Params::kWrittenByProducer || drop != nullptr) {
+        if (params != Params::kWrittenByProducer) {
             core::ThrowError(
-                "RadixSort: a producer-written histogram needs producer-written parameters "
-                "and no dropped keys");
+                "RadixSort: a producer-written histogram needs producer-written parameters");
         }
     } else {
         BindBuffers(cmd, scratch, count, max_count, keys, values, scratch.keys_alt,
