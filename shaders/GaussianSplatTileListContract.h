@@ -48,6 +48,10 @@ OPEN3D_SHADER_CONST uint kEmitBinned = 3u;  // per-tile bins: (depth key, slot) 
 // status word is kEmitChainedStatusBase + b. The recorder zeroes those words each frame.
 OPEN3D_SHADER_CONST uint kEmitChainedTicketWord = 0u;
 OPEN3D_SHADER_CONST uint kEmitChainedStatusBase = 1u;
+// Specialisation constant of gaussian_emit_chained.comp (tests): 1 makes odd blocks publish
+// only their own totals, never their inclusive prefix, so look-backs walk across blocks even
+// where workgroups run one after another (GeometryStageOptions).
+OPEN3D_SHADER_CONST uint kSpecEmitChainedOddBlocksAggregateOnly = 0u;
 
 // ---- Per-tile bins (SortMode::kExactTileBins) ----
 // project (counts per tile) -> gaussian_bin_scan (one workgroup: each tile's begin, the

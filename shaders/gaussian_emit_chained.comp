@@ -22,6 +22,8 @@
 
 layout(local_size_x = kEmitWorkgroupSize) in;
 
+layout(constant_id = kSpecEmitChainedOddBlocksAggregateOnly) const uint kOddBlocksAggregateOnly = 0u;
+
 layout(push_constant, std430) uniform PushConstantsBlock {
     GaussianDispatchArgsPushConstants pc;
     layout(offset = kGeometryAddressesPushOffset) GaussianGeometryAddresses addresses;
@@ -142,8 +144,10 @@ uint LookBack(uint block, uint own) {
         if ((s & kRadixSweepFlagInclusive) != 0u) break;
         --back;  // block 0 always publishes an inclusive prefix, so this stops there
     }
-    atomicExchange(status[word],
-                   kRadixSweepFlagInclusive | min(prefix + own, kRadixSweepValueMask));
+    if (kOddBlocksAggregateOnly == 0u || (block & 1u) == 0u) {
+        atomicExchange(status[word],
+                       kRadixSweepFlagInclusive | min(prefix + own, kRadixSweepValueMask));
+    }
     return prefix;
 }
 

@@ -103,25 +103,12 @@ struct GpuSortResult {
 template <RadixSort::Algorithm kAlgorithm>
 class RadixSortFixture : public VulkanTest {
 protected:
-    // The one-sweep sort runs on lavapipe with one thread: there workgroups run one after
-    // another, so no look-back ever waits (docs/radix-sort.md "One sweep on CPU devices"). With
-    // several threads a look-back may wait for a block whose thread the OS descheduled, and
-    // lavapipe ends a loop after 65,535 iterations: the sort would then depend on the load
-    // of the machine. lavapipe reads LP_NUM_THREADS when an instance is created; a GPU
-    // ignores it.
+    // The one-sweep sort runs on lavapipe with one thread (SetUpTestSuiteOnOneLavapipeThread).
     static void SetUpTestSuite() {
-        if (kAlgorithm != RadixSort::Algorithm::kOneSweep) {
-            VulkanTest::SetUpTestSuite();
-            return;
-        }
-        const char* old = std::getenv("LP_NUM_THREADS");
-        const std::string saved = old ? old : "";
-        setenv("LP_NUM_THREADS", "1", 1);
-        VulkanTest::SetUpTestSuite();
-        if (old) {
-            setenv("LP_NUM_THREADS", saved.c_str(), 1);
+        if (kAlgorithm == RadixSort::Algorithm::kOneSweep) {
+            VulkanTest::SetUpTestSuiteOnOneLavapipeThread();
         } else {
-            unsetenv("LP_NUM_THREADS");
+            VulkanTest::SetUpTestSuite();
         }
     }
     void SetUp() override {

@@ -61,6 +61,18 @@ void VulkanTest::SetUpTestSuite() {
     if (context_) pool_ = std::make_unique<CommandPool>(*context_);
 }
 
+void VulkanTest::SetUpTestSuiteOnOneLavapipeThread() {
+    const char* old = std::getenv("LP_NUM_THREADS");
+    const std::string saved = old ? old : "";
+    setenv("LP_NUM_THREADS", "1", 1);
+    SetUpTestSuite();
+    if (old) {
+        setenv("LP_NUM_THREADS", saved.c_str(), 1);
+    } else {
+        unsetenv("LP_NUM_THREADS");
+    }
+}
+
 void VulkanTest::TearDownTestSuite() {
     // Messages sent while the device and instance are destroyed (e.g. leaked objects)
     // arrive after the context's counters are gone: count them through the log sink.

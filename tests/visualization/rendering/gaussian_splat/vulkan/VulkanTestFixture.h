@@ -37,6 +37,12 @@ inline visualization::rendering::RenderOutput RenderStages(
 class VulkanTest : public ::testing::Test {
 protected:
     static void SetUpTestSuite();
+    /// SetUpTestSuite with LP_NUM_THREADS=1 while the instance is made: lavapipe then runs
+    /// workgroups one after another, so no decoupled look-back (the one-sweep sort, the
+    /// chained emit) ever waits for a workgroup the OS descheduled, which with lavapipe's
+    /// loop limit would make results depend on the machine's load (docs/radix-sort.md
+    /// "One sweep on CPU devices"). A GPU ignores the variable.
+    static void SetUpTestSuiteOnOneLavapipeThread();
     static void TearDownTestSuite();
     void SetUp() override;
     void TearDown() override;

@@ -53,8 +53,9 @@ bool ChainedEmitAllowed() {
 
 }  // namespace
 
-GaussianGeometryStage::GaussianGeometryStage(const VulkanContext& context)
-    : context_(context), sort_(context), lod_cut_(context) {
+GaussianGeometryStage::GaussianGeometryStage(const VulkanContext& context,
+                                             GeometryStageOptions options)
+    : context_(context), sort_(context, options.sort), lod_cut_(context) {
     chained_emit_allowed_ = ChainedEmitAllowed();
     set_layout_ = CreateStorageBufferPushLayout(context, kGeometryStageNumBindings);
     // The scan's or the dispatch-args pass's constants, then the device addresses.
@@ -86,8 +87,13 @@ GaussianGeometryStage::GaussianGeometryStage(const VulkanContext& context)
     const VkSpecializationInfo binned_info{1, &emit_entry, sizeof(uint32_t), &binned_mode};
     emit_binned_ = CreateComputePipeline(context, layout, spirv::kGaussianEmit,
                                          "gaussian_emit (bins)", &binned_info);
+    const uint32_t aggregate_only = options.chained_odd_blocks_aggregate_only ? 1u : 0u;
+    const VkSpecializationMapEntry aggregate_entry{kSpecEmitChainedOddBlocksAggregateOnly, 0,
+                                                   sizeof(uint32_t)};
+    const VkSpecializationInfo aggregate_info{1, &aggregate_entry, sizeof(uint32_t),
+                                              &aggregate_only};
     emit_chained_ = CreateComputePipeline(context, layout, spirv::kGaussianEmitChained,
-                                          "gaussian_emit_chained");
+                                          "gaussian_emit_chained", &aggregate_info);
     bin_scan_ =
         CreateComputePipeline(context, layout, spirv::kGaussianBinScan, "gaussian_bin_scan");
     // A tile sorts in shared memory up to 8-byte pairs filling 32 KiB where the device has

@@ -103,11 +103,21 @@ struct GeometryStageViewBuffers {
     BufferRange lod_buckets, lod_histogram, lod_visibility, lod_group_counts, lod_list, lod_walk;
 };
 
+/// How a geometry stage is built; the defaults are what renderers use.
+struct GeometryStageOptions {
+    /// The sorts' algorithm (RadixSort::Algorithm::kDefault: the device's); the chained emit
+    /// runs where it is the one sweep (UsesChainedEmit).
+    RadixSort::Algorithm sort = RadixSort::Algorithm::kDefault;
+    /// Tests: the chained emit's odd blocks publish only their own totals, so look-backs
+    /// walk across blocks even where workgroups run one after another (lavapipe).
+    bool chained_odd_blocks_aggregate_only = false;
+};
+
 class GaussianGeometryStage {
 public:
     /// Creates the pipelines that do not depend on the scene (the projection pipelines,
     /// specialised on SH degree / antialias / precision, are made on first use).
-    explicit GaussianGeometryStage(const VulkanContext& context);
+    explicit GaussianGeometryStage(const VulkanContext& context, GeometryStageOptions options = {});
 
     /// Sizes for up to `num_splats` splats and `entry_capacity` tile entries. Throws
     /// core::Open3DError when a count exceeds what the sorts support.

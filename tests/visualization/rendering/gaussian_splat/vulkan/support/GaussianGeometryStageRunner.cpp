@@ -69,8 +69,9 @@ RenderStats GeometryStageReadback::ToStats() const {
 
 GaussianGeometryStageRunner::GaussianGeometryStageRunner(const VulkanContext& context,
                                                          const PackedGaussianSplats& packed,
-                                                         uint32_t entry_capacity)
-    : context_(context), pool_(context), geometry_stage_(context) {
+                                                         uint32_t entry_capacity,
+                                                         GeometryStageOptions options)
+    : context_(context), pool_(context), geometry_stage_(context, options) {
     resources_.UploadScene(context, pool_, packed);
     resources_.AllocateView(context, entry_capacity);
 }

@@ -48,7 +48,7 @@ public:
     /// Uploads `packed` and allocates per-view buffers for up to `entry_capacity` tile
     /// entries. A degree-0 scene gets a 16-byte placeholder for the SH binding.
     GaussianGeometryStageRunner(const VulkanContext& context, const PackedGaussianSplats& packed,
-                                uint32_t entry_capacity);
+                                uint32_t entry_capacity, GeometryStageOptions options = {});
 
     /// Replaces the visibility mask ([ceil(N / 32)] words, as in PackedGaussianSplats).
     void SetVisibility(const std::vector<uint32_t>& mask);
