@@ -54,7 +54,11 @@ OPEN3D_SHADER_CONST uint kRadixSortValuesOutBinding = 5u;  // uint[max_count]
 OPEN3D_SHADER_CONST uint kRadixSortHistogramBinding = 6u;  // uint[bins + bins * max_blocks]
 // RadixSweepState of a one-sweep sort (the multi-pass sort binds a placeholder there).
 OPEN3D_SHADER_CONST uint kRadixSortSweepStateBinding = 7u;
-OPEN3D_SHADER_CONST uint kRadixSortNumBindings = 8u;
+// uint[]: where the one-sweep sort's last pass leaves each key's run of the sorted output
+// (RadixSort::RunBounds; a placeholder otherwise): words run_offset + 2 key (begin, lowered
+// with atomicMin) and + 1 (end, raised with atomicMax).
+OPEN3D_SHADER_CONST uint kRadixSortRunBoundsBinding = 8u;
+OPEN3D_SHADER_CONST uint kRadixSortNumBindings = 9u;
 // Most passes one sort records: 32-bit keys.
 OPEN3D_SHADER_CONST uint kRadixSortMaxPasses = 4u;
 
@@ -108,6 +112,9 @@ OPEN3D_SHADER_CONST uint kRadixSweepHistogramGroups = 1024u;
 // and never its inclusive prefix, so look-backs walk across several blocks even where
 // workgroups run one after another (lavapipe with one thread).
 OPEN3D_SHADER_CONST uint kSpecRadixSweepOddBlocksAggregateOnly = 2u;
+// The one-sweep scatter's shared keys for the run bounds where it does not reorder blocks in
+// shared memory (kRadixSortBlockSize in the pipeline that writes run bounds, else 1).
+OPEN3D_SHADER_CONST uint kSpecRadixSortRunCapacity = 3u;
 
 // Zeroed before every one-sweep sort (vkCmdFillBuffer; RadixSort::RecordClearSweepState).
 struct RadixSweepState {
@@ -139,6 +146,10 @@ struct RadixSortPushConstants {
     uint num_bits;  // the sort's key bits (the one-sweep histogram counts every pass)
     // 1: a one-sweep sort (the copy then counts the kept pairs from the sweep state)
     uint sweep;
+    // RadixSort::RunBounds: keys below run_keys get their run written by the last pass
+    // (0: none), at word run_offset + 2 key of the run-bounds binding.
+    uint run_keys;
+    uint run_offset;
 };
 
 // ---- Radix sort parameters for an element count ----
@@ -216,7 +227,7 @@ static_assert(offsetof(RadixSortParams, pass_blocks) == 48);
 static_assert(offsetof(RadixSortParams, pass_rows) == 112);
 static_assert(offsetof(RadixSortParams, copy_blocks) == 176);
 
-static_assert(sizeof(RadixSortPushConstants) == 48);
+static_assert(sizeof(RadixSortPushConstants) == 56);
 static_assert(offsetof(RadixSortPushConstants, target_blocks) == 16);
 static_assert(offsetof(RadixSortPushConstants, shift) == 0);
 static_assert(offsetof(RadixSortPushConstants, digit_bits) == 4);
@@ -229,6 +240,8 @@ static_assert(offsetof(RadixSortPushConstants, values_only) == 32);
 static_assert(offsetof(RadixSortPushConstants, max_groups_x) == 36);
 static_assert(offsetof(RadixSortPushConstants, num_bits) == 40);
 static_assert(offsetof(RadixSortPushConstants, sweep) == 44);
+static_assert(offsetof(RadixSortPushConstants, run_keys) == 48);
+static_assert(offsetof(RadixSortPushConstants, run_offset) == 52);
 static_assert(offsetof(RadixSortParams, reserved0) == 44);
 
 }  // namespace shader

@@ -196,7 +196,9 @@ const uint kUnroll = 16u;
 
 // The entry range of a tile; past the last tile (a claim that found none left) empty.
 uvec2 TileRange(uint tile, uint num_tiles) {
-    return tile < num_tiles ? tile_ranges[tile] : uvec2(0u);
+    // A tile the geometry stage's run bounds never reached holds (0xFFFFFFFF, 0): empty.
+    uvec2 range = tile < num_tiles ? tile_ranges[tile] : uvec2(0u);
+    return uvec2(min(range.x, range.y), range.y);
 }
 
 // The splat index of this invocation's entry in the first batch of `range`; 0 past its end.

@@ -65,6 +65,11 @@ layout(std430, set = 0, binding = kGeometryStageTileSortStateBinding) buffer Til
 layout(std430, set = 0, binding = kGeometryStageSortStatusBinding) writeonly buffer SortStatusBlock {
     uint sort_status[];
 };
+// The composite's state: each tile's [begin, end) from word kBinRangesWordOffset, set here to
+// the empty (0xFFFFFFFF, 0) that the tile sort's last pass lowers and raises (its run bounds).
+layout(std430, set = 0, binding = kGeometryStageTileRangesBinding) writeonly buffer TileRangesBlock {
+    uint tile_ranges[];
+};
 
 // The tile sort's digit counts of this workgroup's entries, pass-major.
 shared uint s_digit_counts[kRadixSortMaxPasses * kRadixSortBins];
@@ -202,11 +207,17 @@ void main() {
         EmitEntries(ListValueSplat(splat_indices[k], view.num_splats), begin, end, false);
     }
     // The tile sort's first pass reads status table 0, rows [0, its blocks): zero every row
-    // it can have, spread over the workgroups (the depth sort used the same words).
+    // it can have, spread over the workgroups (the depth sort used the same words). And every
+    // tile's range starts empty.
     uint status_words = TileSortMaxBlocks(capacity) * kRadixSortBins;
-    for (uint i = block * kEmitWorkgroupSize + local; i < status_words;
-         i += num_blocks * kEmitWorkgroupSize) {
+    uint stride = num_blocks * kEmitWorkgroupSize;
+    for (uint i = block * kEmitWorkgroupSize + local; i < status_words; i += stride) {
         sort_status[i] = 0u;
+    }
+    uint num_tiles = view.tiles_x * view.tiles_y;
+    for (uint t = block * kEmitWorkgroupSize + local; t < num_tiles; t += stride) {
+        tile_ranges[kBinRangesWordOffset + 2u * t] = 0xFFFFFFFFu;
+        tile_ranges[kBinRangesWordOffset + 2u * t + 1u] = 0u;
     }
     barrier();
     uint passes = TileSortPasses();

@@ -15,6 +15,11 @@
 // other table for the next pass (whose blocks are at most this pass's).
 // The first pass reads params.count pairs (dropping kRadixSortDroppedKey keys with
 // drop_max_keys); the later passes the kept ones, the histogram's total.
+// With run bounds (pc.run_keys != 0, RadixSort::RunBounds) the last pass also leaves, for
+// every key below run_keys, the [begin, end) of its run in the sorted output: a block's pairs
+// of one key are contiguous in its sorted order (the lower digits are sorted already, and
+// the pass is stable), so each run inside a block lowers the key's begin and raises its end
+// with one atomic each; runs that span blocks meet in the atomics.
 #extension GL_GOOGLE_include_directive : require
 #include "radix_sort_common.glsl"
 
@@ -42,10 +47,15 @@ layout(std430, set = 0, binding = kRadixSortHistogramBinding) coherent buffer St
 layout(std430, set = 0, binding = kRadixSortSweepStateBinding) coherent buffer SweepStateBlock {
     RadixSweepState state;
 };
+layout(std430, set = 0, binding = kRadixSortRunBoundsBinding) buffer RunBoundsBlock {
+    uint run_bounds[];
+};
 
 // kRadixSortBlockSize when the block is reordered in shared memory, else 1 (RadixSort.cpp).
 layout(constant_id = kSpecRadixSortLocalCapacity) const uint kLocalCapacity = 1u;
 layout(constant_id = kSpecRadixSweepOddBlocksAggregateOnly) const uint kOddBlocksAggregateOnly = 0u;
+// kRadixSortBlockSize in the pipeline that writes run bounds without the local reorder.
+layout(constant_id = kSpecRadixSortRunCapacity) const uint kRunCapacity = 1u;
 
 shared uint s_block;
 shared uint s_identity;                   // 1: every pair of the pass has the same digit
@@ -53,6 +63,15 @@ shared uint s_first[kRadixSortBins];      // block-local position of each digit'
 shared uint s_out_shift[kRadixSortBins];  // output index - block-local position, per digit
 shared uint s_keys[kLocalCapacity];       // the block in sorted order
 shared uint s_values[kLocalCapacity];
+shared uint s_run_keys[kRunCapacity];  // the block's keys in sorted order, for the run bounds
+
+// Key `key` at sorted output index `out_index` starts and/or ends a run there.
+void NoteRun(uint key, uint out_index, bool starts, bool ends) {
+    if (key >= pc.run_keys) return;  // e.g. the geometry stage's filler keys
+    uint word = pc.run_offset + 2u * key;
+    if (starts) atomicMin(run_bounds[word], out_index);
+    if (ends) atomicMax(run_bounds[word + 1u], out_index + 1u);
+}
 
 #include "radix_sort_rank.glsl"
 
@@ -81,10 +100,16 @@ void main() {
         status[(params.num_blocks * kRadixSortBins - table) + block * kRadixSortBins + local] = 0u;
     }
     barrier();
+    bool runs = pc.run_keys != 0u && pass + 1u == pc.num_passes;
     if (s_identity != 0u) {
         for (uint i = block_begin + local; i < block_end; i += kRadixSortWorkgroupSize) {
-            if (write_keys) keys_out[i] = keys_in[i];
+            uint key = keys_in[i];
+            if (write_keys) keys_out[i] = key;
             values_out[i] = values_in[i];
+            if (runs) {  // the pairs keep their places: neighbours are the input's
+                NoteRun(key, i, i == 0u || keys_in[i - 1u] != key,
+                        i + 1u == count || keys_in[i + 1u] != key);
+            }
         }
         return;
     }
@@ -135,14 +160,28 @@ void main() {
         } else {
             if (write_keys) keys_out[s_out_shift[digit] + position] = g_keys[k];
             values_out[s_out_shift[digit] + position] = g_values[k];
+            if (kRunCapacity > 1u && runs) s_run_keys[position] = g_keys[k];
         }
     }
-    if (kLocalCapacity == 1u) return;
+    if (kLocalCapacity == 1u) {
+        if (kRunCapacity == 1u || !runs) return;
+        barrier();
+        for (uint i = local; i < block_kept; i += kRadixSortWorkgroupSize) {
+            uint key = s_run_keys[i];
+            NoteRun(key, s_out_shift[DigitOf(key)] + i, i == 0u || s_run_keys[i - 1u] != key,
+                    i + 1u == block_kept || s_run_keys[i + 1u] != key);
+        }
+        return;
+    }
     barrier();
     for (uint i = local; i < block_kept; i += kRadixSortWorkgroupSize) {
         uint key = s_keys[i];
         uint out_index = s_out_shift[DigitOf(key)] + i;
         if (write_keys) keys_out[out_index] = key;
         values_out[out_index] = s_values[i];
+        if (runs) {
+            NoteRun(key, out_index, i == 0u || s_keys[i - 1u] != key,
+                    i + 1u == block_kept || s_keys[i + 1u] != key);
+        }
     }
 }

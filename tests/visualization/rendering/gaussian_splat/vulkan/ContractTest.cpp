@@ -25,7 +25,7 @@ TEST(GaussianSplatContract, CompilesAsCpp) {
               shader::kRadixSortWorkgroupSize * shader::kRadixSortItemsPerInvocation);
     EXPECT_EQ(sizeof(shader::RadixSortParams), 208u);
     EXPECT_EQ(sizeof(shader::RadixSweepState), 4128u);
-    EXPECT_EQ(sizeof(shader::RadixSortPushConstants), 48u);
+    EXPECT_EQ(sizeof(shader::RadixSortPushConstants), 56u);
 }
 
 TEST(GaussianSplatContract, ListValuesCarryTheSplatAndItsEntryCount) {
@@ -97,6 +97,8 @@ TEST_F(GaussianSplatContractGpu, ShaderLayoutMatchesCpp) {
     push.max_groups_x = 210;
     push.num_bits = 211;
     push.sweep = 212;
+    push.run_keys = 213;
+    push.run_offset = 214;
     SubmitAndWait(Context(), Pool(), [&](VkCommandBuffer cmd) {
         VkDescriptorBufferInfo infos[kBindings] = {
             {params.Get(), 0, VK_WHOLE_SIZE},        {push_out.Get(), 0, VK_WHOLE_SIZE},
@@ -158,6 +160,8 @@ TEST_F(GaussianSplatContractGpu, ShaderLayoutMatchesCpp) {
     EXPECT_EQ(q.max_groups_x, 210u);
     EXPECT_EQ(q.num_bits, 211u);
     EXPECT_EQ(q.sweep, 212u);
+    EXPECT_EQ(q.run_keys, 213u);
+    EXPECT_EQ(q.run_offset, 214u);
 
     // The stage structs: every named member at its C++ offset (numbered as the probe writes).
     shader::GaussianViewParams v;

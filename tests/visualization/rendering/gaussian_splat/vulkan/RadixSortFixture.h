@@ -97,6 +97,8 @@ struct GpuSortResult {
     std::vector<uint32_t> values;  // [capacity]
     shader::RadixSortParams params{};
     double gpu_ms = 0.0;  // submit to fence, lavapipe wall time
+    /// With run_keys: (begin, end) of each key below run_keys (RadixSort::RunBounds).
+    std::vector<uint32_t> run_bounds;
 };
 
 /// A suite of one algorithm's sorter (kAlgorithm), made once per suite.
@@ -129,8 +131,15 @@ protected:
                        RadixSort::Params source = RadixSort::Params::kSetupPass,
                        const uint32_t* kept_count = nullptr,
                        RadixSort::PassCount pass_count = RadixSort::PassCount::kAll,
-                       RadixSort::Output output = RadixSort::Output::kKeysAndValues) {
+                       RadixSort::Output output = RadixSort::Output::kKeysAndValues,
+                       uint32_t run_keys = 0) {
         const auto capacity = static_cast<uint32_t>(keys.size());
+        // Run bounds start as (0xFFFFFFFF, 0) pairs after kRunOffset words of something else
+        // (written with vkCmdUpdateBuffer: at most 64 KiB, about 8,000 keys).
+        constexpr uint32_t kRunOffset = 4;
+        const VkDeviceSize run_bytes = 4 * (kRunOffset + 2 * VkDeviceSize(run_keys));
+        std::vector<uint32_t> run_init(kRunOffset + 2 * size_t(run_keys), 0u);
+        for (uint32_t k = 0; k < run_keys; ++k) run_init[kRunOffset + 2 * k] = 0xFFFFFFFFu;
         const VkDeviceSize bytes = std::max<VkDeviceSize>(capacity, 1) * 4;
         const VkBufferUsageFlags usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT |
                                          VK_BUFFER_USAGE_TRANSFER_SRC_BIT |
@@ -153,8 +162,9 @@ protected:
             MemoryUsage::kDevice);
         Buffer upload(Context(), 2 * bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
                       MemoryUsage::kHostUpload);
-        Buffer readback(Context(), 2 * bytes + sizeof(shader::RadixSortParams),
+        Buffer readback(Context(), 2 * bytes + sizeof(shader::RadixSortParams) + run_bytes,
                         VK_BUFFER_USAGE_TRANSFER_DST_BIT, MemoryUsage::kHostReadback);
+        Buffer runs(Context(), std::max<VkDeviceSize>(run_bytes, 16), usage, MemoryUsage::kDevice);
         auto* up = static_cast<uint8_t*>(upload.GetMapped());
         if (capacity > 0) {
             std::memcpy(up, keys.data(), capacity * 4);
@@ -170,6 +180,7 @@ protected:
             region.srcOffset = bytes;
             vkCmdCopyBuffer(c, upload.Get(), value_buffer.Get(), 1, &region);
         }
+        if (run_keys > 0) vkCmdUpdateBuffer(c, runs.Get(), 0, run_bytes, run_init.data());
         const bool producer = source == RadixSort::Params::kWrittenByProducer;
         // A producer writes the parameters itself (as a shader would); the sort must not
         // read the count then, so the count binding holds garbage.
@@ -190,9 +201,14 @@ protected:
         RadixSortScratch scratch{keys_alt.Range(), values_alt.Range(), histogram.Range(),
                                  params.Range(), sweep_state.Range()};
         const RadixSort::DropMaxKeys drop{count_buffer.Range(44, 4)};
+        RadixSort::RunBounds run_bounds;
+        run_bounds.ranges = runs.Range();
+        run_bounds.word_offset = kRunOffset;
+        run_bounds.num_keys = run_keys;
         sort_->Record(c, key_buffer.Range(), value_buffer.Range(), scratch,
                       count_buffer.Range(20, 4), capacity, num_bits, source,
-                      kept_count ? &drop : nullptr, pass_count, output);
+                      kept_count ? &drop : nullptr, pass_count, output,
+                      run_keys > 0 ? &run_bounds : nullptr);
         RecordMemoryBarrier(c, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
                             VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, VK_PIPELINE_STAGE_2_TRANSFER_BIT,
                             VK_ACCESS_2_TRANSFER_READ_BIT);
@@ -204,6 +220,11 @@ protected:
         }
         VkBufferCopy params_region{0, 2 * bytes, sizeof(shader::RadixSortParams)};
         vkCmdCopyBuffer(c, params.Get(), readback.Get(), 1, &params_region);
+        if (run_keys > 0) {
+            const VkBufferCopy runs_region{0, 2 * bytes + sizeof(shader::RadixSortParams),
+                                           run_bytes};
+            vkCmdCopyBuffer(c, runs.Get(), readback.Get(), 1, &runs_region);
+        }
         RecordMemoryBarrier(c, VK_PIPELINE_STAGE_2_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
                             VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT);
         cmd.End();
@@ -224,6 +245,12 @@ protected:
             std::memcpy(result.values.data(), down + bytes, capacity * 4);
         }
         std::memcpy(&result.params, down + 2 * bytes, sizeof(result.params));
+        if (run_keys > 0) {
+            const auto* runs_down = reinterpret_cast<const uint32_t*>(
+                down + 2 * bytes + sizeof(shader::RadixSortParams));
+            EXPECT_EQ(runs_down[0], 0u) << "the words before the run bounds were written";
+            result.run_bounds.assign(runs_down + kRunOffset, runs_down + kRunOffset + 2 * run_keys);
+        }
         return result;
     }
 

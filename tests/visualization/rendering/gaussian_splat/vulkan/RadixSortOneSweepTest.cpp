@@ -44,6 +44,50 @@ TEST_F(RadixSortOneSweepTest, ReusesScratchAndStateAcrossSorts) {
     }
 }
 
+TEST_F(RadixSortOneSweepTest, LastPassLeavesEachKeysRun) {
+    // RadixSort::RunBounds: each key below run_keys gets [begin, end) of its run in the sorted
+    // keys, (0xFFFFFFFF, 0) when it has none; keys at and above run_keys (filler) are skipped.
+    // Cases: two passes over many blocks, one pass (then the copy back), a last pass whose
+    // keys share their digit (it copies), runs across block borders, and the values-only
+    // output, whose last pass writes no keys.
+    struct RunCase {
+        const char* name;
+        uint32_t count, num_bits, key_mask, run_keys;
+        RadixSort::Output output;
+    };
+    const RunCase cases[] = {
+        {"13 bits, 2 passes", 100000u, 13u, 0x1FFFu, 8000u, RadixSort::Output::kKeysAndValues},
+        {"7 bits, 1 pass", 30000u, 7u, 0x7Fu, 100u, RadixSort::Output::kKeysAndValues},
+        {"last digit shared", 50000u, 16u, 0x00FFu, 300u, RadixSort::Output::kKeysAndValues},
+        {"few long runs", 70000u, 12u, 0x0007u, 8u, RadixSort::Output::kKeysAndValues},
+        {"values only", 60000u, 13u, 0x1FFFu, 7000u, RadixSort::Output::kValuesOnly},
+    };
+    for (const RunCase& c : cases) {
+        SCOPED_TRACE(c.name);
+        std::vector<uint32_t> keys(c.count), values(c.count);
+        uint32_t state = 7;
+        for (uint32_t i = 0; i < c.count; ++i) {
+            state = state * 1664525u + 1013904223u;
+            keys[i] = (state >> 7) & c.key_mask;
+            values[i] = i;
+        }
+        const GpuSortResult gpu =
+            Sort(keys, values, c.count, c.num_bits, RadixSort::Params::kSetupPass, nullptr,
+                 RadixSort::PassCount::kAll, c.output, c.run_keys);
+        std::vector<uint32_t> sorted = keys;
+        std::stable_sort(sorted.begin(), sorted.end());
+        std::vector<uint32_t> want(2 * size_t(c.run_keys), 0u);
+        for (uint32_t k = 0; k < c.run_keys; ++k) want[2 * k] = 0xFFFFFFFFu;
+        for (uint32_t i = 0; i < c.count; ++i) {
+            const uint32_t k = sorted[i];
+            if (k >= c.run_keys) continue;
+            want[2 * k] = std::min(want[2 * k], i);
+            want[2 * k + 1] = std::max(want[2 * k + 1], i + 1);
+        }
+        EXPECT_EQ(gpu.run_bounds, want);
+    }
+}
+
 TEST_F(RadixSortOneSweepTest, PassesWhoseKeysShareTheirDigitCopy) {
     // Keys that differ only in some digits: the passes of the other digits find one non-zero
     // bin in the histogram and copy their blocks. Covers a copy as the first pass (no drop),

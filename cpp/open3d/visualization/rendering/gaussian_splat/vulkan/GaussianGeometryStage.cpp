@@ -142,6 +142,10 @@ GeometryStageStorageRequirements GaussianGeometryStage::GetStorageRequirements(
     return r;
 }
 
+bool GaussianGeometryStage::WritesTileRanges(const GeometryStageChoices& choices) const {
+    return choices.binned || UsesChainedEmit(choices);
+}
+
 bool GaussianGeometryStage::UsesChainedEmit(const GeometryStageChoices& choices) const {
     return chained_emit_allowed_ && !choices.packed_key && !choices.binned &&
            sort_.GetAlgorithm() == RadixSort::Algorithm::kOneSweep &&
@@ -320,20 +324,21 @@ void GaussianGeometryStage::Record(VkCommandBuffer cmd, const GeometryStageScene
         depth_sort_scratch.sweep_histogram_written = chained;
         tile_sort_scratch.sweep_state_cleared = true;
     }
+    const VkDeviceSize ranges_bytes =
+        4 * (kBinRangesWordOffset + 2 * VkDeviceSize(choices.num_tiles));
+    if (WritesTileRanges(choices) &&
+        (buffers.tile_ranges.buffer == VK_NULL_HANDLE ||
+         (buffers.tile_ranges.size != VK_WHOLE_SIZE && buffers.tile_ranges.size < ranges_bytes))) {
+        core::ThrowError(
+            "GaussianGeometryStage: the ranges of {} tiles need {} bytes of tile ranges (the "
+            "composite's state), {} given",
+            choices.num_tiles, ranges_bytes,
+            buffers.tile_ranges.buffer == VK_NULL_HANDLE ? 0 : buffers.tile_ranges.size);
+    }
     if (choices.binned) {
         // Every tile's count starts at 0 (and the composite's tile counter, which it zeroes
-        // again itself).
-        const VkDeviceSize bins_bytes =
-            4 * (kBinRangesWordOffset + 2 * VkDeviceSize(choices.num_tiles));
-        if (buffers.tile_ranges.buffer == VK_NULL_HANDLE ||
-            (buffers.tile_ranges.size != VK_WHOLE_SIZE && buffers.tile_ranges.size < bins_bytes)) {
-            core::ThrowError(
-                "GaussianGeometryStage: per-tile bins of {} tiles need {} bytes of tile "
-                "ranges (the composite's state), {} given",
-                choices.num_tiles, bins_bytes,
-                buffers.tile_ranges.buffer == VK_NULL_HANDLE ? 0 : buffers.tile_ranges.size);
-        }
-        vkCmdFillBuffer(cmd, buffers.tile_ranges.buffer, buffers.tile_ranges.offset, bins_bytes,
+        // again itself). The chained emit sets the ranges up itself.
+        vkCmdFillBuffer(cmd, buffers.tile_ranges.buffer, buffers.tile_ranges.offset, ranges_bytes,
                         0u);
     }
     RecordMemoryBarrier(
@@ -489,10 +494,17 @@ void GaussianGeometryStage::Record(VkCommandBuffer cmd, const GeometryStageScene
     // packed key sorts all 32 bits (4 passes, as the seed), then shifts back to tiles.
     begin(TimedPass::kTileSort);
     tile_sort_scratch.sweep_histogram_written = chained;  // the chained emit counted the digits
+    // In the chained frame the sort's last pass leaves each tile's range in the composite's
+    // state (the chained emit set them to empty), in place of the composite's ranges pass.
+    RadixSort::RunBounds tile_runs;
+    tile_runs.ranges = buffers.tile_ranges;
+    tile_runs.word_offset = kBinRangesWordOffset;
+    tile_runs.num_keys = choices.num_tiles;
     sort_.Record(cmd, buffers.entry_keys, buffers.entry_values, tile_sort_scratch,
                  counter_range(kCounterEntriesIndex), std::max(capacity, 1u),
                  packed_key ? kSortKeyBits : choices.tile_bits,
-                 RadixSort::Params::kWrittenByProducer);
+                 RadixSort::Params::kWrittenByProducer, nullptr, RadixSort::PassCount::kAll,
+                 RadixSort::Output::kKeysAndValues, chained ? &tile_runs : nullptr);
     if (packed_key) {
         ComputeBarrier(cmd);
         PushBindings(cmd, scene, buffers);  // the sort bound its own layout

@@ -161,6 +161,18 @@ public:
                 const GpuTimestamps* timestamps = nullptr,
                 const BufferRange* params_source = nullptr);
 
+    /// Whether Record leaves each tile's [begin, end) in buffers.tile_ranges (the composite's
+    /// state, which must then be the view's size: CompositeStageInputs::ranges_written): the
+    /// per-tile bins and the chained frame (the tile sort's run bounds) do. A range whose
+    /// begin exceeds its end is empty.
+    bool WritesTileRanges(const GeometryStageChoices& choices) const;
+    /// Whether the scan, the capacity cut and the emit run as one chained dispatch
+    /// (gaussian_emit_chained.comp): in the exact order (neither the packed key nor the
+    /// bins), where the sorts run the one sweep (the look-back needs the device's forward
+    /// progress), for a capacity below the look-back words' value range, unless
+    /// OPEN3D_CHAINED_EMIT=0 asks for the separate passes (to measure them).
+    bool UsesChainedEmit(const GeometryStageChoices& choices) const;
+
 private:
     /// `cut_list`: slot i projects the node the cut's list holds (shader::kSpecCutList).
     VkPipeline GetProjectPipeline(uint32_t sh_degree, bool antialias, SplatPrecision precision,
@@ -171,12 +183,6 @@ private:
     void RecordBins(VkCommandBuffer cmd, const PackedView& view, const GpuTimestamps* timestamps);
     void PushBindings(VkCommandBuffer cmd, const GeometryStageSceneBuffers& scene,
                       const GeometryStageViewBuffers& buffers) const;
-    /// Whether the scan, the capacity cut and the emit run as one chained dispatch
-    /// (gaussian_emit_chained.comp): in the exact order (neither the packed key nor the
-    /// bins), where the sorts run the one sweep (the look-back needs the device's forward
-    /// progress), for a capacity below the look-back words' value range, unless
-    /// OPEN3D_CHAINED_EMIT=0 asks for the separate passes (to measure them).
-    bool UsesChainedEmit(const GeometryStageChoices& choices) const;
 
     const VulkanContext& context_;
     RadixSort sort_;

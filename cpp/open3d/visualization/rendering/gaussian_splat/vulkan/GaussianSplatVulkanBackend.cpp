@@ -264,6 +264,7 @@ void GaussianSplatVulkanBackend::RenderGeometryStage(const camera::PinholeCamera
     ++counters_.geometry_runs;
     geometry_.camera = camera;
     geometry_.config = config;
+    geometry_.tile_ranges_written = geometry_stage_.WritesTileRanges(view.choices);
     geometry_.valid = true;
     geometry_.in_flight = true;
     geometry_.reused = false;

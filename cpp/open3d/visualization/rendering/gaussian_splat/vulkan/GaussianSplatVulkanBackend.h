@@ -364,6 +364,9 @@ private:
         bool valid = false;
         bool in_flight = false;
         bool reused = false;
+        /// The geometry stage left each tile's range in composite_state_
+        /// (GaussianGeometryStage::WritesTileRanges): the composite reads them as they are.
+        bool tile_ranges_written = false;
         /// Geometry stage's times as a frame reports them: geometry_ms, gpu_project_ms,
         /// gpu_sort_ms and its parts (the rest stays 0).
         RenderStats times;

@@ -178,7 +178,7 @@ void GaussianSplatVulkanBackend::RecordCompositeFrame(CompositeSink& sink, VkCom
         inputs.entry_count = geometry_stage_resources_.ViewResources().counters.Range(
             offsetof(shader::GaussianGeometryStageCounters, entry_count), sizeof(uint32_t));
         inputs.entry_capacity = geometry_stage_resources_.EntryCapacity();
-        inputs.ranges_written = geometry_.config.sort_mode == SortMode::kExactTileBins;
+        inputs.ranges_written = geometry_.tile_ranges_written;
         CompositeStageTargets targets;
         targets.width = w;
         targets.height = h;

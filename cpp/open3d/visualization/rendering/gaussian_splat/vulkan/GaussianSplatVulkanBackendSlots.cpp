@@ -369,7 +369,7 @@ void GaussianSplatVulkanBackend::RecordSlot(FrameSlot& slot, const FrameRecordin
     inputs.entry_count = slot.view.counters.Range(
         offsetof(GaussianGeometryStageCounters, entry_count), sizeof(uint32_t));
     inputs.entry_capacity = slot.view.EntryCapacity();
-    inputs.ranges_written = key.choices.binned;
+    inputs.ranges_written = geometry_stage_.WritesTileRanges(key.choices);
     CompositeStageTargets targets;
     targets.width = key.width;
     targets.height = key.height;

@@ -96,17 +96,19 @@ RadixSort::RadixSort(const VulkanContext& context, Algorithm algorithm, RadixSor
         uint32_t max_subgroups;
         uint32_t local_capacity;
         uint32_t odd_blocks_aggregate_only;
+        uint32_t run_capacity;
     } constants{kRadixSortWorkgroupSize / info.min_subgroup_size, 1u,
-                options.odd_blocks_aggregate_only ? 1u : 0u};
+                options.odd_blocks_aggregate_only ? 1u : 0u, 1u};
     constants.local_capacity = ScatterSharedBytes(constants.max_subgroups, kRadixSortBlockSize) <=
                                        info.max_compute_shared_memory
                                    ? kRadixSortBlockSize
                                    : 1u;
     local_reorder_ = constants.local_capacity > 1u;
-    const std::array<VkSpecializationMapEntry, 3> entries{
+    const std::array<VkSpecializationMapEntry, 4> entries{
         {{kSpecRadixSortSubgroups, 0, sizeof(uint32_t)},
          {kSpecRadixSortLocalCapacity, sizeof(uint32_t), sizeof(uint32_t)},
-         {kSpecRadixSweepOddBlocksAggregateOnly, 2 * sizeof(uint32_t), sizeof(uint32_t)}}};
+         {kSpecRadixSweepOddBlocksAggregateOnly, 2 * sizeof(uint32_t), sizeof(uint32_t)},
+         {kSpecRadixSortRunCapacity, 3 * sizeof(uint32_t), sizeof(uint32_t)}}};
     const VkSpecializationInfo specialization{static_cast<uint32_t>(entries.size()), entries.data(),
                                               sizeof(constants), &constants};
     const auto create = [&](std::span<const uint32_t> spirv, const char* name) {
@@ -120,6 +122,11 @@ RadixSort::RadixSort(const VulkanContext& context, Algorithm algorithm, RadixSor
     if (algorithm_ == Algorithm::kOneSweep) {
         sweep_histogram_ = create(spirv::kRadixSortSweepHistogram, "radix_sort_sweep_histogram");
         sweep_scatter_ = create(spirv::kRadixSortSweepScatter, "radix_sort_sweep_scatter");
+        // Run bounds need the block's keys in sorted order: the local reorder's, or an array of
+        // their own where the device has no room for that (lavapipe: 8 KiB more).
+        constants.run_capacity = local_reorder_ ? 1u : kRadixSortBlockSize;
+        sweep_scatter_runs_ =
+            create(spirv::kRadixSortSweepScatter, "radix_sort_sweep_scatter (run bounds)");
     }
 }
 
@@ -226,7 +233,8 @@ uint32_t RadixSort::GetTargetBlocks() const {
 void RadixSort::BindBuffers(VkCommandBuffer cmd, const RadixSortScratch& scratch,
                             const BufferRange& count_in, uint32_t max_count,
                             const BufferRange& keys_in, const BufferRange& values_in,
-                            const BufferRange& keys_out, const BufferRange& values_out) const {
+                            const BufferRange& keys_out, const BufferRange& values_out,
+                            const RunBounds* runs) const {
     // The count may sit at any 4-byte offset: bound from the aligned offset below it, the
     // uint indexed with a push constant (count_index).
     const VkDeviceSize alignment = context_->GetDeviceInfo().min_storage_buffer_offset_alignment;
@@ -243,6 +251,10 @@ void RadixSort::BindBuffers(VkCommandBuffer cmd, const RadixSortScratch& scratch
                                            GetStorageRequirements(max_count).histogram_bytes};
     buffers[kRadixSortSweepStateBinding] = {scratch.sweep_state.buffer, scratch.sweep_state.offset,
                                             sizeof(RadixSweepState)};
+    // Without run bounds the binding is never written but must name a buffer: the params.
+    buffers[kRadixSortRunBoundsBinding] =
+        runs ? VkDescriptorBufferInfo{runs->ranges.buffer, runs->ranges.offset, runs->ranges.size}
+             : buffers[kRadixSortParamsBinding];
     std::array<VkWriteDescriptorSet, kRadixSortNumBindings> writes{};
     for (uint32_t i = 0; i < kRadixSortNumBindings; ++i) {
         writes[i].sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET;
@@ -258,17 +270,22 @@ void RadixSort::BindBuffers(VkCommandBuffer cmd, const RadixSortScratch& scratch
 void RadixSort::Record(VkCommandBuffer cmd, const BufferRange& keys, const BufferRange& values,
                        const RadixSortScratch& scratch, const BufferRange& count,
                        uint32_t max_count, uint32_t num_bits, Params params,
-                       const DropMaxKeys* drop, PassCount pass_count, Output output) const {
+                       const DropMaxKeys* drop, PassCount pass_count, Output output,
+                       const RunBounds* runs) const {
     CheckArguments(keys, values, scratch, count, max_count, num_bits);
     if (drop) RequireCountRange(drop->kept_count, "kept_count");
+    if (runs && (runs->ranges.buffer == VK_NULL_HANDLE || runs->num_keys == 0 || num_bits == 0)) {
+        core::ThrowError("RadixSort: run bounds need a buffer, at least one key and key bits");
+    }
     if (GetNumPasses(num_bits) == 0) return;  // no key bits: every order is sorted
     // Status words hold counts below 2^30 (kRadixSweepValueMask).
     if (algorithm_ == Algorithm::kOneSweep && max_count <= kRadixSweepValueMask) {
-        RecordOneSweep(cmd, keys, values, scratch, count, max_count, num_bits, params, drop,
-                       output);
+        RecordOneSweep(cmd, keys, values, scratch, count, max_count, num_bits, params, drop, output,
+                       runs);
     } else {
-        if (scratch.sweep_histogram_written) {
-            core::ThrowError("RadixSort: a producer-written histogram needs the one-sweep sort");
+        if (scratch.sweep_histogram_written || runs) {
+            core::ThrowError(
+                "RadixSort: a producer-written histogram and run bounds need the one-sweep sort");
         }
         RecordMultiPass(cmd, keys, values, scratch, count, max_count, num_bits, params, drop,
                         pass_count, output);

@@ -176,6 +176,17 @@ public:
         kValuesOnly,
     };
 
+    /// Optional for Record (one sweep only): the last pass also leaves each key's run of the
+    /// sorted output in `ranges`, as two uints per key from uint `word_offset` on: begin,
+    /// lowered with atomicMin, and end, raised with atomicMax, for every key below `num_keys`
+    /// (others, e.g. filler keys, are skipped). The caller sets every pair to (0xFFFFFFFF, 0)
+    /// beforehand, so a key without pairs keeps begin > end. Replaces a pass over the sorted
+    /// keys (the geometry stage's tile ranges).
+    struct RunBounds {
+        BufferRange ranges;
+        uint32_t word_offset = 0;
+        uint32_t num_keys = 0;
+    };
     /// Records a stable sort of the first `count` pairs of (keys, values) by the low
     /// `num_bits` (0..32) bits of the keys, count = min(the uint at `count`, max_count).
     /// The result is in `keys` and `values` (with `drop`: see DropMaxKeys).
@@ -193,7 +204,7 @@ public:
                 const BufferRange& count,  // uint32 written on the GPU by the producer
                 uint32_t max_count, uint32_t num_bits, Params params = Params::kSetupPass,
                 const DropMaxKeys* drop = nullptr, PassCount pass_count = PassCount::kAll,
-                Output output = Output::kKeysAndValues) const;
+                Output output = Output::kKeysAndValues, const RunBounds* runs = nullptr) const;
 
 private:
     // The index of a count's uint within its binding, which starts at the aligned offset below
@@ -208,7 +219,7 @@ private:
     void BindBuffers(VkCommandBuffer cmd, const RadixSortScratch& scratch,
                      const BufferRange& count_in, uint32_t max_count, const BufferRange& keys_in,
                      const BufferRange& values_in, const BufferRange& keys_out,
-                     const BufferRange& values_out) const;
+                     const BufferRange& values_out, const RunBounds* runs = nullptr) const;
     void RecordMultiPass(VkCommandBuffer cmd, const BufferRange& keys, const BufferRange& values,
                          const RadixSortScratch& scratch, const BufferRange& count,
                          uint32_t max_count, uint32_t num_bits, Params params,
@@ -216,7 +227,7 @@ private:
     void RecordOneSweep(VkCommandBuffer cmd, const BufferRange& keys, const BufferRange& values,
                         const RadixSortScratch& scratch, const BufferRange& count,
                         uint32_t max_count, uint32_t num_bits, Params params,
-                        const DropMaxKeys* drop, Output output) const;
+                        const DropMaxKeys* drop, Output output, const RunBounds* runs) const;
     void CheckArguments(const BufferRange& keys, const BufferRange& values,
                         const RadixSortScratch& scratch, const BufferRange& count,
                         uint32_t max_count, uint32_t num_bits) const;
@@ -231,6 +242,7 @@ private:
     UniquePipeline copy_;
     UniquePipeline sweep_histogram_;
     UniquePipeline sweep_scatter_;
+    UniquePipeline sweep_scatter_runs_;  // writes RunBounds in its last pass
     Algorithm algorithm_ = Algorithm::kMultiPass;
     bool local_reorder_ = false;
 };

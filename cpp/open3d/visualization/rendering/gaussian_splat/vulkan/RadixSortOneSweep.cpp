@@ -22,10 +22,15 @@ using namespace shader;  // the contract's constants and structs
 void RadixSort::RecordOneSweep(VkCommandBuffer cmd, const BufferRange& keys,
                                const BufferRange& values, const RadixSortScratch& scratch,
                                const BufferRange& count, uint32_t max_count, uint32_t num_bits,
-                               Params params, const DropMaxKeys* drop, Output output) const {
+                               Params params, const DropMaxKeys* drop, Output output,
+                               const RunBounds* runs) const {
     const uint32_t num_passes = GetNumPasses(num_bits);
     RadixSortPushConstants push = PushConstantsFor(count, max_count, num_bits, output);
     push.sweep = 1u;
+    if (runs) {
+        push.run_keys = runs->num_keys;
+        push.run_offset = runs->word_offset;
+    }
     const VkPipelineLayout layout = pipeline_layout_.Get();
     const auto dispatch = [&](VkPipeline pipeline, VkDeviceSize args_member) {
         vkCmdPushConstants(cmd, layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(push), &push);
@@ -42,7 +47,7 @@ void RadixSort::RecordOneSweep(VkCommandBuffer cmd, const BufferRange& keys,
     }
     if (params == Params::kSetupPass) {
         BindBuffers(cmd, scratch, count, max_count, keys, values, scratch.keys_alt,
-                    scratch.values_alt);
+                    scratch.values_alt, runs);
         vkCmdPushConstants(cmd, layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(push), &push);
         vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, setup_.Get());
         RecordDispatch(cmd, 1, 1, 1);
@@ -67,7 +72,7 @@ void RadixSort::RecordOneSweep(VkCommandBuffer cmd, const BufferRange& keys,
         }
     } else {
         BindBuffers(cmd, scratch, count, max_count, keys, values, scratch.keys_alt,
-                    scratch.values_alt);
+                    scratch.values_alt, runs);
         push.drop_max_keys = drop ? 1u : 0u;
         dispatch(sweep_histogram_.Get(), offsetof(RadixSortParams, sweep_histogram_grid));
         // From here every dispatch takes its size from the params made visible above (or by
@@ -79,16 +84,17 @@ void RadixSort::RecordOneSweep(VkCommandBuffer cmd, const BufferRange& keys,
         // Ping-pong: even passes read the caller's buffers, odd passes the scratch.
         if (pass % 2 == 0) {
             BindBuffers(cmd, scratch, count, max_count, keys, values, scratch.keys_alt,
-                        scratch.values_alt);
+                        scratch.values_alt, runs);
         } else {
             BindBuffers(cmd, scratch, count, max_count, scratch.keys_alt, scratch.values_alt, keys,
-                        values);
+                        values, runs);
         }
         push.shift = pass * kRadixSortDigitBits;
         push.digit_bits = std::min(kRadixSortDigitBits, num_bits - push.shift);
         push.drop_max_keys = pass == 0 && drop ? 1u : 0u;
         // Every pass takes the first pass's grid; blocks past the kept pairs end at once.
-        dispatch(sweep_scatter_.Get(), offsetof(RadixSortParams, dispatch_x));
+        dispatch(runs && pass + 1 == num_passes ? sweep_scatter_runs_.Get() : sweep_scatter_.Get(),
+                 offsetof(RadixSortParams, dispatch_x));
         if (pass + 1 < num_passes || num_passes % 2 == 1) RecordComputeToCompute(cmd);
     }
     if (num_passes % 2 == 1) {

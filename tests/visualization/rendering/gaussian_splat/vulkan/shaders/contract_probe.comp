@@ -141,5 +141,7 @@ void main() {
     push_out.max_groups_x = pc.max_groups_x;
     push_out.num_bits = pc.num_bits;
     push_out.sweep = pc.sweep;
+    push_out.run_keys = pc.run_keys;
+    push_out.run_offset = pc.run_offset;
     WriteStageStructs();
 }
