@@ -65,8 +65,9 @@ layout(std430, set = 0, binding = kGeometryStageTileSortStateBinding) buffer Til
 layout(std430, set = 0, binding = kGeometryStageSortStatusBinding) writeonly buffer SortStatusBlock {
     uint sort_status[];
 };
-// The composite's state: each tile's [begin, end) from word kBinRangesWordOffset, set here to
-// the empty (0xFFFFFFFF, 0) that the tile sort's last pass lowers and raises (its run bounds).
+// The composite's state: its header (zeroed here) and each tile's [begin, end) from word
+// kBinRangesWordOffset, set here to the empty (0xFFFFFFFF, 0) that the tile sort's last pass
+// lowers and raises (its run bounds).
 layout(std430, set = 0, binding = kGeometryStageTileRangesBinding) writeonly buffer TileRangesBlock {
     uint tile_ranges[];
 };
@@ -215,6 +216,9 @@ void main() {
         sort_status[i] = 0u;
     }
     uint num_tiles = view.tiles_x * view.tiles_y;
+    // The state's header (the composite's tile counter) starts at zero too
+    // (CompositeStageInputs::state_zeroed).
+    if (block == 0u && local < kBinRangesWordOffset) tile_ranges[local] = 0u;
     for (uint t = block * kEmitWorkgroupSize + local; t < num_tiles; t += stride) {
         tile_ranges[kBinRangesWordOffset + 2u * t] = 0xFFFFFFFFu;
         tile_ranges[kBinRangesWordOffset + 2u * t + 1u] = 0u;

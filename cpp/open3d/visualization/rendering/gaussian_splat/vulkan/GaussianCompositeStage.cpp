@@ -294,16 +294,22 @@ void GaussianCompositeStage::RecordComposite(VkCommandBuffer cmd,
     // Work stealing starts from tile 0 in every dispatch; tiles without entries keep [0, 0).
     // Ranges left by the geometry stage's bins were written by its compute passes, which the
     // fill of the tile counter (the same binding to them) must follow.
-    if (inputs.ranges_written) {
-        RecordMemoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
-                            VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, VK_PIPELINE_STAGE_2_TRANSFER_BIT,
-                            VK_ACCESS_2_TRANSFER_WRITE_BIT);
+    if (inputs.state_zeroed && !inputs.ranges_written) {
+        core::ThrowError("GaussianCompositeStage: a zeroed state needs ranges_written");
     }
-    vkCmdFillBuffer(cmd, state.buffer, state.offset,
-                    inputs.ranges_written ? sizeof(GaussianCompositeState) : state_bytes, 0u);
-    RecordMemoryBarrier(cmd, VK_PIPELINE_STAGE_2_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
-                        VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
-                        VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
+    if (!inputs.state_zeroed) {
+        if (inputs.ranges_written) {
+            RecordMemoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                                VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
+                                VK_PIPELINE_STAGE_2_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT);
+        }
+        vkCmdFillBuffer(cmd, state.buffer, state.offset,
+                        inputs.ranges_written ? sizeof(GaussianCompositeState) : state_bytes, 0u);
+        RecordMemoryBarrier(
+            cmd, VK_PIPELINE_STAGE_2_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
+            VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+            VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
+    }
 
     // The count may sit at any 4-byte offset: bind from the aligned offset below it.
     const VkDeviceSize count_offset =

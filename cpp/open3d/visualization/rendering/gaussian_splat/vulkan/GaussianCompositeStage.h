@@ -72,6 +72,12 @@ struct CompositeStageInputs {
     /// buffer passed to RecordComposite (GeometryStageViewBuffers::tile_ranges): the
     /// ranges pass is skipped and only the tile counter is zeroed.
     bool ranges_written = false;
+    /// With ranges_written: the geometry stage recorded just before this composite, in the
+    /// same recording, also zeroed the state's header (the tile counter; the per-tile bins
+    /// and the chained frame do, GaussianGeometryStage::WritesTileRanges), so the composite
+    /// records no fill and no barriers of its own; the caller's barrier after the geometry
+    /// stage orders it. Not for a composite that may run again on the same geometry stage.
+    bool state_zeroed = false;
 };
 
 /// The composite's outputs, width x height, in VK_IMAGE_LAYOUT_GENERAL.

@@ -370,6 +370,8 @@ void GaussianSplatVulkanBackend::RecordSlot(FrameSlot& slot, const FrameRecordin
         offsetof(GaussianGeometryStageCounters, entry_count), sizeof(uint32_t));
     inputs.entry_capacity = slot.view.EntryCapacity();
     inputs.ranges_written = geometry_stage_.WritesTileRanges(key.choices);
+    // Each view's composite follows its own geometry stage in this recording.
+    inputs.state_zeroed = inputs.ranges_written;
     CompositeStageTargets targets;
     targets.width = key.width;
     targets.height = key.height;
