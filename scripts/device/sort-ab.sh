@@ -68,5 +68,7 @@ bench first1000 -i $d/playbot/playbot_125k.ply --cameras $d/playbot/cameras.json
 bench grid7 -i $d/playbot/playbot_125k.ply --cameras $d/playbot/cameras.json --grid 7 "${hd[@]}"
 bench batch -i $d/playbot/playbot_125k.ply --cameras $d/playbot/cameras.json --resolution 800x800 --batch 24
 nvidia-smi --query-gpu=clocks.sm --format=csv | tee -a "$out/gpu.txt"
-# At most 8 files come back from a device call: the logs and JSON travel as one archive.
+# The comparison as one table (also printed), then the logs and JSON as one archive: at most
+# 8 files come back from a device call.
+command -v python3 >/dev/null && python3 scripts/device/ab_table.py "$out" $values | tee "$out/table.md"
 (cd "$out" && tar -czf runs.tar.gz ./*.log ./*.json 2>/dev/null && rm -f ./*.log ./*.json)
