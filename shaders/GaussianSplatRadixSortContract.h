@@ -152,6 +152,30 @@ struct RadixSortPushConstants {
     uint run_offset;
 };
 
+// The digit of `key` in pass `pass` of a sort of `num_bits` key bits (8-bit digits, the last
+// pass's narrower): what the histograms count, in the sort and in producers that count for it
+// (RadixSortScratch::sweep_histogram_written).
+OPEN3D_SHADER_FUNC uint RadixSortDigit(uint key, uint pass, uint num_bits) {
+    uint shift = pass * kRadixSortDigitBits;
+    uint bits = num_bits - shift < kRadixSortDigitBits ? num_bits - shift : kRadixSortDigitBits;
+    return (key >> shift) & ((1u << bits) - 1u);
+}
+
+// Most blocks RadixSortParamsFor gives any count <= max_count: up to target_blocks (clamped
+// to 1..kRadixSortTargetBlocks) blocks of 256..kRadixSortBlockSize pairs, beyond that blocks
+// of kRadixSortBlockSize. Sizes the status tables, and the rows a producer zeroes for a sort
+// whose count it does not know yet.
+OPEN3D_SHADER_FUNC uint RadixSortMaxBlocks(uint max_count, uint target_blocks) {
+    uint target = target_blocks < 1u ? 1u : target_blocks;
+    target = target < kRadixSortTargetBlocks ? target : kRadixSortTargetBlocks;
+    uint smallest =
+        max_count / kRadixSortWorkgroupSize + (max_count % kRadixSortWorkgroupSize == 0u ? 0u : 1u);
+    uint largest =
+        max_count / kRadixSortBlockSize + (max_count % kRadixSortBlockSize == 0u ? 0u : 1u);
+    smallest = smallest < target ? smallest : target;
+    return smallest > largest ? smallest : largest;
+}
+
 // ---- Radix sort parameters for an element count ----
 // Clamps the count to max_count (kErrorCountsClamped) and chooses the block size: the
 // fewest chunks of kRadixSortWorkgroupSize that keep the block count at or below

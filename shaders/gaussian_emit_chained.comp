@@ -83,44 +83,19 @@ uint TileSortPasses() {
 void CountTileKey(uint key) {
     uint passes = TileSortPasses();
     for (uint p = 0u; p < passes; ++p) {
-        uint bits = min(kRadixSortDigitBits, view.tile_bits - p * kRadixSortDigitBits);
-        uint digit = (key >> (p * kRadixSortDigitBits)) & ((1u << bits) - 1u);
-        atomicAdd(s_digit_counts[p * kRadixSortBins + digit], 1u);
+        atomicAdd(s_digit_counts[p * kRadixSortBins + RadixSortDigit(key, p, view.tile_bits)], 1u);
     }
 }
 #define OPEN3D_EMIT_COUNT_KEY(key) CountTileKey(key)
 
 #include "gaussian_emit_entries.glsl"
 
-// Most blocks the tile sort can have for at most `capacity` entries (RadixSortParamsFor with
-// count <= capacity): up to the target of 256..2048-pair blocks, beyond it 2048-pair ones.
-uint TileSortMaxBlocks(uint capacity) {
-    uint target = clamp(pc.sort_target_blocks, 1u, kRadixSortTargetBlocks);
-    uint smallest = (capacity + kRadixSortWorkgroupSize - 1u) / kRadixSortWorkgroupSize;
-    uint largest = (capacity + kRadixSortBlockSize - 1u) / kRadixSortBlockSize;
-    return max(min(smallest, target), largest);
-}
-
 shared uint s_block;
 shared uint s_prefix;  // entries of the blocks before this one
 shared uint s_block_total;
 shared uint s_sums[kEmitWorkgroupSize];
 
-// The tile count of depth-sorted slot k (gaussian_scan.comp's gather): from the list value,
-// or through the splat index where the value holds the sentinel. A splat over
-// max_tiles_per_splat counts 0 and flags the frame.
-uint SlotCount(uint k) {
-    uint value = splat_indices[k];
-    uint count = ListValueCount(value, view.num_splats);
-    if (count == ListCountSentinel(view.num_splats)) {
-        count = tile_counts[ListValueSplat(value, view.num_splats)];
-    }
-    if (count > view.max_tiles_per_splat) {
-        atomicOr(counters.error_flags, kErrorEntriesDropped);
-        return 0u;
-    }
-    return count;
-}
+#include "gaussian_list_count.glsl"
 
 // The frame's entry count, flags and the tile sort's parameters, from the one slot that
 // decides them.
@@ -167,8 +142,7 @@ void main() {
     if (block >= num_blocks) return;  // uniform: a spare workgroup of the grid's last row
     uint k = block * kEmitWorkgroupSize + local;
     for (uint p = 0u; p < kRadixSortMaxPasses; ++p) s_digit_counts[p * kRadixSortBins + local] = 0u;
-    // Slots past visible_count are stale (the depth sort dropped the culled splats).
-    uint count = k < counters.visible_count ? SlotCount(k) : 0u;
+    uint count = ListSlotTileCount(k);
 
     // Workgroup inclusive scan (Hillis-Steele) in shared memory by local index, so the
     // result does not depend on how invocations form subgroups. <= 256 counts of at most
@@ -210,7 +184,7 @@ void main() {
     // The tile sort's first pass reads status table 0, rows [0, its blocks): zero every row
     // it can have, spread over the workgroups (the depth sort used the same words). And every
     // tile's range starts empty.
-    uint status_words = TileSortMaxBlocks(capacity) * kRadixSortBins;
+    uint status_words = RadixSortMaxBlocks(capacity, pc.sort_target_blocks) * kRadixSortBins;
     uint stride = num_blocks * kEmitWorkgroupSize;
     for (uint i = block * kEmitWorkgroupSize + local; i < status_words; i += stride) {
         sort_status[i] = 0u;

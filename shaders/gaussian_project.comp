@@ -401,7 +401,7 @@ void main() {
         if (visible) {
             uint key = floatBitsToUint(depth);
             [[unroll]] for (uint p = 0u; p < kRadixSortMaxPasses; ++p) {
-                atomicAdd(s_depth_digits[p * kRadixSortBins + ((key >> (8u * p)) & 0xFFu)], 1u);
+                atomicAdd(s_depth_digits[p * kRadixSortBins + RadixSortDigit(key, p, 32u)], 1u);
             }
         }
         uint block = FlatWorkGroupIndex();

@@ -36,24 +36,12 @@ layout(std430, set = 0, binding = kGeometryStageScanBinding) buffer ScanBlock {
 };
 
 #include "gaussian_scan_offset.glsl"
+#include "gaussian_list_count.glsl"
 
 shared uint s_sums[kScanWorkgroupSize];
 
 uint LoadCount(uint index) {
-    if (kGather == 0u) return scan[pc.base + index];
-    // The exact order scans all N slots; past the visible ones the list holds stale slots
-    // (the depth sort dropped the culled splats), which count nothing.
-    if (index >= counters.visible_count) return 0u;
-    uint value = splat_indices[index];
-    uint count = ListValueCount(value, view.num_splats);
-    if (count == ListCountSentinel(view.num_splats)) {
-        count = tile_counts[ListValueSplat(value, view.num_splats)];
-    }
-    if (count > view.max_tiles_per_splat) {  // over max_tiles_per_splat: the splat emits nothing
-        atomicOr(counters.error_flags, kErrorEntriesDropped);
-        return 0u;
-    }
-    return count;
+    return kGather == 0u ? scan[pc.base + index] : ListSlotTileCount(index);
 }
 
 void ScanBlockPass(uint count) {

@@ -53,8 +53,7 @@ void main() {
             uint index = block_begin + local + k * kRadixSortWorkgroupSize;
             if (k < chunks && index < count && IsKept(keys[k])) {
                 for (uint p = 0u; p < passes; ++p) {
-                    uint bits = min(kRadixSortDigitBits, pc.num_bits - p * kRadixSortDigitBits);
-                    uint digit = (keys[k] >> (p * kRadixSortDigitBits)) & ((1u << bits) - 1u);
+                    uint digit = RadixSortDigit(keys[k], p, pc.num_bits);
                     atomicAdd(s_counts[p * kRadixSortBins + digit], 1u);
                 }
             }

@@ -34,17 +34,6 @@ static_assert(offsetof(RadixSortParams, dispatch_x) == offsetof(VkDispatchIndire
 
 VkDeviceSize Words(uint64_t n) { return VkDeviceSize(std::max<uint64_t>(n, 1)) * 4; }
 
-// Most blocks radix_sort_setup.comp can choose for any count <= max_count: up to
-// kRadixSortTargetBlocks blocks of 256..kRadixSortBlockSize elements, beyond that blocks of
-// kRadixSortBlockSize.
-uint32_t MaxBlocks(uint32_t max_count) {
-    const uint64_t smallest =
-        (uint64_t(max_count) + kRadixSortWorkgroupSize - 1) / kRadixSortWorkgroupSize;
-    const uint64_t largest = (uint64_t(max_count) + kRadixSortBlockSize - 1) / kRadixSortBlockSize;
-    return static_cast<uint32_t>(
-        std::max<uint64_t>(std::min<uint64_t>(smallest, kRadixSortTargetBlocks), largest));
-}
-
 // Shared memory of radix_sort_scatter.comp: per-digit first position and output shift,
 // per-subgroup counts (two digits per word), the scan's subgroup sums, and the reordered
 // keys and values.
@@ -160,7 +149,8 @@ RadixSortStorageRequirements RadixSort::GetStorageRequirements(uint32_t max_coun
     requirements.values_alt_bytes = Words(max_count);
     // The multi-pass sort's digit totals and per-block counts, or the one-sweep sort's two
     // tables of look-back status words.
-    const uint64_t blocks = MaxBlocks(max_count);
+    // The most blocks radix_sort_setup.comp can choose for any count <= max_count.
+    const uint64_t blocks = RadixSortMaxBlocks(max_count, kRadixSortTargetBlocks);
     requirements.histogram_bytes =
         Words(std::max(kRadixSortBins + kRadixSortBins * blocks, 2 * kRadixSortBins * blocks));
     requirements.params_bytes = sizeof(RadixSortParams);
