@@ -17,6 +17,9 @@
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_buffer_reference : require
 #extension GL_EXT_shader_explicit_arithmetic_types_int64 : require
+#extension GL_KHR_shader_subgroup_basic : require
+#extension GL_KHR_shader_subgroup_ballot : require
+#extension GL_KHR_shader_subgroup_arithmetic : require
 #include "GaussianSplatTileListContract.h"
 #include "gaussian_device_address.glsl"
 
@@ -72,21 +75,68 @@ layout(std430, set = 0, binding = kGeometryStageTileRangesBinding) writeonly buf
     uint tile_ranges[];
 };
 
-// The tile sort's digit counts of this workgroup's entries, pass-major.
+// The tile sort's digit counts of this workgroup's entries, pass-major. The first pass's
+// come from s_low_diff instead, except the filler keys'.
 shared uint s_digit_counts[kRadixSortMaxPasses * kRadixSortBins];
+// The first pass's counts as a difference array (+1 where a run of low digits starts, -1
+// past where it ends; its prefix sums are the counts) and the whole cycles of 2^bits keys
+// every digit received. A row span's keys are consecutive tiles, so it adds a few words
+// instead of one shared atomic per key: per key, the lanes of a subgroup, whose splats
+// cover nearby rows, queued on the same bins of the later passes.
+shared uint s_low_diff[kRadixSortBins + 1u];
+shared uint s_low_cycles;
 
 // The tile sort's passes over view.tile_bits key bits (RadixSort::GetNumPasses).
 uint TileSortPasses() {
     return (view.tile_bits + kRadixSortDigitBits - 1u) / kRadixSortDigitBits;
 }
 
-void CountTileKey(uint key) {
+// The bits of pass p's digit (RadixSortDigit): 8, fewer in a last pass over fewer bits.
+uint TileDigitBits(uint p) {
+    return min(kRadixSortDigitBits, view.tile_bits - p * kRadixSortDigitBits);
+}
+
+// Counts the keys first .. first + count - 1 (tiles, below 2^tile_bits).
+void CountTileRun(uint first, uint count) {
+    // First pass: the keys take `count` consecutive digits modulo 2^bits.
+    uint bits = TileDigitBits(0u);
+    uint m = 1u << bits;
+    uint cycles = count >> bits;
+    uint rest = count & (m - 1u);
+    if (cycles != 0u) atomicAdd(s_low_cycles, cycles);
+    if (rest != 0u) {
+        uint d = first & (m - 1u);
+        atomicAdd(s_low_diff[d], 1u);
+        if (d + rest <= m) {
+            atomicAdd(s_low_diff[d + rest], 0xFFFFFFFFu);
+        } else {  // wraps past the last digit
+            atomicAdd(s_low_diff[0], 1u);
+            atomicAdd(s_low_diff[d + rest - m], 0xFFFFFFFFu);
+        }
+    }
+    // Later passes: each digit block of 2^shift keys the run crosses gets its overlap.
     uint passes = TileSortPasses();
-    for (uint p = 0u; p < passes; ++p) {
-        atomicAdd(s_digit_counts[p * kRadixSortBins + RadixSortDigit(key, p, view.tile_bits)], 1u);
+    uint end = first + count;
+    for (uint p = 1u; p < passes; ++p) {
+        uint shift = p * kRadixSortDigitBits;
+        uint mask = (1u << TileDigitBits(p)) - 1u;
+        for (uint t = first; t < end;) {
+            uint next = min(((t >> shift) + 1u) << shift, end);
+            atomicAdd(s_digit_counts[p * kRadixSortBins + ((t >> shift) & mask)], next - t);
+            t = next;
+        }
     }
 }
-#define OPEN3D_EMIT_COUNT_KEY(key) CountTileKey(key)
+
+void CountFillerKey() {
+    uint passes = TileSortPasses();
+    for (uint p = 0u; p < passes; ++p) {
+        uint digit = RadixSortDigit(0xFFFFFFFFu, p, view.tile_bits);
+        atomicAdd(s_digit_counts[p * kRadixSortBins + digit], 1u);
+    }
+}
+#define OPEN3D_EMIT_COUNT_RUN(first, count) CountTileRun(first, count)
+#define OPEN3D_EMIT_COUNT_FILLER() CountFillerKey()
 
 #include "gaussian_emit_entries.glsl"
 
@@ -106,30 +156,65 @@ void WriteEntryCount(uint entries, uint flags) {
         RadixSortParamsFor(entries, pc.sort_max_count, pc.sort_target_blocks, pc.max_groups_x);
 }
 
-// Block `block`'s prefix: its own total published as an aggregate, then the earlier blocks'
-// words added walking back until one holds an inclusive prefix (waiting while a word is
-// still 0: its block has started, so it will publish), then its own inclusive prefix.
+// Block `block`'s prefix, found by the workgroup's first subgroup: its own total published
+// as an aggregate, then the earlier blocks' words read a subgroup-wide window at a time (lane
+// i reads block back - i) and added up to the nearest one that holds an inclusive prefix,
+// then its own inclusive prefix. A window with a word still 0 below that point (its block
+// has started, so it will publish) is read again. One word at a time, a block far from the
+// last inclusive prefix waited one global round trip per block: with every block started
+// at once the last of n blocks walked about n / 2 words (docs/perf/h100.md).
 uint LookBack(uint block, uint own) {
     uint word = kEmitChainedStatusBase + block;
+    bool first_lane = gl_SubgroupInvocationID == 0u;
     if (block == 0u) {
-        atomicExchange(status[word], kRadixSweepFlagInclusive | own);
+        if (first_lane) atomicExchange(status[word], kRadixSweepFlagInclusive | own);
         return 0u;
     }
-    atomicExchange(status[word], kRadixSweepFlagAggregate | own);
+    if (first_lane) atomicExchange(status[word], kRadixSweepFlagAggregate | own);
+    uint lane = gl_SubgroupInvocationID;
     uint prefix = 0u;
-    uint back = block - 1u;
+    uint back = block - 1u;  // the window's newest block
     while (true) {
-        uint s = atomicAdd(status[kEmitChainedStatusBase + back], 0u);
-        if (s == 0u) continue;  // not published yet
-        prefix = min(prefix + (s & kRadixSweepValueMask), kRadixSweepValueMask);
-        if ((s & kRadixSweepFlagInclusive) != 0u) break;
-        --back;  // block 0 always publishes an inclusive prefix, so this stops there
+        // Lanes past block 0 read as an inclusive 0 (block 0 always publishes one anyway).
+        uint s = lane <= back ? atomicAdd(status[kEmitChainedStatusBase + back - lane], 0u)
+                              : kRadixSweepFlagInclusive;
+        bool inclusive = (s & kRadixSweepFlagInclusive) != 0u;
+        uvec4 inclusive_lanes = subgroupBallot(inclusive);
+        bool found = subgroupBallotBitCount(inclusive_lanes) != 0u;
+        uint limit = found ? subgroupBallotFindLSB(inclusive_lanes) : gl_SubgroupSize - 1u;
+        bool pending = s == 0u && lane <= limit;  // not published yet
+        if (subgroupBallotBitCount(subgroupBallot(pending)) != 0u) continue;
+        uint value = lane <= limit ? (s & kRadixSweepValueMask) : 0u;
+        // A saturating sum: a subgroup's values of up to 2^30 - 1 can pass 2^32, their
+        // halves cannot.
+        uint high = subgroupAdd(value >> 16u);
+        uint low = subgroupAdd(value & 0xFFFFu);
+        uint sum = high > (kRadixSweepValueMask >> 16u)
+                           ? kRadixSweepValueMask
+                           : min(high * 65536u + low, kRadixSweepValueMask);
+        prefix = min(prefix + sum, kRadixSweepValueMask);
+        if (found) break;
+        back -= gl_SubgroupSize;  // no inclusive word: every lane read a real block
     }
-    if (kOddBlocksAggregateOnly == 0u || (block & 1u) == 0u) {
+    if (first_lane && (kOddBlocksAggregateOnly == 0u || (block & 1u) == 0u)) {
         atomicExchange(status[word],
                        kRadixSweepFlagInclusive | min(prefix + own, kRadixSweepValueMask));
     }
     return prefix;
+}
+
+// Every tile's range starts empty, spread over all workgroups of the dispatch (the recorder
+// adds spare ones where the blocks are fewer than the tiles need), and the composite state's
+// header (its tile counter) starts at zero (CompositeStageInputs::state_zeroed).
+void ClearTileRanges(uint ticket) {
+    uint local = gl_LocalInvocationIndex;
+    uint num_tiles = view.tiles_x * view.tiles_y;
+    uint stride = gl_NumWorkGroups.x * gl_NumWorkGroups.y * kEmitWorkgroupSize;
+    if (ticket == 0u && local < kBinRangesWordOffset) tile_ranges[local] = 0u;
+    for (uint t = ticket * kEmitWorkgroupSize + local; t < num_tiles; t += stride) {
+        tile_ranges[kBinRangesWordOffset + 2u * t] = 0xFFFFFFFFu;
+        tile_ranges[kBinRangesWordOffset + 2u * t + 1u] = 0u;
+    }
 }
 
 void main() {
@@ -137,11 +222,17 @@ void main() {
     if (local == 0u) s_block = atomicAdd(status[kEmitChainedTicketWord], 1u);
     barrier();
     uint block = s_block;
+    ClearTileRanges(block);
     uint num_slots = max(view.num_splats, 1u);
     uint num_blocks = (num_slots + kEmitWorkgroupSize - 1u) / kEmitWorkgroupSize;
-    if (block >= num_blocks) return;  // uniform: a spare workgroup of the grid's last row
+    if (block >= num_blocks) return;  // uniform: a spare workgroup, its ranges cleared
     uint k = block * kEmitWorkgroupSize + local;
     for (uint p = 0u; p < kRadixSortMaxPasses; ++p) s_digit_counts[p * kRadixSortBins + local] = 0u;
+    s_low_diff[local] = 0u;
+    if (local == 0u) {
+        s_low_diff[kRadixSortBins] = 0u;
+        s_low_cycles = 0u;
+    }
     uint count = ListSlotTileCount(k);
 
     // Workgroup inclusive scan (Hillis-Steele) in shared memory by local index, so the
@@ -155,10 +246,13 @@ void main() {
         s_sums[local] += other;
         barrier();
     }
-    if (local == 0u) {
+    if (gl_SubgroupID == 0u) {
         uint own = min(s_sums[kEmitWorkgroupSize - 1u], kRadixSweepValueMask);
-        s_block_total = own;
-        s_prefix = LookBack(block, own);
+        uint prefix = LookBack(block, own);
+        if (gl_SubgroupInvocationID == 0u) {
+            s_block_total = own;
+            s_prefix = prefix;
+        }
     }
     barrier();
     uint local_begin = s_sums[local] - count;
@@ -181,23 +275,31 @@ void main() {
     if (count != 0u && end <= capacity) {
         EmitEntries(ListValueSplat(splat_indices[k], view.num_splats), begin, end, false);
     }
-    // The tile sort's first pass reads status table 0, rows [0, its blocks): zero every row
-    // it can have, spread over the workgroups (the depth sort used the same words). And every
-    // tile's range starts empty.
-    uint status_words = RadixSortMaxBlocks(capacity, pc.sort_target_blocks) * kRadixSortBins;
-    uint stride = num_blocks * kEmitWorkgroupSize;
-    for (uint i = block * kEmitWorkgroupSize + local; i < status_words; i += stride) {
-        sort_status[i] = 0u;
-    }
-    uint num_tiles = view.tiles_x * view.tiles_y;
-    // The state's header (the composite's tile counter) starts at zero too
-    // (CompositeStageInputs::state_zeroed).
-    if (block == 0u && local < kBinRangesWordOffset) tile_ranges[local] = 0u;
-    for (uint t = block * kEmitWorkgroupSize + local; t < num_tiles; t += stride) {
-        tile_ranges[kBinRangesWordOffset + 2u * t] = 0xFFFFFFFFu;
-        tile_ranges[kBinRangesWordOffset + 2u * t + 1u] = 0u;
+    // The tile sort's first pass reads status table 0 (the depth sort used the same words),
+    // rows [0, its blocks) for blocks of at least kRadixSortWorkgroupSize keys: each workgroup
+    // zeroes the rows of the smallest blocks its own kept entries fall in. The workgroups'
+    // entries tile [0, entry_count), so every row the sort can read is zeroed, and no more
+    // than the entries need.
+    uint kept_begin = min(s_prefix, capacity);
+    uint kept_end = min(s_prefix + s_block_total, capacity);
+    if (kept_begin < kept_end) {
+        uint row_begin = kept_begin / kRadixSortWorkgroupSize;
+        uint row_end = (kept_end - 1u) / kRadixSortWorkgroupSize + 1u;
+        for (uint i = row_begin * kRadixSortBins + local; i < row_end * kRadixSortBins;
+             i += kEmitWorkgroupSize) {
+            sort_status[i] = 0u;
+        }
     }
     barrier();
+    // The first pass's counts: the difference array's inclusive prefix sums (Hillis-Steele;
+    // the words wrap modulo 2^32 but every sum is a count) and the whole cycles.
+    for (uint offset = 1u; offset < kRadixSortBins; offset <<= 1u) {
+        uint other = local >= offset ? s_low_diff[local - offset] : 0u;
+        barrier();
+        s_low_diff[local] += other;
+        barrier();
+    }
+    if (local < (1u << TileDigitBits(0u))) s_digit_counts[local] += s_low_diff[local] + s_low_cycles;
     uint passes = TileSortPasses();
     for (uint p = 0u; p < passes; ++p) {
         uint c = s_digit_counts[p * kRadixSortBins + local];

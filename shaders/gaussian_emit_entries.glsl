@@ -4,10 +4,14 @@
 #ifndef OPEN3D_GAUSSIAN_EMIT_ENTRIES_GLSL
 #define OPEN3D_GAUSSIAN_EMIT_ENTRIES_GLSL
 
-// What an includer does with every key it writes (the chained emit counts the tile sort's
-// digits); nothing by default.
-#ifndef OPEN3D_EMIT_COUNT_KEY
-#define OPEN3D_EMIT_COUNT_KEY(key)
+// What an includer does with the tile keys it writes (the chained emit counts the tile
+// sort's digits): a run of `count` consecutive tile keys from `first` (a row span, exact
+// order only), and the filler key 0xFFFFFFFF; nothing by default.
+#ifndef OPEN3D_EMIT_COUNT_RUN
+#define OPEN3D_EMIT_COUNT_RUN(first, count)
+#endif
+#ifndef OPEN3D_EMIT_COUNT_FILLER
+#define OPEN3D_EMIT_COUNT_FILLER()
 #endif
 
 // Writes (key, splat) for every tile of the splat's rectangle that TileRowSpan keeps, at
@@ -45,15 +49,16 @@ void EmitEntries(uint splat, uint begin, uint end, bool packed) {
         uint span = whole_rect ? min_x | (max_x << 16u)
                                : TileRowSpan(center.x, center.y, conic.x, conic.y, conic.z,
                                              det_q, cull_t, ty, min_x, max_x);
-        uint last = min(span >> 16u, (span & 0xFFFFu) + (end - out_index));
-        for (uint tx = span & 0xFFFFu; tx < last; ++tx) {
+        uint first = span & 0xFFFFu;
+        uint last = min(span >> 16u, first + (end - out_index));
+        for (uint tx = first; tx < last; ++tx) {
             uint tile = ty * tiles_x + tx;
             uint key = packed ? PackedSortKey(tile, norm_depth, tile_bits) : tile;
             entry_keys[out_index] = key;
             entry_values[out_index] = splat;
-            OPEN3D_EMIT_COUNT_KEY(key);
             ++out_index;
         }
+        if (!packed && last > first) OPEN3D_EMIT_COUNT_RUN(ty * tiles_x + first, last - first);
     }
     // The projection counted these spans from the same stored values with the same
     // `precise` code, so this never runs; should a driver still round differently, the
@@ -62,7 +67,7 @@ void EmitEntries(uint splat, uint begin, uint end, bool packed) {
     for (; out_index < end; ++out_index) {
         entry_keys[out_index] = 0xFFFFFFFFu;
         entry_values[out_index] = splat;
-        OPEN3D_EMIT_COUNT_KEY(0xFFFFFFFFu);
+        OPEN3D_EMIT_COUNT_FILLER();
     }
 }
 

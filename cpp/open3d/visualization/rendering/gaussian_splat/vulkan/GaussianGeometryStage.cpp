@@ -448,7 +448,10 @@ void GaussianGeometryStage::Record(VkCommandBuffer cmd, const GeometryStageScene
         // by look-back, cuts at the capacity and emits (gaussian_emit_chained.comp).
         vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, emit_chained_.Get());
         vkCmdPushConstants(cmd, layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(args), &args);
-        const uvec4 grid = DispatchGridFor(chained_blocks, max_groups_x);
+        // Spare workgroups beyond the blocks only clear tile ranges, so that a frame of few
+        // splats does not leave every tile's range to one workgroup (at most four a thread).
+        const uint32_t clear_groups = DivCeil(choices.num_tiles, 4 * kEmitWorkgroupSize);
+        const uvec4 grid = DispatchGridFor(std::max(chained_blocks, clear_groups), max_groups_x);
         RecordDispatch(cmd, grid.x, grid.y, 1);
         ComputeBarrier(cmd);
     } else {
