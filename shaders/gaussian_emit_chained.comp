@@ -143,7 +143,9 @@ void CountFillerKey() {
 shared uint s_block;
 shared uint s_prefix;  // entries of the blocks before this one
 shared uint s_block_total;
-shared uint s_sums[kEmitWorkgroupSize];
+// Per subgroup: its lanes (for the slot order), then its sums in the workgroup scans.
+shared uint s_subgroup_lanes[kEmitWorkgroupSize];
+shared uint s_subgroup_sums[kEmitWorkgroupSize];
 
 #include "gaussian_list_count.glsl"
 
@@ -217,16 +219,41 @@ void ClearTileRanges(uint ticket) {
     }
 }
 
+// The inclusive sum of `value` over the workgroup in slot order (subgroups by gl_SubgroupID,
+// lanes by gl_SubgroupInvocationID), and the workgroup's total: a subgroup scan and one
+// barrier, where a scan in shared memory by local index took sixteen. The caller puts a
+// barrier between two calls (s_subgroup_sums is reused).
+uint WorkgroupInclusiveAdd(uint value, out uint total) {
+    uint inclusive = subgroupInclusiveAdd(value);
+    if (gl_SubgroupInvocationID == subgroupMax(gl_SubgroupInvocationID)) {
+        s_subgroup_sums[gl_SubgroupID] = inclusive;
+    }
+    barrier();
+    uint before = 0u;
+    total = 0u;
+    for (uint s = 0u; s < gl_NumSubgroups; ++s) {
+        if (s == gl_SubgroupID) before = total;
+        total += s_subgroup_sums[s];
+    }
+    return before + inclusive;
+}
+
 void main() {
     uint local = gl_LocalInvocationIndex;
+    // This invocation's slot of the block, in the order the subgroup scans add (the lanes of
+    // earlier subgroups first); gl_LocalInvocationIndex need not follow it.
+    uint lanes = subgroupAdd(1u);
+    if (subgroupElect()) s_subgroup_lanes[gl_SubgroupID] = lanes;
     if (local == 0u) s_block = atomicAdd(status[kEmitChainedTicketWord], 1u);
     barrier();
+    uint slot = subgroupExclusiveAdd(1u);
+    for (uint sg = 0u; sg < gl_SubgroupID; ++sg) slot += s_subgroup_lanes[sg];
     uint block = s_block;
     ClearTileRanges(block);
     uint num_slots = max(view.num_splats, 1u);
     uint num_blocks = (num_slots + kEmitWorkgroupSize - 1u) / kEmitWorkgroupSize;
     if (block >= num_blocks) return;  // uniform: a spare workgroup, its ranges cleared
-    uint k = block * kEmitWorkgroupSize + local;
+    uint k = block * kEmitWorkgroupSize + slot;
     for (uint p = 0u; p < kRadixSortMaxPasses; ++p) s_digit_counts[p * kRadixSortBins + local] = 0u;
     s_low_diff[local] = 0u;
     if (local == 0u) {
@@ -235,19 +262,12 @@ void main() {
     }
     uint count = ListSlotTileCount(k);
 
-    // Workgroup inclusive scan (Hillis-Steele) in shared memory by local index, so the
-    // result does not depend on how invocations form subgroups. <= 256 counts of at most
-    // the tiles of an image each: no wrap.
-    s_sums[local] = count;
-    barrier();
-    for (uint offset = 1u; offset < kEmitWorkgroupSize; offset <<= 1u) {
-        uint other = local >= offset ? s_sums[local - offset] : 0u;
-        barrier();
-        s_sums[local] += other;
-        barrier();
-    }
+    // The block's scan in slot order. <= 256 counts of at most the tiles of an image each:
+    // no wrap.
+    uint block_sum = 0u;
+    uint inclusive = WorkgroupInclusiveAdd(count, block_sum);
     if (gl_SubgroupID == 0u) {
-        uint own = min(s_sums[kEmitWorkgroupSize - 1u], kRadixSweepValueMask);
+        uint own = min(block_sum, kRadixSweepValueMask);
         uint prefix = LookBack(block, own);
         if (gl_SubgroupInvocationID == 0u) {
             s_block_total = own;
@@ -255,14 +275,14 @@ void main() {
         }
     }
     barrier();
-    uint local_begin = s_sums[local] - count;
+    uint local_begin = inclusive - count;
     uint begin = min(s_prefix + local_begin, kRadixSweepValueMask);
     uint end = min(begin + count, kRadixSweepValueMask);
     uint capacity = view.entry_capacity;
     if (count != 0u && begin <= capacity && end > capacity) {
         WriteEntryCount(begin, kErrorEntriesDropped);  // the first splat that does not fit
     }
-    if (block == num_blocks - 1u && local == kEmitWorkgroupSize - 1u) {
+    if (block == num_blocks - 1u && local == 0u) {
         uint total = min(s_prefix + s_block_total, kRadixSweepValueMask);
         counters.requested_entries = total;
         if (total <= capacity) {
@@ -291,18 +311,14 @@ void main() {
         }
     }
     barrier();
-    // The first pass's counts: the difference array's inclusive prefix sums (Hillis-Steele;
-    // the words wrap modulo 2^32 but every sum is a count) and the whole cycles.
-    for (uint offset = 1u; offset < kRadixSortBins; offset <<= 1u) {
-        uint other = local >= offset ? s_low_diff[local - offset] : 0u;
-        barrier();
-        s_low_diff[local] += other;
-        barrier();
-    }
-    if (local < (1u << TileDigitBits(0u))) s_digit_counts[local] += s_low_diff[local] + s_low_cycles;
+    // The first pass's counts: the difference array's inclusive prefix sums in bin order,
+    // bin = slot (the words wrap modulo 2^32 but every sum is a count), and the whole cycles.
+    uint unused_total;
+    uint low = WorkgroupInclusiveAdd(s_low_diff[slot], unused_total);
+    if (slot < (1u << TileDigitBits(0u))) s_digit_counts[slot] += low + s_low_cycles;
     uint passes = TileSortPasses();
     for (uint p = 0u; p < passes; ++p) {
-        uint c = s_digit_counts[p * kRadixSortBins + local];
-        if (c != 0u) atomicAdd(tile_sort_state.histogram[p * kRadixSortBins + local], c);
+        uint c = s_digit_counts[p * kRadixSortBins + slot];
+        if (c != 0u) atomicAdd(tile_sort_state.histogram[p * kRadixSortBins + slot], c);
     }
 }
