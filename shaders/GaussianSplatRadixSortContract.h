@@ -176,6 +176,29 @@ OPEN3D_SHADER_FUNC uint RadixSortMaxBlocks(uint max_count, uint target_blocks) {
     return smallest > largest ? smallest : largest;
 }
 
+// The first pass's status rows a producer zeroes for a sort whose count it does not know yet
+// (RadixSortScratch::sweep_histogram_written, docs/radix-sort.md): a sort of at most
+// target x kRadixSortBlockSize keys has at most `target` blocks (RadixSortParamsFor), so
+// rows [0, RadixSortSmallRows) cover it; a larger sort has blocks of kRadixSortBlockSize,
+// and the producer workgroup that writes keys [begin, end) zeroes rows
+// [RadixSortLargeRows.x, .y), those of the blocks its keys fall in past `target`: together the
+// workgroups cover every block of the sort. Both stay below RadixSortMaxBlocks(max_count).
+OPEN3D_SHADER_FUNC uint RadixSortSmallRows(uint max_count, uint target_blocks) {
+    uint target = target_blocks < 1u ? 1u : target_blocks;
+    target = target < kRadixSortTargetBlocks ? target : kRadixSortTargetBlocks;
+    uint rows = RadixSortMaxBlocks(max_count, target_blocks);
+    return target < rows ? target : rows;
+}
+
+OPEN3D_SHADER_FUNC uvec4 RadixSortLargeRows(uint begin, uint end, uint target_blocks) {
+    uint target = target_blocks < 1u ? 1u : target_blocks;
+    target = target < kRadixSortTargetBlocks ? target : kRadixSortTargetBlocks;
+    uint first = begin / kRadixSortBlockSize;
+    first = first > target ? first : target;
+    uint last = begin < end ? (end - 1u) / kRadixSortBlockSize + 1u : 0u;
+    return last > first ? uvec4(first, last, 0u, 0u) : uvec4(0u, 0u, 0u, 0u);  // or none
+}
+
 // ---- Radix sort parameters for an element count ----
 // Clamps the count to max_count (kErrorCountsClamped) and chooses the block size: the
 // fewest chunks of kRadixSortWorkgroupSize that keep the block count at or below

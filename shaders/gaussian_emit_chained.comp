@@ -219,6 +219,27 @@ void ClearTileRanges(uint ticket) {
     }
 }
 
+// The rows of status table 0 that the tile sort's first pass reads, zeroed before it runs
+// (the depth sort used the same words) without knowing the entry count yet: rows
+// [0, RadixSortSmallRows) by every workgroup of the dispatch together, spares included, and
+// by each workgroup the rows RadixSortLargeRows gives for its own kept entries.
+void ZeroSmallSortRows(uint ticket) {
+    uint rows = RadixSortSmallRows(view.entry_capacity, pc.sort_target_blocks);
+    uint stride = gl_NumWorkGroups.x * gl_NumWorkGroups.y * kEmitWorkgroupSize;
+    for (uint i = ticket * kEmitWorkgroupSize + gl_LocalInvocationIndex; i < rows * kRadixSortBins;
+         i += stride) {
+        sort_status[i] = 0u;
+    }
+}
+
+void ZeroLargeSortRows(uint begin, uint end) {
+    uvec4 rows = RadixSortLargeRows(begin, end, pc.sort_target_blocks);
+    for (uint i = rows.x * kRadixSortBins + gl_LocalInvocationIndex; i < rows.y * kRadixSortBins;
+         i += kEmitWorkgroupSize) {
+        sort_status[i] = 0u;
+    }
+}
+
 // The inclusive sum of `value` over the workgroup in slot order (subgroups by gl_SubgroupID,
 // lanes by gl_SubgroupInvocationID), and the workgroup's total: a subgroup scan and one
 // barrier, where a scan in shared memory by local index took sixteen. The caller puts a
@@ -250,6 +271,7 @@ void main() {
     for (uint sg = 0u; sg < gl_SubgroupID; ++sg) slot += s_subgroup_lanes[sg];
     uint block = s_block;
     ClearTileRanges(block);
+    ZeroSmallSortRows(block);
     uint num_slots = max(view.num_splats, 1u);
     uint num_blocks = (num_slots + kEmitWorkgroupSize - 1u) / kEmitWorkgroupSize;
     if (block >= num_blocks) return;  // uniform: a spare workgroup, its ranges cleared
@@ -295,21 +317,8 @@ void main() {
     if (count != 0u && end <= capacity) {
         EmitEntries(ListValueSplat(splat_indices[k], view.num_splats), begin, end, false);
     }
-    // The tile sort's first pass reads status table 0 (the depth sort used the same words),
-    // rows [0, its blocks) for blocks of at least kRadixSortWorkgroupSize keys: each workgroup
-    // zeroes the rows of the smallest blocks its own kept entries fall in. The workgroups'
-    // entries tile [0, entry_count), so every row the sort can read is zeroed, and no more
-    // than the entries need.
-    uint kept_begin = min(s_prefix, capacity);
-    uint kept_end = min(s_prefix + s_block_total, capacity);
-    if (kept_begin < kept_end) {
-        uint row_begin = kept_begin / kRadixSortWorkgroupSize;
-        uint row_end = (kept_end - 1u) / kRadixSortWorkgroupSize + 1u;
-        for (uint i = row_begin * kRadixSortBins + local; i < row_end * kRadixSortBins;
-             i += kEmitWorkgroupSize) {
-            sort_status[i] = 0u;
-        }
-    }
+    // The tile sort's first pass reads status table 0 (the depth sort used the same words).
+    ZeroLargeSortRows(min(s_prefix, capacity), min(s_prefix + s_block_total, capacity));
     barrier();
     // The first pass's counts: the difference array's inclusive prefix sums in bin order,
     // bin = slot (the words wrap modulo 2^32 but every sum is a count), and the whole cycles.

@@ -2,7 +2,9 @@
 // the mirrored structs out at the offsets the C++ side asserts.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstring>
+#include <vector>
 
 #include "GaussianSplatCompositeContract.h"
 #include "GaussianSplatTileListContract.h"
@@ -26,6 +28,52 @@ TEST(GaussianSplatContract, CompilesAsCpp) {
     EXPECT_EQ(sizeof(shader::RadixSortParams), 208u);
     EXPECT_EQ(sizeof(shader::RadixSweepState), 4128u);
     EXPECT_EQ(sizeof(shader::RadixSortPushConstants), 56u);
+}
+
+// A producer that counts a one-sweep sort's digits zeroes the first pass's status rows before
+// the count is known (the chained emit, RadixSortSmallRows / RadixSortLargeRows): whatever
+// the count and however its keys are split between the producer's workgroups, every block
+// of the sort RadixSortParamsFor then chooses has its row zeroed, and no row past the table
+// (RadixSortMaxBlocks of the capacity) is written. On lavapipe the look-backs run in order and
+// never read a stale row, so the suites cannot see a missing one: this checks the rule.
+TEST(GaussianSplatContract, ProducerZeroedRowsCoverEverySortBlock) {
+    uint32_t state = 2024u;
+    const auto random = [&state](uint32_t bound) {
+        state = state * 1664525u + 1013904223u;
+        return (state >> 8) % bound;
+    };
+    for (const uint32_t target : {1u, 16u, 100u, 256u, 1000u}) {
+        const uint32_t wave =
+            std::min(target, shader::kRadixSortTargetBlocks) * shader::kRadixSortBlockSize;
+        for (const uint32_t count : {0u, 1u, 255u, 256u, 257u, 2047u, 2048u, 2049u, wave - 1, wave,
+                                     wave + 1, wave + 5000u, 3 * wave + 17u}) {
+            for (const uint32_t capacity : {count, count + 1u, 2 * count + 3000u, 1u << 22}) {
+                const uint32_t table = shader::RadixSortMaxBlocks(capacity, target);
+                std::vector<bool> zeroed(table, false);
+                const uint32_t small = shader::RadixSortSmallRows(capacity, target);
+                ASSERT_LE(small, table);
+                for (uint32_t r = 0; r < small; ++r) zeroed[r] = true;
+                // Producer workgroups' kept keys: consecutive ranges of 0 to 3,000 keys up to
+                // the capacity (the one holding the cut may reach past the count).
+                for (uint32_t begin = 0; begin < std::max(count, 1u);) {
+                    const uint32_t end = std::min(begin + random(3001u), capacity);
+                    const shader::uvec4 rows = shader::RadixSortLargeRows(begin, end, target);
+                    ASSERT_LE(rows.y, table) << begin << ".." << end;
+                    for (uint32_t r = rows.x; r < rows.y; ++r) zeroed[r] = true;
+                    if (end >= capacity) break;
+                    begin = end;
+                }
+                const shader::RadixSortParams params =
+                    shader::RadixSortParamsFor(count, capacity, target, 65535u);
+                const uint32_t blocks = count == 0 ? 0 : params.num_blocks;
+                ASSERT_LE(blocks, table);
+                for (uint32_t r = 0; r < blocks; ++r) {
+                    ASSERT_TRUE(zeroed[r]) << "target " << target << ", count " << count
+                                           << ", capacity " << capacity << ": row " << r;
+                }
+            }
+        }
+    }
 }
 
 TEST(GaussianSplatContract, ListValuesCarryTheSplatAndItsEntryCount) {

@@ -448,9 +448,12 @@ void GaussianGeometryStage::Record(VkCommandBuffer cmd, const GeometryStageScene
         // by look-back, cuts at the capacity and emits (gaussian_emit_chained.comp).
         vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, emit_chained_.Get());
         vkCmdPushConstants(cmd, layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(args), &args);
-        // Spare workgroups beyond the blocks only clear tile ranges, so that a frame of few
-        // splats does not leave every tile's range to one workgroup (at most four a thread).
-        const uint32_t clear_groups = DivCeil(choices.num_tiles, 4 * kEmitWorkgroupSize);
+        // Spare workgroups beyond the blocks only clear tile ranges and the tile sort's first
+        // status rows, so that a frame of few splats does not leave them to one workgroup (at
+        // most four words a thread).
+        const uint32_t clear_groups =
+            DivCeil(std::max(choices.num_tiles, kRadixSortTargetBlocks * kRadixSortBins),
+                    4 * kEmitWorkgroupSize);
         const uvec4 grid = DispatchGridFor(std::max(chained_blocks, clear_groups), max_groups_x);
         RecordDispatch(cmd, grid.x, grid.y, 1);
         ComputeBarrier(cmd);
