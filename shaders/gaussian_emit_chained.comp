@@ -164,7 +164,7 @@ void WriteEntryCount(uint entries, uint flags) {
 // then its own inclusive prefix. A window with a word still 0 below that point (its block
 // has started, so it will publish) is read again. One word at a time, a block far from the
 // last inclusive prefix waited one global round trip per block: with every block started
-// at once the last of n blocks walked about n / 2 words (docs/perf/h100.md).
+// at once the last of n blocks walked about n / 2 words (docs/perf/h100-chained-frame.md).
 uint LookBack(uint block, uint own) {
     uint word = kEmitChainedStatusBase + block;
     bool first_lane = gl_SubgroupInvocationID == 0u;
