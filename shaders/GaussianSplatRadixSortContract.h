@@ -152,13 +152,25 @@ struct RadixSortPushConstants {
     uint run_offset;
 };
 
-// The digit of `key` in pass `pass` of a sort of `num_bits` key bits (8-bit digits, the last
-// pass's narrower): what the histograms count, in the sort and in producers that count for it
+// The bits of pass `pass`'s digit in a sort of `num_bits` key bits: 8, the last pass's fewer.
+OPEN3D_SHADER_FUNC uint RadixSortDigitBits(uint pass, uint num_bits) {
+    uint shift = pass * kRadixSortDigitBits;
+    return num_bits - shift < kRadixSortDigitBits ? num_bits - shift : kRadixSortDigitBits;
+}
+
+// The digit of `key` in pass `pass` of a sort of `num_bits` key bits: what the histograms
+// count, in the sort and in producers that count for it
 // (RadixSortScratch::sweep_histogram_written).
 OPEN3D_SHADER_FUNC uint RadixSortDigit(uint key, uint pass, uint num_bits) {
-    uint shift = pass * kRadixSortDigitBits;
-    uint bits = num_bits - shift < kRadixSortDigitBits ? num_bits - shift : kRadixSortDigitBits;
-    return (key >> shift) & ((1u << bits) - 1u);
+    uint mask = (1u << RadixSortDigitBits(pass, num_bits)) - 1u;
+    return (key >> (pass * kRadixSortDigitBits)) & mask;
+}
+
+// A sort's target block count as every rule below reads it: clamped to
+// 1..kRadixSortTargetBlocks.
+OPEN3D_SHADER_FUNC uint RadixSortClampedTarget(uint target_blocks) {
+    uint target = target_blocks < 1u ? 1u : target_blocks;
+    return target < kRadixSortTargetBlocks ? target : kRadixSortTargetBlocks;
 }
 
 // Most blocks RadixSortParamsFor gives any count <= max_count: up to target_blocks (clamped
@@ -166,8 +178,7 @@ OPEN3D_SHADER_FUNC uint RadixSortDigit(uint key, uint pass, uint num_bits) {
 // of kRadixSortBlockSize. Sizes the status tables, and the rows a producer zeroes for a sort
 // whose count it does not know yet.
 OPEN3D_SHADER_FUNC uint RadixSortMaxBlocks(uint max_count, uint target_blocks) {
-    uint target = target_blocks < 1u ? 1u : target_blocks;
-    target = target < kRadixSortTargetBlocks ? target : kRadixSortTargetBlocks;
+    uint target = RadixSortClampedTarget(target_blocks);
     uint smallest =
         max_count / kRadixSortWorkgroupSize + (max_count % kRadixSortWorkgroupSize == 0u ? 0u : 1u);
     uint largest =
@@ -184,15 +195,13 @@ OPEN3D_SHADER_FUNC uint RadixSortMaxBlocks(uint max_count, uint target_blocks) {
 // [RadixSortLargeRows.x, .y), those of the blocks its keys fall in past `target`: together the
 // workgroups cover every block of the sort. Both stay below RadixSortMaxBlocks(max_count).
 OPEN3D_SHADER_FUNC uint RadixSortSmallRows(uint max_count, uint target_blocks) {
-    uint target = target_blocks < 1u ? 1u : target_blocks;
-    target = target < kRadixSortTargetBlocks ? target : kRadixSortTargetBlocks;
+    uint target = RadixSortClampedTarget(target_blocks);
     uint rows = RadixSortMaxBlocks(max_count, target_blocks);
     return target < rows ? target : rows;
 }
 
 OPEN3D_SHADER_FUNC uvec4 RadixSortLargeRows(uint begin, uint end, uint target_blocks) {
-    uint target = target_blocks < 1u ? 1u : target_blocks;
-    target = target < kRadixSortTargetBlocks ? target : kRadixSortTargetBlocks;
+    uint target = RadixSortClampedTarget(target_blocks);
     uint first = begin / kRadixSortBlockSize;
     first = first > target ? first : target;
     uint last = begin < end ? (end - 1u) / kRadixSortBlockSize + 1u : 0u;
@@ -217,8 +226,7 @@ OPEN3D_SHADER_FUNC RadixSortParams RadixSortParamsFor(uint count, uint max_count
         count = max_count;
         p.flags = kErrorCountsClamped;
     }
-    uint target = target_blocks < 1u ? 1u : target_blocks;
-    target = target < kRadixSortTargetBlocks ? target : kRadixSortTargetBlocks;
+    uint target = RadixSortClampedTarget(target_blocks);
     uint wave = kRadixSortWorkgroupSize * target;
     uint chunks = (count + wave - 1u) / wave;
     chunks = chunks < 1u ? 1u : chunks;

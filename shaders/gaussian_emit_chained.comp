@@ -91,15 +91,10 @@ uint TileSortPasses() {
     return (view.tile_bits + kRadixSortDigitBits - 1u) / kRadixSortDigitBits;
 }
 
-// The bits of pass p's digit (RadixSortDigit): 8, fewer in a last pass over fewer bits.
-uint TileDigitBits(uint p) {
-    return min(kRadixSortDigitBits, view.tile_bits - p * kRadixSortDigitBits);
-}
-
 // Counts the keys first .. first + count - 1 (tiles, below 2^tile_bits).
 void CountTileRun(uint first, uint count) {
     // First pass: the keys take `count` consecutive digits modulo 2^bits.
-    uint bits = TileDigitBits(0u);
+    uint bits = RadixSortDigitBits(0u, view.tile_bits);
     uint m = 1u << bits;
     uint cycles = count >> bits;
     uint rest = count & (m - 1u);
@@ -119,10 +114,10 @@ void CountTileRun(uint first, uint count) {
     uint end = first + count;
     for (uint p = 1u; p < passes; ++p) {
         uint shift = p * kRadixSortDigitBits;
-        uint mask = (1u << TileDigitBits(p)) - 1u;
         for (uint t = first; t < end;) {
             uint next = min(((t >> shift) + 1u) << shift, end);
-            atomicAdd(s_digit_counts[p * kRadixSortBins + ((t >> shift) & mask)], next - t);
+            atomicAdd(s_digit_counts[p * kRadixSortBins + RadixSortDigit(t, p, view.tile_bits)],
+                      next - t);
             t = next;
         }
     }
@@ -324,7 +319,7 @@ void main() {
     // bin = slot (the words wrap modulo 2^32 but every sum is a count), and the whole cycles.
     uint unused_total;
     uint low = WorkgroupInclusiveAdd(s_low_diff[slot], unused_total);
-    if (slot < (1u << TileDigitBits(0u))) s_digit_counts[slot] += low + s_low_cycles;
+    if (slot < (1u << RadixSortDigitBits(0u, view.tile_bits))) s_digit_counts[slot] += low + s_low_cycles;
     uint passes = TileSortPasses();
     for (uint p = 0u; p < passes; ++p) {
         uint c = s_digit_counts[p * kRadixSortBins + slot];
